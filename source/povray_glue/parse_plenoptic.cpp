@@ -1,0 +1,361 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Parser for the body of `camera { plenoptic ... }`. Every value is checked while its
+// token is current, so POV-Ray's error names the file and line; cross-field checks run
+// when a block's closing brace is read. The optics themselves live in source/plenoptic/.
+
+#include <string>
+
+#include "backend/frame.h"
+#include "backend/parser/parse.h"
+#include "backend/scene/camera.h"
+#include "povray_glue/plenoptic_setup.h"
+
+#include "base/povdebug.h"
+
+namespace pov
+{
+
+namespace
+{
+
+const char *kPlenopticKeywords =
+	"main_lens { }, microlens_array { }, sensor { }, mm_per_unit, samples, confidence, variance, depth_map, "
+	"and the placement keywords of every camera (location, look_at, sky, right, up, direction, rotate, "
+	"translate, scale, matrix, transform)";
+const char *kMainLensKeywords = "thin_lens, pinhole, focal_length, f_number, aperture, focus_distance, distance";
+const char *kArrayKeywords = "hexagonal, rectangular, pitch, focal_length, focal_lengths, pinhole, distance, rotate, translate";
+const char *kSensorKeywords = "pixel_size, offset";
+
+}
+
+// Raises a parse error at the current token when a check returned a message.
+void Parser::Plenoptic_Check(const std::string& message)
+{
+	if (!message.empty())
+		Error("plenoptic camera: %s.", message.c_str());
+}
+
+// An unknown keyword inside one of our blocks is an error that names it and what is allowed.
+void Parser::Plenoptic_Unknown(const char *block, const char *allowed)
+{
+	const char *found = (Token.Token_String != NULL && Token.Token_String[0] != '\0') ? Token.Token_String : Get_Token_String(Token.Token_Id);
+	Error("plenoptic camera: '%s' is not a %s keyword; allowed: %s.", found, block, allowed);
+}
+
+DBL Parser::Plenoptic_Float(const char *keyword)
+{
+	DBL value = Parse_Float();
+	Plenoptic_Check(plenoptic::check_finite(keyword, value));
+	return value;
+}
+
+DBL Parser::Plenoptic_Length(const char *keyword)
+{
+	DBL value = Plenoptic_Float(keyword);
+	Plenoptic_Check(plenoptic::check_positive_length(keyword, value));
+	return value;
+}
+
+void Parser::Parse_Plenoptic_Main_Lens(plenoptic::CameraParams& params)
+{
+	plenoptic::MainLensParams& lens = params.main;
+	lens = plenoptic::MainLensParams();
+	lens.given = true;
+
+	Parse_Begin();
+	EXPECT
+		CASE (THIN_LENS_TOKEN)
+			lens.type = plenoptic::MainLensType::ThinLens;
+		END_CASE
+
+		CASE (PINHOLE_TOKEN)
+			lens.type = plenoptic::MainLensType::Pinhole;
+		END_CASE
+
+		CASE (FOCAL_LENGTH_TOKEN)
+			lens.focal_length_mm = Plenoptic_Length("main_lens focal_length");
+			lens.has_focal_length = true;
+		END_CASE
+
+		CASE (F_NUMBER_TOKEN)
+			lens.f_number = Plenoptic_Float("f_number");
+			Plenoptic_Check(plenoptic::check_f_number(lens.f_number));
+			lens.has_f_number = true;
+		END_CASE
+
+		CASE (APERTURE_TOKEN)
+			lens.aperture_mm = Plenoptic_Length("aperture");
+			lens.has_aperture = true;
+		END_CASE
+
+		CASE (FOCUS_DISTANCE_TOKEN)
+			lens.focus_distance_units = Plenoptic_Float("focus_distance");
+			Plenoptic_Check(plenoptic::check_focus_distance(lens.focus_distance_units));
+			lens.has_focus_distance = true;
+		END_CASE
+
+		CASE (DISTANCE_TOKEN)
+			lens.distance_mm = Plenoptic_Length("main_lens distance");
+			lens.has_distance = true;
+		END_CASE
+
+		CASE (RIGHT_CURLY_TOKEN)
+			UNGET
+			EXIT
+		END_CASE
+
+		OTHERWISE
+			Plenoptic_Unknown("main_lens", kMainLensKeywords);
+		END_CASE
+	END_EXPECT
+	// The closing brace is current: cross-field errors point at the end of the block.
+	Get_Token();
+	Plenoptic_Check(plenoptic::check_main_lens(lens, params.mm_per_unit));
+	UNGET
+	Parse_End();
+}
+
+void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
+{
+	plenoptic::ArrayParams& array = params.array;
+	array = plenoptic::ArrayParams();
+	array.given = true;
+	VECTOR v;
+
+	Parse_Begin();
+	EXPECT
+		CASE (HEXAGONAL_TOKEN)
+			array.grid = plenoptic::GridType::Hexagonal;
+		END_CASE
+
+		CASE (RECTANGULAR_TOKEN)
+			array.grid = plenoptic::GridType::Rectangular;
+		END_CASE
+
+		CASE (PITCH_TOKEN)
+			array.pitch_mm = Plenoptic_Length("pitch");
+			array.has_pitch = true;
+		END_CASE
+
+		CASE (FOCAL_LENGTH_TOKEN)
+			array.focal_lengths_mm[0] = Plenoptic_Length("microlens_array focal_length");
+			array.focal_length_count = 1;
+			array.lens = plenoptic::MicrolensType::ThinLens;
+			array.has_lens = true;
+		END_CASE
+
+		CASE (FOCAL_LENGTHS_TOKEN)
+			Parse_Vector(v);
+			for (int i = 0; i < 3; i++)
+			{
+				Plenoptic_Check(plenoptic::check_finite("focal_lengths", v[i]));
+				Plenoptic_Check(plenoptic::check_positive_length("focal_lengths", v[i]));
+				array.focal_lengths_mm[i] = v[i];
+			}
+			array.focal_length_count = 3;
+			array.lens = plenoptic::MicrolensType::ThinLens;
+			array.has_lens = true;
+		END_CASE
+
+		CASE (PINHOLE_TOKEN)
+			array.focal_length_count = 0;
+			array.lens = plenoptic::MicrolensType::Pinhole;
+			array.has_lens = true;
+		END_CASE
+
+		CASE (DISTANCE_TOKEN)
+			array.distance_mm = Plenoptic_Length("microlens_array distance");
+			array.has_distance = true;
+		END_CASE
+
+		CASE (ROTATE_TOKEN)
+			Parse_Vector(v);
+			for (int i = 0; i < 3; i++)
+				Plenoptic_Check(plenoptic::check_angle("microlens_array rotate", v[i]));
+			for (int i = 0; i < 3; i++)
+				array.rotate_deg[i] = v[i];
+		END_CASE
+
+		CASE (TRANSLATE_TOKEN)
+			Parse_Vector(v);
+			for (int i = 0; i < 3; i++)
+				Plenoptic_Check(plenoptic::check_translation("microlens_array translate", v[i]));
+			for (int i = 0; i < 3; i++)
+				array.translate_mm[i] = v[i];
+		END_CASE
+
+		CASE (RIGHT_CURLY_TOKEN)
+			UNGET
+			EXIT
+		END_CASE
+
+		OTHERWISE
+			Plenoptic_Unknown("microlens_array", kArrayKeywords);
+		END_CASE
+	END_EXPECT
+	Get_Token();
+	Plenoptic_Check(plenoptic::check_array(array));
+	UNGET
+	Parse_End();
+}
+
+void Parser::Parse_Plenoptic_Sensor(plenoptic::CameraParams& params)
+{
+	plenoptic::SensorParams& sensor = params.sensor;
+	UV_VECT uv;
+
+	Parse_Begin();
+	EXPECT
+		CASE (PIXEL_SIZE_TOKEN)
+			Parse_UV_Vect(uv);
+			for (int i = 0; i < 2; i++)
+			{
+				Plenoptic_Check(plenoptic::check_finite("pixel_size", uv[i]));
+				Plenoptic_Check(plenoptic::check_positive_length("pixel_size", uv[i]));
+			}
+			sensor.pixel_size_mm[0] = uv[U];
+			sensor.pixel_size_mm[1] = uv[V];
+		END_CASE
+
+		CASE (OFFSET_TOKEN)
+			Parse_UV_Vect(uv);
+			for (int i = 0; i < 2; i++)
+				Plenoptic_Check(plenoptic::check_translation("sensor offset", uv[i]));
+			sensor.offset_mm[0] = uv[U];
+			sensor.offset_mm[1] = uv[V];
+		END_CASE
+
+		CASE (RIGHT_CURLY_TOKEN)
+			UNGET
+			EXIT
+		END_CASE
+
+		OTHERWISE
+			Plenoptic_Unknown("sensor", kSensorKeywords);
+		END_CASE
+	END_EXPECT
+	Get_Token();
+	Plenoptic_Check(plenoptic::check_sensor(sensor));
+	UNGET
+	Parse_End();
+}
+
+// samples N            a fixed count
+// samples MIN, MAX     adaptive, stopping on confidence/variance as focal_blur does
+void Parser::Parse_Plenoptic_Samples(plenoptic::CameraParams& params)
+{
+	plenoptic::SamplingParams& sampling = params.sampling;
+	DBL first = Plenoptic_Float("samples");
+	Plenoptic_Check(plenoptic::check_samples("samples", first));
+	Parse_Comma();
+	DBL second = Allow_Float(0.0);
+	if (second == 0.0)
+	{
+		sampling.adaptive = false;
+		sampling.samples = (int)first;
+		return;
+	}
+	Plenoptic_Check(plenoptic::check_finite("samples maximum", second));
+	Plenoptic_Check(plenoptic::check_samples("samples maximum", second));
+	if (first > second)
+		Error("plenoptic camera: samples minimum (%g) must not be larger than the maximum (%g).", first, second);
+	sampling.adaptive = true;
+	sampling.samples_min = (int)first;
+	sampling.samples_max = (int)second;
+	sampling.samples = (int)second;
+}
+
+void Parser::Parse_Plenoptic_Camera(Camera& New)
+{
+	POV_TR1_NAMESPACE::shared_ptr<plenoptic::CameraSetup> setup(new plenoptic::CameraSetup());
+	plenoptic::CameraParams& params = setup->params;
+	// A camera declared earlier and modified here keeps its plenoptic parameters.
+	if (New.Plenoptic)
+	{
+		params = New.Plenoptic->params;
+		setup->depth_map = New.Plenoptic->depth_map;
+	}
+	DBL k;
+
+	EXPECT
+		CASE (MM_PER_UNIT_TOKEN)
+			k = Plenoptic_Float("mm_per_unit");
+			Plenoptic_Check(plenoptic::check_mm_per_unit(k));
+			params.mm_per_unit = k;
+		END_CASE
+
+		CASE (MAIN_LENS_TOKEN)
+			Parse_Plenoptic_Main_Lens(params);
+		END_CASE
+
+		CASE (MICROLENS_ARRAY_TOKEN)
+			Parse_Plenoptic_Array(params);
+		END_CASE
+
+		CASE (SENSOR_TOKEN)
+			Parse_Plenoptic_Sensor(params);
+		END_CASE
+
+		CASE (SAMPLES_TOKEN)
+			Parse_Plenoptic_Samples(params);
+		END_CASE
+
+		CASE (CONFIDENCE_TOKEN)
+			k = Plenoptic_Float("confidence");
+			Plenoptic_Check(plenoptic::check_confidence(k));
+			params.sampling.confidence = k;
+		END_CASE
+
+		CASE (VARIANCE_TOKEN)
+			k = Plenoptic_Float("variance");
+			Plenoptic_Check(plenoptic::check_variance(k));
+			params.sampling.variance = k;
+		END_CASE
+
+		CASE (DEPTH_MAP_TOKEN)
+			setup->depth_map = ((int)Allow_Float(1.0) != 0);
+		END_CASE
+
+		// Focal blur and field-of-view modifiers would silently mean nothing here.
+		CASE5 (APERTURE_TOKEN, BLUR_SAMPLES_TOKEN, FOCAL_POINT_TOKEN, BOKEH_TOKEN, ANGLE_TOKEN)
+			Error("plenoptic camera: '%s' does not apply to a plenoptic camera (the aperture, focus and field "
+			      "of view come from main_lens { }, microlens_array { } and sensor { }).",
+			      Get_Token_String(Token.Token_Id));
+		END_CASE
+
+		CASE (TNORMAL_TOKEN)
+			Error("plenoptic camera: 'normal' (ray perturbation) is not supported by the plenoptic camera.");
+		END_CASE
+
+		CASE6 (PERSPECTIVE_TOKEN, ORTHOGRAPHIC_TOKEN, FISHEYE_TOKEN, ULTRA_WIDE_ANGLE_TOKEN, OMNIMAX_TOKEN, PANORAMIC_TOKEN)
+		CASE3 (SPHERICAL_TOKEN, CYLINDER_TOKEN, MESH_CAMERA_TOKEN)
+			Expectation_Error("plenoptic camera modifier");
+		END_CASE
+
+		CASE (RIGHT_CURLY_TOKEN)
+			UNGET
+			EXIT
+		END_CASE
+
+		OTHERWISE
+			UNGET
+			if (Parse_Camera_Mods(New) == false)
+			{
+				Get_Token();
+				Plenoptic_Unknown("plenoptic camera", kPlenopticKeywords);
+			}
+		END_CASE
+	END_EXPECT
+
+	// The camera's closing brace is current for the checks across blocks.
+	Get_Token();
+	Plenoptic_Check(plenoptic::check_camera(params));
+	UNGET
+	setup->model = plenoptic::make_model(params);
+	std::vector<std::string> warnings = plenoptic::warnings(setup->model);
+	for (size_t i = 0; i < warnings.size(); i++)
+		Warning(0, "plenoptic camera: %s", warnings[i].c_str());
+	New.Plenoptic = setup;
+}
+
+}

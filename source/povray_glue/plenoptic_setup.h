@@ -1,0 +1,21 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// What the parser hands the renderer for a `camera { plenoptic ... }`: the checked
+// parameters, the model precomputed from them, and the requested ground-truth outputs.
+
+#ifndef POVRAY_GLUE_PLENOPTIC_SETUP_H
+#define POVRAY_GLUE_PLENOPTIC_SETUP_H
+
+#include "plenoptic/plenoptic_model.h"
+#include "plenoptic/plenoptic_params.h"
+
+namespace plenoptic {
+
+struct CameraSetup {
+    CameraParams params;
+    Model model;
+    bool depth_map = false;  // write <output>.depth.exr beside the image
+};
+
+} // namespace plenoptic
+
+#endif

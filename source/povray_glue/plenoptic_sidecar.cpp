@@ -1,0 +1,141 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Metadata and depth-map files beside a plenoptic render (see plenoptic_sidecar.h).
+
+#include "povray_glue/plenoptic_sidecar.h"
+
+#include <atomic>
+#include <cstdio>
+#include <mutex>
+#include <vector>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
+
+namespace plenoptic {
+
+namespace {
+
+struct Registration {
+    std::shared_ptr<const CameraSetup> setup;
+    CameraFrame frame;
+    int width = 0, height = 0;
+    std::vector<float> depth;
+};
+
+std::mutex registration_mutex;
+Registration registration;
+// The registration as every pixel reads it, without the lock.
+std::atomic<const CameraSetup*> registered_setup(nullptr);
+std::atomic<long long> registered_size(0);  // W * 2^32 + H
+std::atomic<float*> registered_depth(nullptr);
+
+std::string replace_extension(const std::string& path, const std::string& suffix)
+{
+    const size_t slash = path.find_last_of('/');
+    const size_t dot = path.find_last_of('.');
+    const bool has_ext = dot != std::string::npos && (slash == std::string::npos || dot > slash + 1);
+    return (has_ext ? path.substr(0, dot) : path) + suffix;
+}
+
+bool write_text_atomically(const std::string& path, const std::string& text)
+{
+    const std::string tmp = path + ".tmp";
+    FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (f == nullptr)
+        return false;
+    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
+        std::remove(tmp.c_str());
+        return false;
+    }
+    return true;
+}
+
+bool write_depth_exr(const std::string& path, const std::vector<float>& depth, int W, int H)
+{
+    const std::string tmp = path + ".tmp.exr";
+    try {
+        Imf::Header header(W, H);
+        header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+        Imf::OutputFile file(tmp.c_str(), header);
+        Imf::FrameBuffer buffer;
+        buffer.insert("Z", Imf::Slice(Imf::FLOAT, (char*)depth.data(), sizeof(float), sizeof(float) * W));
+        file.setFrameBuffer(buffer);
+        file.writePixels(H);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "plenoptic camera: cannot write depth map %s: %s\n", path.c_str(), e.what());
+        std::remove(tmp.c_str());
+        return false;
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+        std::remove(tmp.c_str());
+        return false;
+    }
+    return true;
+}
+
+std::string base_name(const std::string& path)
+{
+    const size_t slash = path.find_last_of('/');
+    return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+} // namespace
+
+std::string metadata_path_for(const std::string& image_path) { return replace_extension(image_path, ".plenoptic.json"); }
+std::string depth_path_for(const std::string& image_path) { return replace_extension(image_path, ".depth.exr"); }
+
+float* sidecar_register(const std::shared_ptr<const CameraSetup>& setup, const CameraFrame& frame, int W, int H)
+{
+    const long long size = ((long long)W << 32) + H;
+    if (registered_setup.load(std::memory_order_acquire) == setup.get() &&
+        registered_size.load(std::memory_order_acquire) == size)
+        return registered_depth.load(std::memory_order_acquire);
+    std::lock_guard<std::mutex> lock(registration_mutex);
+    if (registered_setup.load() != setup.get() || registered_size.load() != size) {
+        registration.setup = setup;
+        registration.frame = frame;
+        registration.width = W;
+        registration.height = H;
+        registration.depth.clear();
+        // -1 marks a pixel that no light reaches (and one not rendered, e.g. outside +SR/+ER).
+        if (setup->depth_map)
+            registration.depth.assign(size_t(W) * size_t(H), -1.0f);
+        registered_depth.store(registration.depth.empty() ? nullptr : registration.depth.data());
+        registered_size.store(size);
+        registered_setup.store(setup.get(), std::memory_order_release);
+    }
+    return registered_depth.load();
+}
+
+bool sidecar_write(const std::string& image_path, int W, int H)
+{
+    std::lock_guard<std::mutex> lock(registration_mutex);
+    if (!registration.setup)
+        return true;
+    bool ok = true;
+    std::string depth_file;
+    if (!registration.depth.empty() && W == registration.width && H == registration.height) {
+        const std::string depth_path = depth_path_for(image_path);
+        if (write_depth_exr(depth_path, registration.depth, W, H))
+            depth_file = base_name(depth_path);
+        else
+            ok = false;
+    }
+    const std::string json = metadata_json(registration.setup->model, registration.setup->params, W, H,
+                                           registration.frame, depth_file);
+    const std::string metadata_path = metadata_path_for(image_path);
+    if (!write_text_atomically(metadata_path, json)) {
+        std::fprintf(stderr, "plenoptic camera: cannot write metadata %s\n", metadata_path.c_str());
+        ok = false;
+    }
+    registered_setup.store(nullptr);
+    registered_depth.store(nullptr);
+    registered_size.store(0);
+    registration = Registration();
+    return ok;
+}
+
+} // namespace plenoptic

@@ -1,0 +1,34 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Ground truth written beside a plenoptic render: the metadata JSON and, on request, the
+// depth map. The renderer registers its camera and fills the depth buffer; the front end
+// calls sidecar_write() right after it has written the image, so a render that never
+// writes its image leaves no metadata behind.
+
+#ifndef POVRAY_GLUE_PLENOPTIC_SIDECAR_H
+#define POVRAY_GLUE_PLENOPTIC_SIDECAR_H
+
+#include <memory>
+#include <string>
+
+#include "plenoptic/plenoptic_metadata.h"
+#include "povray_glue/plenoptic_setup.h"
+
+namespace plenoptic {
+
+// Names of the files beside an image `dir/name.ext`.
+std::string metadata_path_for(const std::string& image_path);  // dir/name.plenoptic.json
+std::string depth_path_for(const std::string& image_path);     // dir/name.depth.exr
+
+// Called by every render thread before its first plenoptic pixel; cheap after the first call.
+// Returns the depth buffer (W*H floats, row-major, top row first) when the camera asked for a
+// depth map, else nullptr.
+float* sidecar_register(const std::shared_ptr<const CameraSetup>& setup, const CameraFrame& frame, int W, int H);
+
+// Writes the files for the image just written (if a plenoptic camera rendered it) and forgets
+// the registration. Returns false, with a message on stderr, when a file could not be written;
+// files are written to a temporary name and renamed, never left half-written.
+bool sidecar_write(const std::string& image_path, int W, int H);
+
+} // namespace plenoptic
+
+#endif
