@@ -42,6 +42,13 @@ void Parser::Plenoptic_Unknown(const char *block, const char *allowed)
 	Error("plenoptic camera: '%s' is not a %s keyword; allowed: %s.", found, block, allowed);
 }
 
+// A microlens array has one kind of lens: pinhole, focal_length or focal_lengths.
+void Parser::Plenoptic_One_Lens_Kind(bool already_given)
+{
+	if (already_given)
+		Error("plenoptic camera: microlens_array takes one of pinhole, focal_length or focal_lengths, not several.");
+}
+
 DBL Parser::Plenoptic_Float(const char *keyword)
 {
 	DBL value = Parse_Float();
@@ -64,12 +71,10 @@ void Parser::Parse_Plenoptic_Main_Lens(plenoptic::CameraParams& params)
 
 	Parse_Begin();
 	EXPECT
-		CASE (THIN_LENS_TOKEN)
-			lens.type = plenoptic::MainLensType::ThinLens;
-		END_CASE
-
-		CASE (PINHOLE_TOKEN)
-			lens.type = plenoptic::MainLensType::Pinhole;
+		CASE2 (THIN_LENS_TOKEN, PINHOLE_TOKEN)
+			if (lens.type != plenoptic::MainLensType::None)
+				Error("plenoptic camera: main_lens takes one of thin_lens or pinhole, not both.");
+			lens.type = (Token.Token_Id == THIN_LENS_TOKEN) ? plenoptic::MainLensType::ThinLens : plenoptic::MainLensType::Pinhole;
 		END_CASE
 
 		CASE (FOCAL_LENGTH_TOKEN)
@@ -124,12 +129,10 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 
 	Parse_Begin();
 	EXPECT
-		CASE (HEXAGONAL_TOKEN)
-			array.grid = plenoptic::GridType::Hexagonal;
-		END_CASE
-
-		CASE (RECTANGULAR_TOKEN)
-			array.grid = plenoptic::GridType::Rectangular;
+		CASE2 (HEXAGONAL_TOKEN, RECTANGULAR_TOKEN)
+			if (array.grid != plenoptic::GridType::None)
+				Error("plenoptic camera: microlens_array takes one of hexagonal or rectangular, not both.");
+			array.grid = (Token.Token_Id == HEXAGONAL_TOKEN) ? plenoptic::GridType::Hexagonal : plenoptic::GridType::Rectangular;
 		END_CASE
 
 		CASE (PITCH_TOKEN)
@@ -138,6 +141,7 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 		END_CASE
 
 		CASE (FOCAL_LENGTH_TOKEN)
+			Plenoptic_One_Lens_Kind(array.has_lens);
 			array.focal_lengths_mm[0] = Plenoptic_Length("microlens_array focal_length");
 			array.focal_length_count = 1;
 			array.lens = plenoptic::MicrolensType::ThinLens;
@@ -145,6 +149,7 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 		END_CASE
 
 		CASE (FOCAL_LENGTHS_TOKEN)
+			Plenoptic_One_Lens_Kind(array.has_lens);
 			Parse_Vector(v);
 			for (int i = 0; i < 3; i++)
 			{
@@ -158,6 +163,7 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 		END_CASE
 
 		CASE (PINHOLE_TOKEN)
+			Plenoptic_One_Lens_Kind(array.has_lens);
 			array.focal_length_count = 0;
 			array.lens = plenoptic::MicrolensType::Pinhole;
 			array.has_lens = true;

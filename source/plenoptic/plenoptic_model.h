@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The plenoptic camera model: everything precomputed once from checked parameters.
+
+#ifndef PLENOPTIC_MODEL_H
+#define PLENOPTIC_MODEL_H
+
+#include <string>
+#include <vector>
+
+#include "plenoptic_params.h"
+#include "plenoptic_vec.h"
+
+namespace plenoptic {
+
+// Most rings of neighbouring lenses whose light a pixel may receive when microimages overlap.
+const int kMaxOverlapRings = 8;
+// Lenses in that many rings of a rectangular grid (the larger of the two grids): (2*8+1)^2.
+const int kMaxOverlapLenses = (2 * kMaxOverlapRings + 1) * (2 * kMaxOverlapRings + 1);
+
+// Pose of the microlens array in the optics frame: q_optics = centre_mm + rotation * q_local.
+struct ArrayPose {
+    Mat3 rotation;   // array-local -> optics frame, Rz * Ry * Rx
+    Vec3 centre_mm;  // where the array's lens (0, 0) sits
+    Vec3 normal;     // rotation * (0, 0, 1): towards the scene
+    bool tilted;     // rotated about x or y: the array plane is not parallel to the sensor
+    double tilt_sine;// sine of the angle between the array's normal and the optical axis
+};
+
+// Above this tilt (sine of the angle, about 11.5 degrees) a pixel's overlap lenses are not pruned.
+const double kMaxPrunedTiltSine = 0.2;
+
+// Optics frame: origin at the main-lens centre (the array centre when there is no main lens),
+// +z towards the scene, +x right, +y up; millimetres throughout.
+struct Model {
+    double mm_per_unit;
+
+    MainLensType main_lens;
+    double focal_length_mm;      // F; 0 unless thin lens
+    double aperture_mm;          // A (diameter); 0 unless thin lens
+    double f_number;             // F / A; 0 unless thin lens
+    double distance_mm;          // D; 0 without main lens
+    bool has_focus_distance;     // D came from focus_distance
+    double focus_distance_units; // as given; 0 when D was given directly
+
+    GridType grid;               // None: no microlens array
+    double pitch_mm;
+    MicrolensType microlens;
+    int lens_type_count;         // 1, or 3 for multi-focus arrays
+    double microlens_focal_mm[3];// per lens type; 0 for pinholes
+    double array_distance_mm;    // d; 0 without array
+    ArrayPose pose;
+    double cell_inradius_mm;     // of a lens's lattice cell
+    double cell_circumradius_mm;
+
+    double sensor_z_mm;          // -(D + d); -D without array; -d without main lens
+    double pixel_size_mm[2];
+    double sensor_offset_mm[2];
+
+    // Overlapping microimages: modelled only when the parameters make overlap possible.
+    bool model_overlap;
+    int overlap_rings;           // rings of neighbours a pixel may receive light through
+    bool overlap_rings_capped;   // the bound asked for more than kMaxOverlapRings
+
+    bool adaptive;
+    int samples_min;             // == samples_max when not adaptive
+    int samples_max;
+    double confidence;
+    double variance;
+    std::vector<double> thresholds; // adaptive stop thresholds, index n-1 for n samples
+};
+
+// Builds the model from parameters that passed check_camera. Pure: no image size, no state.
+Model make_model(const CameraParams& params);
+
+// Legal but implausible parameters, one sentence each (empty when nothing is odd).
+std::vector<std::string> warnings(const Model& model);
+
+// Rotation about x, then y, then z, in degrees: v -> Rz * Ry * Rx * v, with the same
+// matrices as POV-Ray's Compute_Rotation_Transform (which applies them to row vectors).
+// Multiples of 90 degrees are exact.
+Mat3 rotation_from_degrees(const double degrees[3]);
+
+// Main-lens -> array and array -> sensor distances measured at the array centre, including the
+// array's z translation. Without a main lens the first is 0.
+double effective_main_distance_mm(const Model& model);
+double effective_array_distance_mm(const Model& model);
+
+} // namespace plenoptic
+
+#endif

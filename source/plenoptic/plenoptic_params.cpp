@@ -1,0 +1,344 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Parse-time checks of the plenoptic camera's parameters: per value and per block.
+
+#include "plenoptic_params.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "plenoptic_model.h"
+
+namespace plenoptic {
+
+std::string format_number(double value)
+{
+    if (std::isnan(value))
+        return "nan";
+    if (std::isinf(value))
+        return value > 0 ? "inf" : "-inf";
+    char buffer[40];
+    // The shortest of %.15g .. %.17g that reads back exactly: "0.1", not "0.10000000000000001".
+    for (int precision = 15; precision <= 17; ++precision) {
+        std::snprintf(buffer, sizeof buffer, "%.*g", precision, value);
+        if (std::strtod(buffer, nullptr) == value)
+            break;
+    }
+    return buffer;
+}
+
+namespace {
+
+std::string str(const char* text) { return std::string(text); }
+
+bool is_whole(double value) { return std::floor(value) == value; }
+
+} // namespace
+
+std::string check_finite(const char* keyword, double value)
+{
+    if (std::isfinite(value))
+        return "";
+    return str(keyword) + " must be a finite number, got " + format_number(value);
+}
+
+std::string check_positive_length(const char* keyword, double value_mm)
+{
+    std::string finite = check_finite(keyword, value_mm);
+    if (!finite.empty())
+        return finite;
+    if (value_mm > 0)
+        return "";
+    return str(keyword) + " must be a positive length in mm (> 0), got " + format_number(value_mm);
+}
+
+std::string check_f_number(double value)
+{
+    std::string finite = check_finite("f_number", value);
+    if (!finite.empty())
+        return finite;
+    if (value > 0)
+        return "";
+    return "f_number must be positive (> 0), got " + format_number(value);
+}
+
+std::string check_mm_per_unit(double value)
+{
+    std::string finite = check_finite("mm_per_unit", value);
+    if (!finite.empty())
+        return finite;
+    if (value > 0)
+        return "";
+    return "mm_per_unit must be a positive number of millimetres per scene unit (> 0), got " +
+           format_number(value);
+}
+
+std::string check_focus_distance(double value_units)
+{
+    std::string finite = check_finite("focus_distance", value_units);
+    if (!finite.empty())
+        return finite;
+    if (value_units > 0)
+        return "";
+    return "focus_distance must be a positive distance in scene units (> 0), got " +
+           format_number(value_units);
+}
+
+std::string check_angle(const char* keyword, double degrees)
+{
+    if (std::isfinite(degrees))
+        return "";
+    return str(keyword) + " must be a finite angle in degrees, got " + format_number(degrees);
+}
+
+std::string check_translation(const char* keyword, double value_mm)
+{
+    if (std::isfinite(value_mm))
+        return "";
+    return str(keyword) + " must be a finite length in mm, got " + format_number(value_mm);
+}
+
+std::string check_samples(const char* keyword, double value)
+{
+    if (std::isfinite(value) && is_whole(value) && value >= 1 && value <= kMaxSamples)
+        return "";
+    return str(keyword) + " must be a whole number from 1 to " + std::to_string(kMaxSamples) +
+           ", got " + format_number(value);
+}
+
+std::string check_confidence(double value)
+{
+    std::string finite = check_finite("confidence", value);
+    if (!finite.empty())
+        return finite;
+    if (value > 0 && value < 1)
+        return "";
+    return "confidence must be between 0 and 1 (0 < confidence < 1), got " + format_number(value);
+}
+
+std::string check_variance(double value)
+{
+    std::string finite = check_finite("variance", value);
+    if (!finite.empty())
+        return finite;
+    if (value > 0)
+        return "";
+    return "variance must be positive (> 0), got " + format_number(value);
+}
+
+std::string check_main_lens(const MainLensParams& main, double mm_per_unit)
+{
+    if (!main.given)
+        return "";
+    if (main.type == MainLensType::None)
+        return "main_lens needs thin_lens or pinhole";
+
+    // Values again: a backstop for a caller that filled the struct without the token checks.
+    std::string message;
+    if (main.has_focal_length && !(message = check_positive_length("focal_length", main.focal_length_mm)).empty())
+        return message;
+    if (main.has_f_number && !(message = check_f_number(main.f_number)).empty())
+        return message;
+    if (main.has_aperture && !(message = check_positive_length("aperture", main.aperture_mm)).empty())
+        return message;
+    if (main.has_focus_distance && !(message = check_focus_distance(main.focus_distance_units)).empty())
+        return message;
+    if (main.has_distance && !(message = check_positive_length("distance", main.distance_mm)).empty())
+        return message;
+
+    if (main.has_focus_distance && main.has_distance)
+        return "main_lens: give focus_distance or distance, not both";
+
+    if (main.type == MainLensType::Pinhole) {
+        // A pinhole has no focal length, so neither can it focus nor have an f-number.
+        if (main.has_focal_length)
+            return "main_lens pinhole takes no focal_length (a pinhole has no focal length); "
+                   "give distance (D in mm) only";
+        if (main.has_f_number)
+            return "main_lens pinhole takes no f_number (a pinhole has no aperture to size); "
+                   "give distance (D in mm) only";
+        if (main.has_aperture)
+            return "main_lens pinhole takes no aperture (a pinhole has no aperture to size); "
+                   "give distance (D in mm) only";
+        if (main.has_focus_distance)
+            return "main_lens pinhole takes distance (D in mm), not focus_distance: "
+                   "a pinhole has no focal length to focus with";
+        if (!main.has_distance)
+            return "main_lens pinhole needs distance (D: main lens to microlens array, "
+                   "or to the sensor when there is no array, in mm)";
+        return "";
+    }
+
+    if (!main.has_focal_length)
+        return "main_lens thin_lens needs focal_length (F in mm)";
+    if (main.has_f_number && main.has_aperture)
+        return "main_lens: give f_number or aperture, not both";
+    if (!main.has_f_number && !main.has_aperture)
+        return "main_lens thin_lens needs f_number or aperture (exactly one of the two)";
+    if (!main.has_focus_distance && !main.has_distance)
+        return "main_lens thin_lens needs focus_distance (scene units) or distance (D in mm)";
+    if (main.has_f_number) {
+        const double aperture = main.focal_length_mm / main.f_number;
+        if (!(std::isfinite(aperture) && aperture > 0))
+            return "main_lens: focal_length " + format_number(main.focal_length_mm) + " mm / f_number " +
+                   format_number(main.f_number) + " gives an unusable aperture of " +
+                   format_number(aperture) + " mm";
+    }
+    if (main.has_focus_distance) {
+        std::string scale = check_mm_per_unit(mm_per_unit);
+        if (!scale.empty())
+            return scale;
+        const double z_mm = main.focus_distance_units * mm_per_unit;
+        if (!(z_mm > main.focal_length_mm))
+            return "focus_distance " + format_number(main.focus_distance_units) + " (" +
+                   format_number(z_mm) + " mm at mm_per_unit " + format_number(mm_per_unit) +
+                   ") is at or inside the focal length " + format_number(main.focal_length_mm) +
+                   " mm; it must be greater than " + format_number(main.focal_length_mm / mm_per_unit) +
+                   " scene units";
+    }
+    return "";
+}
+
+std::string check_array(const ArrayParams& array)
+{
+    if (!array.given)
+        return "";
+    if (array.grid == GridType::None)
+        return "microlens_array needs rectangular or hexagonal";
+    if (!array.has_pitch)
+        return "microlens_array needs pitch (lens centre to centre, mm)";
+    std::string message = check_positive_length("pitch", array.pitch_mm);
+    if (!message.empty())
+        return message;
+    if (!array.has_lens)
+        return "microlens_array needs focal_length, focal_lengths or pinhole";
+    if (array.lens == MicrolensType::Pinhole && array.focal_length_count != 0)
+        return "microlens_array: give pinhole or focal_length(s), not both";
+    if (array.lens == MicrolensType::ThinLens && array.focal_length_count != 1 && array.focal_length_count != 3)
+        return "microlens_array focal_lengths must have exactly 3 values (one per lens type), got " +
+               std::to_string(array.focal_length_count);
+    if (array.focal_length_count == 3 && array.grid != GridType::Hexagonal)
+        return "microlens_array focal_lengths (three interleaved lens types) needs a hexagonal grid; "
+               "a rectangular grid takes a single focal_length";
+    for (int i = 0; i < array.focal_length_count; ++i) {
+        message = check_positive_length(array.focal_length_count == 1 ? "focal_length" : "focal_lengths",
+                                        array.focal_lengths_mm[i]);
+        if (!message.empty())
+            return message;
+    }
+    if (!array.has_distance)
+        return "microlens_array needs distance (d: microlens array to sensor, mm)";
+    message = check_positive_length("distance", array.distance_mm);
+    if (!message.empty())
+        return message;
+    for (int i = 0; i < 3; ++i) {
+        if (!(message = check_angle("rotate", array.rotate_deg[i])).empty())
+            return message;
+        if (!(message = check_translation("translate", array.translate_mm[i])).empty())
+            return message;
+    }
+    return "";
+}
+
+std::string check_sensor(const SensorParams& sensor)
+{
+    std::string message;
+    for (int i = 0; i < 2; ++i) {
+        if (!(message = check_positive_length("pixel_size", sensor.pixel_size_mm[i])).empty())
+            return message;
+        if (!(message = check_translation("offset", sensor.offset_mm[i])).empty())
+            return message;
+    }
+    return "";
+}
+
+std::string check_sampling(const SamplingParams& sampling)
+{
+    std::string message;
+    if (!sampling.adaptive)
+        return check_samples("samples", sampling.samples);
+    if (!(message = check_samples("samples (minimum)", sampling.samples_min)).empty())
+        return message;
+    if (!(message = check_samples("samples (maximum)", sampling.samples_max)).empty())
+        return message;
+    if (sampling.samples_max < sampling.samples_min)
+        return "samples: the maximum (" + std::to_string(sampling.samples_max) +
+               ") must not be less than the minimum (" + std::to_string(sampling.samples_min) + ")";
+    if (!(message = check_confidence(sampling.confidence)).empty())
+        return message;
+    return check_variance(sampling.variance);
+}
+
+std::string check_camera(const CameraParams& camera)
+{
+    std::string message;
+    if (!(message = check_mm_per_unit(camera.mm_per_unit)).empty())
+        return message;
+    if (!(message = check_main_lens(camera.main, camera.mm_per_unit)).empty())
+        return message;
+    if (!(message = check_array(camera.array)).empty())
+        return message;
+    if (!(message = check_sensor(camera.sensor)).empty())
+        return message;
+    if (!(message = check_sampling(camera.sampling)).empty())
+        return message;
+
+    const bool has_main = camera.main.given;
+    const bool has_array = camera.array.given;
+    if (!has_main && !has_array)
+        return "plenoptic camera needs a main_lens block, a microlens_array block, or both";
+    if (!has_array)
+        return "";
+
+    const ArrayParams& array = camera.array;
+    if (has_main && camera.main.type == MainLensType::Pinhole && array.lens == MicrolensType::Pinhole)
+        return "a pinhole main_lens with a pinhole microlens_array is degenerate: no light reaches the "
+               "sensor (a ray would have to pass two points and the pixel at once); make one of them "
+               "a thin lens";
+
+    const Mat3 rotation = rotation_from_degrees(array.rotate_deg);
+    // The array's normal must face the scene; edge-on or reversed arrays pass no light.
+    if (!(rotation.m[2][2] > 0))
+        return "microlens_array rotate <" + format_number(array.rotate_deg[0]) + ", " +
+               format_number(array.rotate_deg[1]) + ", " + format_number(array.rotate_deg[2]) +
+               "> turns the array edge-on or backwards; its tilt about x and y must stay below 90 degrees";
+
+    // The array must stay between the main lens and the sensor (at its centre).
+    const double tz = array.translate_mm[2];
+    const double d_eff = array.distance_mm + tz;
+    if (!(d_eff > 0))
+        return "microlens_array translate z = " + format_number(tz) + " mm moves the array onto or behind "
+               "the sensor (distance d = " + format_number(array.distance_mm) + " mm)";
+    if (!has_main)
+        return "";
+
+    double main_distance = camera.main.distance_mm;
+    if (camera.main.type == MainLensType::ThinLens && camera.main.has_focus_distance) {
+        const double z_mm = camera.main.focus_distance_units * camera.mm_per_unit;
+        const double f = camera.main.focal_length_mm;
+        main_distance = f / (1.0 - f / z_mm);
+    }
+    const double main_eff = main_distance - tz;
+    if (!(main_eff > 0))
+        return "microlens_array translate z = " + format_number(tz) + " mm moves the array onto or in front "
+               "of the main lens (distance D = " + format_number(main_distance) + " mm)";
+
+    // Pinhole main lens: a thin microlens that images the sensor plane onto the pinhole sends every
+    // ray from a sensor point back to that point, so only one point per microimage would be lit.
+    const bool tilted = !(rotation.m[0][2] == 0 && rotation.m[1][2] == 0);
+    if (camera.main.type == MainLensType::Pinhole && array.lens == MicrolensType::ThinLens && !tilted) {
+        for (int i = 0; i < array.focal_length_count; ++i) {
+            const double f = array.focal_lengths_mm[i];
+            const double g = 1.0 + main_eff / d_eff - main_eff / f;
+            const double scale = 1.0 + main_eff / d_eff + main_eff / f;
+            if (std::fabs(g) <= 1e-12 * scale)
+                return "pinhole main_lens with microlens focal length " + format_number(f) +
+                       " mm at D = " + format_number(main_eff) + " mm and d = " + format_number(d_eff) +
+                       " mm is degenerate: the microlenses image the sensor onto the pinhole "
+                       "(1/D + 1/d = 1/f), so no light reaches the sensor; change distance or focal_length";
+        }
+    }
+    return "";
+}
+
+} // namespace plenoptic

@@ -1,0 +1,112 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Parameters of the plenoptic camera as the parser fills them, and the checks that refuse bad input.
+
+#ifndef PLENOPTIC_PARAMS_H
+#define PLENOPTIC_PARAMS_H
+
+#include <string>
+
+namespace plenoptic {
+
+enum class MainLensType { None, Pinhole, ThinLens };
+enum class GridType { None, Rectangular, Hexagonal };
+enum class MicrolensType { Pinhole, ThinLens };
+
+// Defaults for keywords the user may omit.
+const double kDefaultMmPerUnit = 1000.0;     // one scene unit is one metre
+const double kDefaultPixelSizeMm = 0.01;
+const double kDefaultSensorOffsetMm = 0.0;
+// Rays per pixel when `samples` is omitted. A named constant because a benchmark will pick it;
+// 1 gives the chief ray of each pixel (pixel centre, aperture centre).
+const int kDefaultSamples = 1;
+const double kDefaultConfidence = 0.9;       // as focal_blur
+const double kDefaultVariance = 1.0 / 128.0; // as focal_blur
+// Upper bound of `samples`: keeps every count an int and a render finite.
+const int kMaxSamples = 1000000;
+
+// main_lens { ... }. `given` is false when the scene has no main_lens block (type stays None).
+struct MainLensParams {
+    bool given = false;
+    MainLensType type = MainLensType::None; // None inside a given block: no thin_lens/pinhole keyword
+    bool has_focal_length = false;
+    double focal_length_mm = 0;             // F
+    bool has_f_number = false;
+    double f_number = 0;                    // N = F / A
+    bool has_aperture = false;
+    double aperture_mm = 0;                 // A, diameter
+    bool has_focus_distance = false;
+    double focus_distance_units = 0;        // scene units in front of the lens
+    bool has_distance = false;
+    double distance_mm = 0;                 // D: main lens -> array (-> sensor without array)
+};
+
+// microlens_array { ... }. `given` is false when the scene has no array (grid stays None).
+struct ArrayParams {
+    bool given = false;
+    GridType grid = GridType::None;         // None inside a given block: no grid keyword
+    bool has_pitch = false;
+    double pitch_mm = 0;
+    bool has_lens = false;                  // one of pinhole / focal_length / focal_lengths was read
+    MicrolensType lens = MicrolensType::Pinhole;
+    int focal_length_count = 0;             // 0 = pinhole, 1 = focal_length, 3 = focal_lengths
+    double focal_lengths_mm[3] = {0, 0, 0};
+    bool has_distance = false;
+    double distance_mm = 0;                 // d: array -> sensor
+    double rotate_deg[3] = {0, 0, 0};       // about x, then y, then z (POV-Ray's order)
+    double translate_mm[3] = {0, 0, 0};     // camera frame, after the rotation
+};
+
+struct SensorParams {
+    double pixel_size_mm[2] = {kDefaultPixelSizeMm, kDefaultPixelSizeMm};
+    double offset_mm[2] = {kDefaultSensorOffsetMm, kDefaultSensorOffsetMm};
+};
+
+// `samples N` gives adaptive = false and samples = N.
+// `samples MIN, MAX [confidence C] [variance V]` gives adaptive = true.
+struct SamplingParams {
+    int samples = kDefaultSamples;
+    bool adaptive = false;
+    int samples_min = 0;
+    int samples_max = 0;
+    double confidence = kDefaultConfidence;
+    double variance = kDefaultVariance;
+};
+
+struct CameraParams {
+    double mm_per_unit = kDefaultMmPerUnit;
+    MainLensParams main;
+    ArrayParams array;
+    SensorParams sensor;
+    SamplingParams sampling;
+};
+
+// ---- Per-value checks, called by the parser while the token is current. ----
+// Each returns "" when the value is fine, else a complete message naming the keyword,
+// the value and the valid range.
+
+std::string check_finite(const char* keyword, double value);
+std::string check_positive_length(const char* keyword, double value_mm);  // pitch, focal_length, ...
+std::string check_f_number(double value);
+std::string check_mm_per_unit(double value);
+std::string check_focus_distance(double value_units);
+std::string check_angle(const char* keyword, double degrees);             // rotate components
+std::string check_translation(const char* keyword, double value_mm);      // translate, offset
+std::string check_samples(const char* keyword, double value);             // a whole number 1..kMaxSamples
+std::string check_confidence(double value);
+std::string check_variance(double value);
+
+// ---- Cross-field checks, run when a block's closing brace is read. ----
+std::string check_main_lens(const MainLensParams& main, double mm_per_unit);
+std::string check_array(const ArrayParams& array);
+std::string check_sensor(const SensorParams& sensor);
+std::string check_sampling(const SamplingParams& sampling);
+// The whole camera, run when the camera's closing brace is read. Runs the block checks again
+// (cheap), then the checks that need several blocks at once.
+std::string check_camera(const CameraParams& camera);
+
+// Shortest text that reads back as the same double ("0.5", "1e-300", "nan").
+std::string format_number(double value);
+
+} // namespace plenoptic
+
+#endif

@@ -1,0 +1,120 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The per-pixel sample loop of the plenoptic camera: fixed or adaptive, with overlap weighting.
+
+#ifndef PLENOPTIC_PIXEL_H
+#define PLENOPTIC_PIXEL_H
+
+#include <algorithm>
+
+#include "plenoptic_optics.h"
+
+namespace plenoptic {
+
+struct Rgbt {
+    double r, g, b, t;
+};
+
+namespace detail {
+
+// Running sums of one lens's samples.
+struct SampleSums {
+    double sum[4];
+    double sum_sq[4];
+    int count;
+};
+
+inline void add_sample(SampleSums* s, const Rgbt& c)
+{
+    const double v[4] = {c.r, c.g, c.b, c.t};
+    for (int ch = 0; ch < 4; ++ch) {
+        s->sum[ch] += v[ch];
+        s->sum_sq[ch] += v[ch] * v[ch];
+    }
+    ++s->count;
+}
+
+// The pixel value and, per channel, the variance of that estimate. One lens: the mean of its
+// samples. Several lenses: the sum over lenses of the mean over each lens's samples (irradiance
+// adds), scaled up when fewer samples than lenses left some lens without a sample.
+inline void estimate(const SampleSums* sums, int lenses, double value[4], double variance[4])
+{
+    int sampled = 0;
+    for (int ch = 0; ch < 4; ++ch)
+        value[ch] = variance[ch] = 0;
+    for (int s = 0; s < lenses; ++s) {
+        const int n = sums[s].count;
+        if (n == 0)
+            continue;
+        ++sampled;
+        for (int ch = 0; ch < 4; ++ch) {
+            const double mean = sums[s].sum[ch] / n;
+            value[ch] += mean;
+            // Variance of the mean, as focal_blur computes it: (E[x^2] - E[x]^2) / n.
+            variance[ch] += (sums[s].sum_sq[ch] / n - mean * mean) / n;
+        }
+    }
+    if (sampled == 0)
+        return;
+    const double scale = double(lenses) / sampled;
+    for (int ch = 0; ch < 4; ++ch) {
+        value[ch] *= scale;
+        variance[ch] *= scale * scale;
+    }
+}
+
+} // namespace detail
+
+// Shades pixel (i, j) of a W x H image. For each sample it builds the sample, generates the ray
+// and calls trace(const OpticsRay&) -> Rgbt for unblocked rays only; a blocked sample counts as
+// black and opaque (0, 0, 0, t = 0). Fixed count: model.samples_max samples. Adaptive (as
+// focal_blur): samples_min samples, then batches of 4, stopping once the variance of the
+// estimate is below thresholds[n-1] in every channel (r, g, b, t) or samples_max is reached.
+// With overlap modelling, sample n goes through the pixel's lens n mod L (L lenses from
+// overlap_lenses) and the value is the sum over lenses of each lens's mean; t is clamped to
+// [0, 1]. A pixel that no lens reaches is black and opaque, never background.
+template <class TraceFn>
+Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
+{
+    LensIndex lenses[kMaxOverlapLenses];
+    int lens_count = 1;
+    if (model.model_overlap) {
+        lens_count = overlap_lenses(model, W, H, i, j, lenses, kMaxOverlapLenses);
+        if (lens_count == 0)
+            return Rgbt{0, 0, 0, 0};
+    }
+    detail::SampleSums sums[kMaxOverlapLenses];
+    for (int s = 0; s < lens_count; ++s)
+        sums[s] = detail::SampleSums{{0, 0, 0, 0}, {0, 0, 0, 0}, 0};
+
+    const int count = std::max(1, model.samples_max);
+    int batch = model.adaptive ? std::max(1, model.samples_min) : count;
+    double value[4], variance[4];
+    int n = 0;
+    for (;;) {
+        const int stop = std::min(count, n + batch);
+        for (; n < stop; ++n) {
+            const int slot = model.model_overlap ? n % lens_count : 0;
+            const CameraSample sample = make_sample(i, j, n, count);
+            OpticsRay ray;
+            Rgbt colour{0, 0, 0, 0};
+            if (generate_ray(model, W, H, i, j, sample, model.model_overlap ? &lenses[slot] : nullptr, &ray))
+                colour = trace(static_cast<const OpticsRay&>(ray));
+            detail::add_sample(&sums[slot], colour);
+        }
+        if (!model.adaptive || n >= count)
+            break;
+        detail::estimate(sums, lens_count, value, variance);
+        const double threshold = model.thresholds[n - 1];
+        if (std::fabs(variance[0]) < threshold && std::fabs(variance[1]) < threshold &&
+            std::fabs(variance[2]) < threshold && std::fabs(variance[3]) < threshold)
+            break;
+        batch = 4;
+    }
+    detail::estimate(sums, lens_count, value, variance);
+    const double t = lens_count > 1 ? std::min(1.0, std::max(0.0, value[3])) : value[3];
+    return Rgbt{value[0], value[1], value[2], t};
+}
+
+} // namespace plenoptic
+
+#endif

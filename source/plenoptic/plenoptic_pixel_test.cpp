@@ -1,0 +1,178 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Tests of the pixel loop: blocked samples, adaptive stop, determinism, overlap weighting.
+
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "plenoptic_pixel.h"
+#include "plenoptic_test_util.h"
+
+namespace plenoptic {
+namespace {
+
+using test::plenoptic_camera;
+
+// A scene whose radiance depends on the ray: enough structure to tell samples apart.
+Rgbt textured(const OpticsRay& ray)
+{
+    const double a = std::sin(40 * ray.dir[0]) * std::cos(30 * ray.dir[1]);
+    return Rgbt{0.5 + 0.5 * a, 0.25 + 0.1 * ray.origin_mm[0], 0.5 - 0.5 * a, 0.0};
+}
+
+TEST(Pixel, BlockedSamplesAreBlackAndOpaqueNeverBackground)
+{
+    // Pinhole array behind a small main aperture: small microimage discs, dark cells between.
+    CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.5, 0, 2, 50, 50, 52);
+    params.sampling.samples = 16;
+    const Model m = make_model(params);
+    const int W = 101, H = 101;
+    int calls = 0;
+    // The scene returns fully transparent background for every ray it is asked about.
+    auto background = [&](const OpticsRay&) {
+        ++calls;
+        return Rgbt{1, 1, 1, 1};
+    };
+    const Rgbt dark = shade_pixel(m, 70, 50, W, H, background);
+    EXPECT_EQ(calls, 0) << "no ray reaches a pixel between the microimages";
+    EXPECT_EQ(dark.r, 0.0);
+    EXPECT_EQ(dark.g, 0.0);
+    EXPECT_EQ(dark.b, 0.0);
+    EXPECT_EQ(dark.t, 0.0) << "a pixel no ray reaches is opaque, never background";
+
+    const Rgbt lit = shade_pixel(m, 50, 50, W, H, background);
+    EXPECT_EQ(calls, 16);
+    EXPECT_EQ(lit.r, 1.0);
+    EXPECT_EQ(lit.t, 1.0);
+
+    // At the disc's edge some samples are blocked: the value is the unblocked fraction.
+    bool partial = false;
+    for (int i = 51; i < 60 && !partial; ++i) {
+        const Rgbt edge = shade_pixel(m, i, 50, W, H, background);
+        if (edge.r > 0 && edge.r < 1) {
+            partial = true;
+            EXPECT_EQ(edge.r, edge.t);
+            EXPECT_EQ(edge.r * 16, std::floor(edge.r * 16)) << "a whole number of the 16 samples";
+        }
+    }
+    EXPECT_TRUE(partial) << "expected a partly vignetted pixel near the microimage's edge";
+}
+
+TEST(Pixel, AdaptiveSamplingStopsEarlyOnFlatScenesAndGoesOnOnNoisyOnes)
+{
+    CameraParams params = test::thin_lens_camera(50, 2, 55);
+    params.sampling.adaptive = true;
+    params.sampling.samples_min = 8;
+    params.sampling.samples_max = 64;
+    const Model m = make_model(params);
+    int calls = 0;
+    auto flat = [&](const OpticsRay&) {
+        ++calls;
+        return Rgbt{0.3, 0.3, 0.3, 0};
+    };
+    const Rgbt value = shade_pixel(m, 10, 10, 64, 64, flat);
+    EXPECT_EQ(calls, 8) << "zero variance after the minimum";
+    EXPECT_NEAR(value.r, 0.3, 1e-15);
+
+    calls = 0;
+    auto noisy = [&](const OpticsRay& ray) {
+        ++calls;
+        return Rgbt{ray.origin_mm[0] > 0 ? 1.0 : 0.0, 0, 0, 0};
+    };
+    shade_pixel(m, 10, 10, 64, 64, noisy);
+    EXPECT_GT(calls, 8);
+    EXPECT_LE(calls, 64);
+    EXPECT_EQ((calls - 8) % 4 == 0 || calls == 64, true) << calls << " samples: batches of 4 after the minimum";
+}
+
+TEST(Pixel, DeterministicWhateverThePixelOrder)
+{
+    CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.2, 1.5, 2, 50, 4, 55);
+    params.sampling.samples = 8;
+    params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.01;
+    const Model m = make_model(params);
+    const int W = 40, H = 30;
+    std::vector<Rgbt> forward, backward(W * H);
+    for (int j = 0; j < H; ++j)
+        for (int i = 0; i < W; ++i)
+            forward.push_back(shade_pixel(m, i, j, W, H, textured));
+    for (int j = H - 1; j >= 0; --j)
+        for (int i = W - 1; i >= 0; --i)
+            backward[j * W + i] = shade_pixel(m, i, j, W, H, textured);
+    for (int k = 0; k < W * H; ++k) {
+        ASSERT_EQ(forward[k].r, backward[k].r) << k;
+        ASSERT_EQ(forward[k].g, backward[k].g) << k;
+        ASSERT_EQ(forward[k].b, backward[k].b) << k;
+    }
+}
+
+TEST(Pixel, OverlapModellingLeavesSingleLensPixelsUnchanged)
+{
+    // Microimages cannot overlap here (main lens at twice the matched f-number); force the
+    // overlap path anyway: a pixel that only its own lens reaches must keep its value exactly.
+    CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 10, 50);
+    params.sampling.samples = 16;
+    params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.005;
+    const Model plain = make_model(params);
+    ASSERT_FALSE(plain.model_overlap);
+    Model forced = plain;
+    forced.model_overlap = true;
+    forced.overlap_rings = 2;
+    const int W = 100, H = 100;
+    int single = 0;
+    LensIndex lenses[kMaxOverlapLenses];
+    for (int j = 0; j < H; ++j) {
+        for (int i = 0; i < W; ++i) {
+            if (overlap_lenses(forced, W, H, i, j, lenses, kMaxOverlapLenses) != 1)
+                continue;
+            ++single;
+            const Rgbt a = shade_pixel(plain, i, j, W, H, textured);
+            const Rgbt b = shade_pixel(forced, i, j, W, H, textured);
+            ASSERT_EQ(a.r, b.r) << i << "," << j;
+            ASSERT_EQ(a.g, b.g) << i << "," << j;
+            ASSERT_EQ(a.b, b.b) << i << "," << j;
+            ASSERT_EQ(a.t, b.t) << i << "," << j;
+        }
+    }
+    EXPECT_GT(single, W * H / 2) << "most pixels are reached by their own lens only";
+}
+
+double mean_white_image(const Model& m, int W, int H)
+{
+    double sum = 0;
+    for (int j = 0; j < H; ++j)
+        for (int i = 0; i < W; ++i)
+            sum += shade_pixel(m, i, j, W, H, [](const OpticsRay&) { return Rgbt{1, 1, 1, 0}; }).r;
+    return sum / (double(W) * H);
+}
+
+TEST(Pixel, WhiteSceneMeanIsApertureImageAreaOverCellArea)
+{
+    // Light through a lens from the whole aperture lands on a disc of radius (A/2) d/D around every
+    // cell point; summed over lenses, a white scene's mean pixel value over whole microimage cells is
+    // pi (A d / 2D)^2 / (p (1 + d/D))^2, overlap or not. The image covers 11 x 11 whole cells.
+    const double p = 0.1, d = 0.5, F = 50, D = 50;
+    const double cell = p * (1 + d / D);
+    for (double f_number : {10.0, 5.0, 2.5}) {
+        CameraParams params = plenoptic_camera(GridType::Rectangular, p, d, d, F, f_number, D);
+        params.sampling.samples = 16;
+        params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = cell / 20;
+        const Model m = make_model(params);
+        const int W = 220, H = 220;
+        const double A = F / f_number;
+        const double expected = test::kPi * (A * d / (2 * D)) * (A * d / (2 * D)) / (cell * cell);
+        const double mean = mean_white_image(m, W, H);
+        EXPECT_NEAR(mean, expected, 0.003 * expected)
+            << "f/" << f_number << " overlap modelled: " << m.model_overlap << " rings " << m.overlap_rings;
+        if (f_number == 2.5) {
+            // Without overlap modelling the neighbours' light would be lost.
+            Model without = m;
+            without.model_overlap = false;
+            EXPECT_LT(mean_white_image(without, W, H), 0.5 * expected);
+        }
+    }
+}
+
+} // namespace
+} // namespace plenoptic
