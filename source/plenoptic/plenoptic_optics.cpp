@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace plenoptic {
 
@@ -352,6 +353,72 @@ bool lens_sees(const Model& m, Homogeneous image, LensIndex lens)
     return distance_to_origin(projected, count) <= radius;
 }
 
+// The cone of light from the main aperture to the point's image X', met with the array plane:
+// a polygon of kFootprintSides corners in array-local coordinates. False when the cone does not
+// cross the plane as a bounded region.
+const int kFootprintSides = 96;
+
+bool cone_footprint(const Model& m, Homogeneous image, Vec2 footprint[kFootprintSides])
+{
+    const double r = 0.5 * m.aperture_mm;
+    double first_sign = 0;
+    for (int i = 0; i < kFootprintSides; ++i) {
+        const double angle = 2 * 3.14159265358979323846 * i / kFootprintSides;
+        Homogeneous hit;
+        if (!line_meets_plane(image, Vec3{r * std::cos(angle), r * std::sin(angle), 0}, m.pose.normal,
+                              m.pose.centre_mm, &hit))
+            return false;
+        const double sign = hit.w > 0 ? 1 : -1;
+        if (i == 0)
+            first_sign = sign;
+        else if (sign != first_sign)
+            return false;
+        const Vec3 local = to_local(m, (1 / hit.w) * hit.xyz);
+        footprint[i] = Vec2{local.x, local.y};
+    }
+    return true;
+}
+
+// Centroid of (convex polygon `subject`) clipped by the convex polygon `clip` (counter-clockwise);
+// false when they do not overlap. Sutherland-Hodgman, then the shoelace centroid.
+bool clipped_centroid(const Vec2* subject, int subject_count, const Vec2* clip, int clip_count, Vec2* centroid)
+{
+    std::vector<Vec2> poly(subject, subject + subject_count), next;
+    // The footprint may wind either way; the clip test below assumes counter-clockwise.
+    double area2 = 0;
+    for (size_t i = 0; i < poly.size(); ++i)
+        area2 += cross(poly[i], poly[(i + 1) % poly.size()]);
+    if (area2 < 0)
+        std::reverse(poly.begin(), poly.end());
+    for (int e = 0; e < clip_count && !poly.empty(); ++e) {
+        const Vec2 a = clip[e], b = clip[(e + 1) % clip_count];
+        next.clear();
+        for (size_t i = 0; i < poly.size(); ++i) {
+            const Vec2 p = poly[i], q = poly[(i + 1) % poly.size()];
+            const double sp = cross(b - a, p - a), sq = cross(b - a, q - a);
+            if (sp >= 0)
+                next.push_back(p);
+            if ((sp >= 0) != (sq >= 0)) {
+                const double t = sp / (sp - sq);
+                next.push_back(p + t * (q - p));
+            }
+        }
+        poly.swap(next);
+    }
+    double area = 0, cx = 0, cy = 0;
+    for (size_t i = 0; i < poly.size(); ++i) {
+        const Vec2 p = poly[i], q = poly[(i + 1) % poly.size()];
+        const double w = cross(p, q);
+        area += w;
+        cx += (p.x + q.x) * w;
+        cy += (p.y + q.y) * w;
+    }
+    if (!(std::fabs(area) > 0))
+        return false;
+    *centroid = Vec2{cx / (3 * area), cy / (3 * area)};
+    return is_finite(*centroid);
+}
+
 void add_hit_if_own(const Model& m, int W, int H, LensIndex lens, Vec3 hit, std::vector<PixelHit>* hits)
 {
     double u, v;
@@ -418,9 +485,38 @@ void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::ve
         return;
     }
 
+    // Thin microlenses: the point's light through a lens is the part of the cone's footprint
+    // inside that lens's cell; its image is where that light lands, centred on the ray from X'
+    // through the centroid of that part (the map from array to sensor is affine, so centroids
+    // map to centroids). A whole cell gives the Institut Pascal line through the lens centre;
+    // plenoptic 1.0 cameras, whose footprints are small, need the partial cells.
+    Vec2 cone[kFootprintSides];
+    const bool thin_microlenses = m.microlens == MicrolensType::ThinLens;
+    const bool use_footprint = thin_microlenses && cone_footprint(m, image, cone);
+    Vec2 cell[6];
+    const int cell_count = thin_microlenses ? cell_polygon(m.grid, m.pitch_mm, cell) : 0;
+
     for_each_lens_in_box(m, box, [&](LensIndex lens) {
         if (!lens_sees(m, image, lens))
             return;
+        if (use_footprint) {
+            const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+            Vec2 corners[6];
+            for (int i = 0; i < cell_count; ++i)
+                corners[i] = c + cell[i];
+            Vec2 centroid;
+            if (!clipped_centroid(cone, kFootprintSides, corners, cell_count, &centroid))
+                return;
+            const Vec3 h = to_optics(m, Vec3{centroid.x, centroid.y, 0});
+            // Direction of the light at h, towards the sensor: along the line X' - h.
+            Vec3 towards = image.w == 0 ? image.xyz : (1 / image.w) * image.xyz - h;
+            if (dot(towards, m.pose.normal) > 0)
+                towards = -towards;
+            Vec3 hit;
+            if (sensor_hit_through_lens(m, lens, h, towards, &hit))
+                add_hit_if_own(m, W, H, lens, hit, hits);
+            return;
+        }
         // Line from X' through the lens centre (its chief ray), met with the sensor plane.
         Homogeneous meet;
         if (!line_meets_plane(image, lens_centre_mm(m, lens), Vec3{0, 0, 1}, Vec3{0, 0, m.sensor_z_mm}, &meet))

@@ -1,0 +1,336 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Metadata JSON -> CameraParams -> Model, with a message naming the field for every refusal.
+
+#include "plenoptic_metadata_reader.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace plenoptic {
+
+namespace {
+
+// Thrown inside this file only; read_* turn it into `error`.
+struct FieldError : std::runtime_error {
+    explicit FieldError(const std::string& message) : std::runtime_error(message) {}
+};
+
+std::string describe(const json::Value& v)
+{
+    if (v.type == json::Type::Number)
+        return "the number " + format_number(v.number);
+    if (v.type == json::Type::String)
+        return "the string \"" + v.string + "\"";
+    return json::type_name(v.type);
+}
+
+[[noreturn]] void refuse(const std::string& path, const std::string& must, const json::Value& found)
+{
+    throw FieldError("field '" + path + "' must be " + must + ", found " + describe(found));
+}
+
+std::string join(const std::string& parent, const std::string& key)
+{
+    return parent.empty() ? key : parent + "." + key;
+}
+
+const json::Value& member(const json::Value& object, const std::string& parent, const std::string& key)
+{
+    const json::Value* v = object.member(key);
+    if (v == nullptr)
+        throw FieldError("field '" + join(parent, key) + "' is missing");
+    return *v;
+}
+
+const json::Value& object_member(const json::Value& object, const std::string& parent, const std::string& key)
+{
+    const json::Value& v = member(object, parent, key);
+    if (v.type != json::Type::Object)
+        refuse(join(parent, key), "an object", v);
+    return v;
+}
+
+double finite_number(const json::Value& v, const std::string& path)
+{
+    if (v.type != json::Type::Number || !std::isfinite(v.number))
+        refuse(path, "a finite number", v);
+    return v.number;
+}
+
+double positive_number(const json::Value& v, const std::string& path)
+{
+    if (v.type != json::Type::Number || !std::isfinite(v.number) || !(v.number > 0))
+        refuse(path, "a positive number", v);
+    return v.number;
+}
+
+std::string string_member(const json::Value& object, const std::string& parent, const std::string& key)
+{
+    const json::Value& v = member(object, parent, key);
+    if (v.type != json::Type::String)
+        refuse(join(parent, key), "a string", v);
+    return v.string;
+}
+
+// A fixed-length array of finite numbers (positive ones when `positive`).
+void numbers(const json::Value& object, const std::string& parent, const std::string& key, int count,
+             bool positive, double* out)
+{
+    const std::string path = join(parent, key);
+    const json::Value& v = member(object, parent, key);
+    const std::string must = "an array of " + std::to_string(count) + (positive ? " positive numbers" : " finite numbers");
+    if (v.type != json::Type::Array || v.items.size() != size_t(count))
+        refuse(path, must, v);
+    for (int i = 0; i < count; ++i) {
+        const json::Value& item = v.items[i];
+        if (item.type != json::Type::Number || !std::isfinite(item.number) || (positive && !(item.number > 0)))
+            refuse(path + "[" + std::to_string(i) + "]", positive ? "a positive number" : "a finite number", item);
+        out[i] = item.number;
+    }
+}
+
+int positive_integer(const json::Value& object, const std::string& parent, const std::string& key)
+{
+    const json::Value& v = member(object, parent, key);
+    if (v.type != json::Type::Number || !v.integral || !(v.number >= 1) || !(v.number <= 1e9))
+        refuse(join(parent, key), "a positive whole number", v);
+    return int(v.number);
+}
+
+void check_close(const std::string& path, double stored, double derived, double scale, const std::string& from)
+{
+    if (!(std::fabs(stored - derived) <= 1e-6 * scale))
+        throw FieldError("field '" + path + "' is " + format_number(stored) + " but " + from + " give " +
+                         format_number(derived) + ": the metadata file is inconsistent (edited?)");
+}
+
+void read_main_lens(const json::Value& root, CameraParams* params)
+{
+    const std::string parent = "main_lens";
+    const json::Value& main = object_member(root, "", parent);
+    const std::string type = string_member(main, parent, "type");
+    MainLensParams& m = params->main;
+    if (type == "none")
+        return;  // no main lens: given stays false
+    m.given = true;
+    if (type == "pinhole") {
+        m.type = MainLensType::Pinhole;
+    } else if (type == "thin_lens") {
+        m.type = MainLensType::ThinLens;
+        m.has_focal_length = true;
+        m.focal_length_mm = positive_number(member(main, parent, "focal_length_mm"), parent + ".focal_length_mm");
+        m.has_aperture = true;
+        m.aperture_mm = positive_number(member(main, parent, "aperture_mm"), parent + ".aperture_mm");
+        const json::Value& n = member(main, parent, "f_number");
+        const double f_number = positive_number(n, parent + ".f_number");
+        check_close(parent + ".f_number", f_number, m.focal_length_mm / m.aperture_mm, f_number,
+                    "focal_length_mm / aperture_mm");
+    } else {
+        refuse(parent + ".type", "\"thin_lens\", \"pinhole\" or \"none\"", member(main, parent, "type"));
+    }
+    // D as resolved by the render, whether the scene gave focus_distance or distance.
+    m.has_distance = true;
+    m.distance_mm = positive_number(member(main, parent, "distance_mm"), parent + ".distance_mm");
+}
+
+void read_array(const json::Value& root, CameraParams* params)
+{
+    const std::string parent = "microlens_array";
+    const json::Value& v = member(root, "", parent);
+    if (v.type == json::Type::Null)
+        return;
+    if (v.type != json::Type::Object)
+        refuse(parent, "an object or null", v);
+    ArrayParams& a = params->array;
+    a.given = true;
+    const std::string grid = string_member(v, parent, "grid");
+    if (grid == "hexagonal")
+        a.grid = GridType::Hexagonal;
+    else if (grid == "rectangular")
+        a.grid = GridType::Rectangular;
+    else
+        refuse(parent + ".grid", "\"hexagonal\" or \"rectangular\"", member(v, parent, "grid"));
+    const std::string lens = string_member(v, parent, "lens");
+    const json::Value& focal = member(v, parent, "focal_lengths_mm");
+    if (focal.type != json::Type::Array)
+        refuse(parent + ".focal_lengths_mm", "an array", focal);
+    a.has_lens = true;
+    if (lens == "pinhole") {
+        a.lens = MicrolensType::Pinhole;
+        if (!focal.items.empty())
+            refuse(parent + ".focal_lengths_mm", "empty for pinhole microlenses", focal);
+        a.focal_length_count = 0;
+    } else if (lens == "thin_lens") {
+        a.lens = MicrolensType::ThinLens;
+        const size_t count = focal.items.size();
+        if (count != 1 && (count != 3 || a.grid != GridType::Hexagonal))
+            refuse(parent + ".focal_lengths_mm",
+                   a.grid == GridType::Hexagonal ? "an array of 1 or 3 positive numbers" : "an array of 1 positive number",
+                   focal);
+        a.focal_length_count = int(count);
+        for (size_t i = 0; i < count; ++i)
+            a.focal_lengths_mm[i] =
+                positive_number(focal.items[i], parent + ".focal_lengths_mm[" + std::to_string(i) + "]");
+    } else {
+        refuse(parent + ".lens", "\"thin_lens\" or \"pinhole\"", member(v, parent, "lens"));
+    }
+    a.has_pitch = true;
+    a.pitch_mm = positive_number(member(v, parent, "pitch_mm"), parent + ".pitch_mm");
+    a.has_distance = true;
+    a.distance_mm = positive_number(member(v, parent, "distance_mm"), parent + ".distance_mm");
+    numbers(v, parent, "rotate_deg", 3, false, a.rotate_deg);
+    numbers(v, parent, "translate_mm", 3, false, a.translate_mm);
+}
+
+void read_frame(const json::Value& root, CameraFrame* frame)
+{
+    const std::string parent = "camera_frame";
+    const json::Value& f = object_member(root, "", parent);
+    numbers(f, parent, "location", 3, false, frame->location);
+    numbers(f, parent, "right", 3, false, frame->right);
+    numbers(f, parent, "up", 3, false, frame->up);
+    numbers(f, parent, "direction", 3, false, frame->direction);
+    const Vec3 r{frame->right[0], frame->right[1], frame->right[2]};
+    const Vec3 u{frame->up[0], frame->up[1], frame->up[2]};
+    const Vec3 d{frame->direction[0], frame->direction[1], frame->direction[2]};
+    const double volume = dot(r, cross(u, d));
+    if (!(std::fabs(volume) > 1e-9 * length(r) * length(u) * length(d)) || !std::isfinite(volume))
+        throw FieldError("field 'camera_frame': right, up and direction are linearly dependent "
+                         "(they must span 3-D space)");
+}
+
+void read_all(const json::Value& root, RenderMetadata* out)
+{
+    if (root.type != json::Type::Object)
+        refuse("(top level)", "an object", root);
+    const json::Value& format = member(root, "", "format");
+    if (format.type != json::Type::String || format.string != "povray-plenoptic-metadata")
+        refuse("format", "\"povray-plenoptic-metadata\"", format);
+    const json::Value& version = member(root, "", "version");
+    if (version.type != json::Type::Number || version.number != 1)
+        refuse("version", "1 (the only version this tool reads)", version);
+
+    const json::Value& image = object_member(root, "", "image");
+    out->width = positive_integer(image, "image", "width");
+    out->height = positive_integer(image, "image", "height");
+
+    CameraParams& p = out->params;
+    p = CameraParams();
+    p.mm_per_unit = positive_number(member(root, "", "mm_per_unit"), "mm_per_unit");
+    read_frame(root, &out->frame);
+    read_main_lens(root, &p);
+    read_array(root, &p);
+
+    const json::Value& sensor = object_member(root, "", "sensor");
+    numbers(sensor, "sensor", "pixel_size_mm", 2, true, p.sensor.pixel_size_mm);
+    numbers(sensor, "sensor", "offset_mm", 2, false, p.sensor.offset_mm);
+    const double plane_z = finite_number(member(sensor, "sensor", "plane_z_mm"), "sensor.plane_z_mm");
+
+    const json::Value& depth = member(root, "", "depth_map");
+    if (depth.type == json::Type::String)
+        out->depth_map = depth.string;
+    else if (depth.type != json::Type::Null)
+        refuse("depth_map", "a file name or null", depth);
+
+    // Sampling does not change where points image; any legal value will do.
+    p.sampling = SamplingParams();
+
+    const std::string problem = check_camera(p);
+    if (!problem.empty())
+        throw FieldError("the camera described is invalid: " + problem);
+    out->model = make_model(p);
+    const Model& m = out->model;
+
+    // Derived values must agree with what the parameters give.
+    check_close("sensor.plane_z_mm", plane_z, m.sensor_z_mm, std::fabs(m.sensor_z_mm) + 1,
+                "the distances (main_lens.distance_mm, microlens_array.distance_mm, translate_mm)");
+    double principal[2];
+    numbers(root, "", "principal_point_px", 2, false, principal);
+    const Vec2 pp = principal_point_px(m, out->width, out->height);
+    check_close("principal_point_px[0]", principal[0], pp.x, out->width + 1.0, "image.width and sensor.offset_mm");
+    check_close("principal_point_px[1]", principal[1], pp.y, out->height + 1.0, "image.height and sensor.offset_mm");
+    const json::Value& lattice = member(root, "", "microimage_lattice");
+    if (m.grid == GridType::None) {
+        if (lattice.type != json::Type::Null)
+            refuse("microimage_lattice", "null when microlens_array is null", lattice);
+    } else {
+        if (lattice.type != json::Type::Object)
+            refuse("microimage_lattice", "an object (the file has a microlens array)", lattice);
+        double origin[2];
+        numbers(lattice, "microimage_lattice", "origin_px", 2, false, origin);
+        double u, v;
+        if (microimage_centre_px(m, out->width, out->height, LensIndex{0, 0}, &u, &v)) {
+            const double scale = out->width + out->height + 1.0;
+            check_close("microimage_lattice.origin_px[0]", origin[0], u, scale, "the lens parameters");
+            check_close("microimage_lattice.origin_px[1]", origin[1], v, scale, "the lens parameters");
+        }
+    }
+}
+
+} // namespace
+
+bool metadata_from_json(const json::Value& root, RenderMetadata* out, std::string* error)
+{
+    try {
+        *out = RenderMetadata();
+        read_all(root, out);
+        return true;
+    } catch (const FieldError& e) {
+        *error = e.what();
+        return false;
+    }
+}
+
+bool read_metadata_file(const std::string& path, RenderMetadata* out, std::string* error)
+{
+    std::ifstream in(path.c_str(), std::ios::binary);
+    if (!in) {
+        *error = "cannot open the metadata file";
+        return false;
+    }
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (in.bad()) {
+        *error = "cannot read the metadata file";
+        return false;
+    }
+    json::Value root;
+    std::string parse_error;
+    if (!json::parse(text.str(), &root, &parse_error)) {
+        *error = "not valid JSON (" + parse_error + ")";
+        return false;
+    }
+    return metadata_from_json(root, out, error);
+}
+
+bool world_to_optics_mm(const RenderMetadata& md, const double world[3], double optics_mm[3])
+{
+    const CameraFrame& f = md.frame;
+    const Vec3 r{f.right[0], f.right[1], f.right[2]};
+    const Vec3 u{f.up[0], f.up[1], f.up[2]};
+    const Vec3 d{f.direction[0], f.direction[1], f.direction[2]};
+    const Vec3 w{world[0] - f.location[0], world[1] - f.location[1], world[2] - f.location[2]};
+    // Cramer's rule for x r + y u + z d = w.
+    const double det = dot(r, cross(u, d));
+    if (!(det != 0) || !std::isfinite(det))
+        return false;
+    const double x = dot(w, cross(u, d)) / det;
+    const double y = dot(r, cross(w, d)) / det;
+    const double z = dot(r, cross(u, w)) / det;
+    optics_mm[0] = x * md.model.mm_per_unit;
+    optics_mm[1] = y * md.model.mm_per_unit;
+    optics_mm[2] = z * md.model.mm_per_unit;
+    return std::isfinite(optics_mm[0]) && std::isfinite(optics_mm[1]) && std::isfinite(optics_mm[2]);
+}
+
+std::vector<PixelHit> project_world_point(const RenderMetadata& md, const double world[3])
+{
+    double optics[3];
+    if (!world_to_optics_mm(md, world, optics))
+        return std::vector<PixelHit>();
+    return forward_project(md.model, md.width, md.height, optics);
+}
+
+} // namespace plenoptic

@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Reads a render's metadata file (docs/metadata.md) back into the camera model, so that tools
+// can apply the very optics the render used: forward projection from world points to pixels.
+
+#ifndef PLENOPTIC_TOOLS_METADATA_READER_H
+#define PLENOPTIC_TOOLS_METADATA_READER_H
+
+#include <string>
+#include <vector>
+
+#include "plenoptic_json.h"
+#include "plenoptic_metadata.h"
+#include "plenoptic_model.h"
+#include "plenoptic_optics.h"
+#include "plenoptic_params.h"
+
+namespace plenoptic {
+
+struct RenderMetadata {
+    int width = 0;
+    int height = 0;
+    CameraParams params;  // rebuilt from the resolved values (D as distance_mm)
+    Model model;
+    CameraFrame frame;    // world frame of the optics frame, scene units
+    std::string depth_map;// file name of the depth EXR, empty when none
+};
+
+// Rebuilds the camera from parsed metadata. On failure returns false and sets `error` to one
+// sentence naming the offending field, e.g. "field 'main_lens.focal_length_mm' must be a
+// positive number, found null". Also checks that the stored derived values (sensor plane,
+// principal point, lattice origin) agree with the parameters, to catch edited files.
+bool metadata_from_json(const json::Value& root, RenderMetadata* out, std::string* error);
+
+// Reads and parses the file, then metadata_from_json. Errors start with the cause
+// ("cannot open", "not valid JSON (line 3, column 7: ...)", "field ...").
+bool read_metadata_file(const std::string& path, RenderMetadata* out, std::string* error);
+
+// World point (scene units) -> optics frame (mm): solves location + (x right + y up + z direction)
+// / mm_per_unit = world. False when the frame is singular or the result is not finite.
+bool world_to_optics_mm(const RenderMetadata& metadata, const double world[3], double optics_mm[3]);
+
+// Every pixel position (docs/metadata.md's centre convention) where the world point images, one
+// per microlens that sees it; lens indices in row form ((0, 0) without an array).
+std::vector<PixelHit> project_world_point(const RenderMetadata& metadata, const double world[3]);
+
+} // namespace plenoptic
+
+#endif

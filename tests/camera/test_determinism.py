@@ -1,0 +1,65 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: AGPL-3.0-or-later
+"""Determinism: the same scene and options give the same image, whatever the threads.
+
+Contract, section 3. A textured scene through the most involved set-up the camera has
+(thin main lens, multi-focus hexagonal array, rotated and translated, overlapping
+microimages, adaptive sampling, a depth map) is rendered with one thread, with two
+threads, and with two threads and tiny render blocks (a different order of pixels
+across threads). The three images, depth maps and metadata files must be identical.
+"""
+import os
+import sys
+
+import numpy as np
+
+import camlib
+
+W, H = 160, 120
+CAMERA = """
+camera { plenoptic location <0.15, 0.7, -3> look_at <0, 0.45, 0>
+  main_lens { thin_lens focal_length 12 f_number 2.8 focus_distance 2.5 }
+  microlens_array { hexagonal pitch 0.1 focal_lengths <0.3, 0.33, 0.36> distance 0.3
+                    rotate <0.4, -0.3, 3> translate <0.01, -0.02, 0.005> }
+  sensor { pixel_size 0.008 }
+  samples 4, 32 confidence 0.95 variance 1/256
+  depth_map
+}
+"""
+
+
+def main():
+    args = camlib.common_args(__doc__).parse_args()
+    checks = camlib.Checks("determinism across thread counts")
+    runs = [("wt1", ["+WT1"]), ("wt2", ["+WT2"]), ("wt2_bs4", ["+WT2", "+BS4"])]
+    images, depths, metas = {}, {}, {}
+    for name, extra in runs:
+        path = camlib.render(args.povray, args.work, name, camlib.TEXTURED_SCENE + CAMERA, W, H, extra=extra)
+        images[name] = camlib.load(path)
+        meta = camlib.metadata(path)
+        depth_file = meta.get("depth_map")
+        depths[name] = camlib.load(os.path.join(args.work, depth_file)) if depth_file else None
+        meta.pop("depth_map", None)
+        metas[name] = meta
+    ref = "wt1"
+    checks.check(depths[ref] is not None, "depth map written", "metadata depth_map: %r" % (depths[ref] is not None))
+    for name, _ in runs[1:]:
+        diff = np.abs(images[name] - images[ref]).max(axis=2)
+        checks.check(int((diff > 0).sum()) == 0, "image %s == %s" % (name, ref),
+                     "%d of %d pixels differ, max |diff| %.3g (expected 0)"
+                     % (int((diff > 0).sum()), W * H, float(diff.max())))
+        if depths[ref] is not None and depths[name] is not None:
+            a, b = depths[ref], depths[name]
+            same = np.array_equal(a, b) or np.array_equal(np.nan_to_num(a, posinf=-9), np.nan_to_num(b, posinf=-9))
+            checks.check(same, "depth map %s == %s" % (name, ref),
+                         "%d values differ" % int((np.nan_to_num(a, posinf=-9) != np.nan_to_num(b, posinf=-9)).sum()))
+        checks.check(metas[name] == metas[ref], "metadata %s == %s" % (name, ref),
+                     "identical apart from the file name of the depth map: %s" % (metas[name] == metas[ref]))
+    # The image must hold a real picture, or identity would prove little.
+    spread = float(images[ref][:, :, :3].std())
+    checks.check(spread > 0.05, "the render is not trivial", "standard deviation of the pixels %.3f" % spread)
+    return checks.finish()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

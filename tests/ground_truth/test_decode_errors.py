@@ -1,0 +1,163 @@
+# SPDX-License-Identifier: AGPL-3.0-or-later
+"""plenoptic-decode and plenoptic-project refuse missing or garbled metadata cleanly.
+
+A tiny plenoptic render and a tiny thin-lens-only render (metadata without an array) give real
+files; the test then breaks the metadata in the ways a user might (missing, truncated, not
+JSON, wrong format, a missing or malformed field, a non-finite number, the wrong image size) and
+checks that each tool exits with status 2, prints exactly one line naming the problem (and the
+field, where there is one) and no Python traceback, and writes no contact sheet. The unbroken
+files must decode and project (exit 0) so that the refusals are not the tools failing anyway.
+"""
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+import gt_common as gt
+
+SCENE_ARRAY = """camera {
+  plenoptic
+  location <0, 0, -2>
+  look_at <0, 0, 0>
+  main_lens { thin_lens focal_length 50 f_number 4 focus_distance 2 }
+  microlens_array { hexagonal pitch 0.1 focal_length 0.4 distance 0.4 }
+  sensor { pixel_size 0.01 }
+}
+sky_sphere { pigment { rgb <0.6, 0.7, 0.9> } }
+sphere { 0, 0.3 pigment { checker rgb 1 rgb <1, 0.2, 0.1> scale 0.1 } finish { emission 1 diffuse 0 } }
+"""
+
+SCENE_NO_ARRAY = """camera {
+  plenoptic
+  location <0, 0, -2>
+  look_at <0, 0, 0>
+  main_lens { thin_lens focal_length 50 f_number 4 focus_distance 2 }
+  sensor { pixel_size 0.02 }
+}
+sphere { 0, 0.3 pigment { rgb 1 } finish { emission 1 diffuse 0 } }
+"""
+
+
+def run(cmd):
+    return subprocess.run(cmd, capture_output=True, text=True, errors="replace")
+
+
+def main():
+    args = gt.parse_args(__doc__)
+    checks = gt.Checks("ground_truth_decode_errors")
+    png, meta_path, _ = gt.render(args, "decode_ok", SCENE_ARRAY, 96, 72)
+    png_plain, meta_plain, _ = gt.render(args, "decode_no_array", SCENE_NO_ARRAY, 64, 48)
+    good = gt.read_json(meta_path)
+    decode = [sys.executable, os.path.join(args.tools, "plenoptic-decode"), "-q"]
+    bad_dir = os.path.join(args.work, "decode_bad")
+    shutil.rmtree(bad_dir, ignore_errors=True)
+    os.makedirs(bad_dir)
+
+    # Positive controls.
+    out = os.path.join(args.work, "decode_ok.lightfield")
+    result = run(decode + [png, "-o", out])
+    checks.check(result.returncode == 0 and os.path.exists(os.path.join(out, "contact_sheet.png")),
+                 "the unbroken render decodes (exit %d, stderr %r)" % (result.returncode, result.stderr.strip()[-300:]))
+    result = run([args.project, meta_path, "0", "0", "0"])
+    checks.check(result.returncode == 0 and len(result.stdout.split()) >= 5,
+                 "plenoptic-project projects the sphere's centre with the unbroken metadata (exit %d, output %r)"
+                 % (result.returncode, result.stdout.strip()))
+
+    def broken(name, edit=None, text=None):
+        """A copy of the metadata broken by edit(dict) or replaced by text."""
+        path = os.path.join(bad_dir, name + ".plenoptic.json")
+        if text is None:
+            data = json.loads(json.dumps(good))
+            edit(data)
+            text = json.dumps(data, indent=1)
+        with open(path, "wb") as f:
+            f.write(text if isinstance(text, bytes) else text.encode("utf-8"))
+        return path
+
+    def drop(path):
+        def edit(data):
+            node = data
+            parts = path.split(".")
+            for p in parts[:-1]:
+                node = node[p]
+            del node[parts[-1]]
+        return edit
+
+    def setter(path, value):
+        def edit(data):
+            node = data
+            parts = path.split(".")
+            for p in parts[:-1]:
+                node = node[p]
+            node[parts[-1]] = value
+        return edit
+
+    text = open(meta_path).read()
+    cases = [
+        ("missing file", os.path.join(bad_dir, "absent.plenoptic.json"), ["cannot read"], True),
+        ("truncated", broken("truncated", text=text[:len(text) // 2]), ["not valid JSON"], True),
+        ("not JSON at all", broken("binary", text=b"\x89PNG\r\n\x1a\n\x00\x00garbage"), ["not valid JSON"], True),
+        ("a JSON array", broken("array", text="[1, 2, 3]"), ["object"], True),
+        ("wrong format", broken("format", setter("format", "something-else")), ["format"], True),
+        ("wrong version", broken("version", setter("version", 7)), ["version"], True),
+        ("no lattice basis", broken("nobasis", drop("microimage_lattice.basis_px")),
+         ["microimage_lattice.basis_px"], False),
+        ("basis not numbers", broken("basisstr", setter("microimage_lattice.basis_px", "wide")),
+         ["microimage_lattice.basis_px"], False),
+        ("NaN origin", broken("nan", setter("microimage_lattice.origin_px", [float("nan"), 1.0])),
+         ["microimage_lattice.origin_px"], False),
+        ("image size", broken("size", setter("image.width", good["image"]["width"] + 8)), ["image.width"], True),
+        ("pixel size", broken("pixel", setter("sensor.pixel_size_mm", [0, 0.01])), ["sensor.pixel_size_mm"], True),
+        ("focal length null", broken("focal", setter("main_lens.focal_length_mm", None)),
+         ["main_lens.focal_length_mm"], True),
+        ("array distance negative", broken("distance", setter("microlens_array.distance_mm", -0.4)),
+         ["microlens_array.distance_mm"], True),
+        ("no array", meta_plain, ["microlens_array"], "projects"),
+    ]
+    for label, path, words, project_too in cases:
+        image = png_plain if path == meta_plain else png
+        target = os.path.join(bad_dir, "out_" + label.replace(" ", "_"))
+        result = run(decode + [image, path, "-o", target])
+        lines = [l for l in result.stderr.splitlines() if l.strip()]
+        ok = (result.returncode == 2 and len(lines) == 1 and lines[0].startswith("plenoptic-decode: error:")
+              and all(w in lines[0] for w in words) and "Traceback" not in result.stderr
+              and not os.path.exists(os.path.join(target, "contact_sheet.png")))
+        checks.check(ok, "decode, %s: exit %d (want 2), stderr %r (want one line mentioning %s)"
+                     % (label, result.returncode, result.stderr.strip()[-400:], words))
+        # plenoptic-project reads the same file. True: it must refuse it too, naming the same
+        # field; False: a field it does not need; "projects": a file it must accept.
+        if project_too is False:
+            continue
+        result = run([args.project, path, "0", "0", "0"])
+        lines = [l for l in result.stderr.splitlines() if l.strip()]
+        if project_too == "projects":
+            checks.check(result.returncode == 0, "project, %s: a camera without an array still projects (exit %d, %r)"
+                         % (label, result.returncode, result.stderr.strip()))
+            continue
+        ok = (result.returncode == 2 and len(lines) == 1 and lines[0].startswith("plenoptic-project: " + path)
+              and all(w in lines[0] for w in words if w not in ("cannot read", "object")))
+        checks.check(ok, "project, %s: exit %d (want 2), stderr %r" % (label, result.returncode, result.stderr.strip()))
+
+    # plenoptic-project: the field it names when a camera value is wrong, and bad coordinates.
+    for label, edit, word in (
+            ("focal length null", setter("main_lens.focal_length_mm", None), "main_lens.focal_length_mm"),
+            ("unknown grid", setter("microlens_array.grid", "triangular"), "microlens_array.grid"),
+            ("edited sensor plane", setter("sensor.plane_z_mm", good["sensor"]["plane_z_mm"] - 1),
+             "sensor.plane_z_mm")):
+        path = broken("project_" + label.replace(" ", "_"), edit)
+        result = run([args.project, path, "0", "0", "0"])
+        checks.check(result.returncode == 2 and word in result.stderr and len(result.stderr.strip().splitlines()) == 1,
+                     "project, %s: exit %d, stderr %r (want 2, one line naming %s)"
+                     % (label, result.returncode, result.stderr.strip(), word))
+    for label, coords in (("two coordinates", ["0", "0"]), ("not a number", ["0", "zero", "1"]),
+                          ("infinite", ["0", "inf", "1"])):
+        result = run([args.project, meta_path] + coords)
+        checks.check(result.returncode == 2 and result.stdout == "" and result.stderr.strip(),
+                     "project, %s: exit %d (want 2), stderr %r" % (label, result.returncode, result.stderr.strip()))
+    checks.finish()
+
+
+if __name__ == "__main__":
+    main()
