@@ -126,6 +126,7 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 	array = plenoptic::ArrayParams();
 	array.given = true;
 	VECTOR v;
+	bool had_rotate = false, had_translate = false;
 
 	Parse_Begin();
 	EXPECT
@@ -175,6 +176,10 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 		END_CASE
 
 		CASE (ROTATE_TOKEN)
+			// The pose is one rotation then one translation (contract, section 2): not a chain.
+			if (had_rotate)
+				Error("plenoptic camera: microlens_array takes rotate once (about x, then y, then z, in degrees).");
+			had_rotate = true;
 			Parse_Vector(v);
 			for (int i = 0; i < 3; i++)
 				Plenoptic_Check(plenoptic::check_angle("microlens_array rotate", v[i]));
@@ -183,6 +188,9 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 		END_CASE
 
 		CASE (TRANSLATE_TOKEN)
+			if (had_translate)
+				Error("plenoptic camera: microlens_array takes translate once (mm, after the rotation).");
+			had_translate = true;
 			Parse_Vector(v);
 			for (int i = 0; i < 3; i++)
 				Plenoptic_Check(plenoptic::check_translation("microlens_array translate", v[i]));
