@@ -39,6 +39,10 @@ bool finish(Vec3 origin, Vec3 direction, OpticsRay* out)
     const Vec3 unit = normalized(direction);
     if (!is_finite(origin) || !is_finite(unit))
         return false;
+    // A lens of high power, or a steeply tilted one, can bend a ray back towards the camera:
+    // it would meet the camera body, not the scene.
+    if (!(unit.z > 0))
+        return false;
     out->origin_mm[0] = origin.x;
     out->origin_mm[1] = origin.y;
     out->origin_mm[2] = origin.z;
@@ -163,7 +167,7 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
     const double mx = leave.x + travel * direction.x;
     const double my = leave.y + travel * direction.y;
     const double radius = 0.5 * m.aperture_mm;
-    if (check_apertures && !(mx * mx + my * my <= radius * radius))
+    if (check_apertures && !(std::hypot(mx, my) <= radius))
         return false;  // misses the main-lens aperture: carries no light
     const double wx = direction.x / direction.z - mx / m.focal_length_mm;
     const double wy = direction.y / direction.z - my / m.focal_length_mm;

@@ -47,8 +47,11 @@ std::string check_positive_length(const char* keyword, double value_mm)
     std::string finite = check_finite(keyword, value_mm);
     if (!finite.empty())
         return finite;
-    if (value_mm > 0)
+    if (value_mm >= kMinLengthMm && value_mm <= kMaxLengthMm)
         return "";
+    if (value_mm > 0)
+        return str(keyword) + " must be a length from " + format_number(kMinLengthMm) + " to " +
+               format_number(kMaxLengthMm) + " mm, got " + format_number(value_mm);
     return str(keyword) + " must be a positive length in mm (> 0), got " + format_number(value_mm);
 }
 
@@ -195,6 +198,12 @@ std::string check_main_lens(const MainLensParams& main, double mm_per_unit)
                    ") is at or inside the focal length " + format_number(main.focal_length_mm) +
                    " mm; it must be greater than " + format_number(main.focal_length_mm / mm_per_unit) +
                    " scene units";
+        const double f = main.focal_length_mm;
+        const double D = f / (1.0 - f / z_mm);
+        if (!(D >= kMinLengthMm && D <= kMaxLengthMm))
+            return "main_lens: focus_distance " + format_number(main.focus_distance_units) + " puts the image "
+                   "at D = F z / (z - F) = " + format_number(D) + " mm, outside " + format_number(kMinLengthMm) +
+                   " to " + format_number(kMaxLengthMm) + " mm; focus farther from the focal length";
     }
     return "";
 }
@@ -318,6 +327,10 @@ std::string check_camera(const CameraParams& camera)
         const double f = camera.main.focal_length_mm;
         main_distance = f / (1.0 - f / z_mm);
     }
+    // The sensor must stay a separate plane from the array in double precision.
+    if (!((main_distance + d_eff) - main_distance > 0.5 * d_eff))
+        return "microlens_array distance d = " + format_number(d_eff) + " mm is too small beside D = " +
+               format_number(main_distance) + " mm: the sensor would coincide with the array";
     const double main_eff = main_distance - tz;
     if (!(main_eff > 0))
         return "microlens_array translate z = " + format_number(tz) + " mm moves the array onto or in front "

@@ -23,6 +23,10 @@ const double kDefaultConfidence = 0.9;       // as focal_blur
 const double kDefaultVariance = 1.0 / 128.0; // as focal_blur
 // Upper bound of `samples`: keeps every count an int and a render finite.
 const int kMaxSamples = 1000000;
+// Every length of the optics lies in this range (mm). Outside it, products and
+// squares of lengths would leave double precision.
+const double kMinLengthMm = 1e-12;
+const double kMaxLengthMm = 1e12;
 
 // main_lens { ... }. `given` is false when the scene has no main_lens block (type stays None).
 struct MainLensParams {

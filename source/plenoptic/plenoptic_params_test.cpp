@@ -70,7 +70,10 @@ TEST(Params, PerValueRefusalsNameKeywordValueAndRange)
 TEST(Params, PerValueChecksAcceptValidValues)
 {
     EXPECT_EQ(check_positive_length("pitch", 0.5), "");
-    EXPECT_EQ(check_positive_length("pitch", 1e-300), "");
+    EXPECT_EQ(check_positive_length("pitch", kMinLengthMm), "");
+    EXPECT_EQ(check_positive_length("pitch", kMaxLengthMm), "");
+    EXPECT_TRUE(contains(check_positive_length("pitch", 1e-300), "1e-12 to 1000000000000 mm")) << check_positive_length("pitch", 1e-300);
+    EXPECT_TRUE(contains(check_positive_length("pitch", 1e13), "1e-12 to 1000000000000 mm")) << check_positive_length("pitch", 1e13);
     EXPECT_EQ(check_f_number(4), "");
     EXPECT_EQ(check_mm_per_unit(1000), "");
     EXPECT_EQ(check_focus_distance(2.5), "");

@@ -115,6 +115,19 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
     return Rgbt{value[0], value[1], value[2], t};
 }
 
+// Whether any of the samples shade_pixel would take for pixel (i, j) passes the apertures: the
+// pixels for which it is false are those no light reaches (no scene needed). With adaptive
+// sampling it looks at the first samples_min samples, where shade_pixel always starts.
+inline bool pixel_receives_light(const Model& model, int i, int j, int W, int H)
+{
+    bool lit = false;
+    shade_pixel(model, i, j, W, H, [&lit](const OpticsRay&) {
+        lit = true;
+        return Rgbt{0, 0, 0, 0};
+    });
+    return lit;
+}
+
 } // namespace plenoptic
 
 #endif

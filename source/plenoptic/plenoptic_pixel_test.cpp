@@ -174,5 +174,27 @@ TEST(Pixel, WhiteSceneMeanIsApertureImageAreaOverCellArea)
     }
 }
 
+TEST(Pixel, ReceivesLightExactlyWhenSomeSampleIsTraced)
+{
+    // f/8 behind f/4-matched microlenses: a ring of every microimage is dark.
+    CameraParams p = test::plenoptic_camera(GridType::Hexagonal, 0.2, 0.8, 0.8, 50, 8, 52);
+    p.sampling.samples = 8;
+    const Model m = make_model(p);
+    const int W = 60, H = 40;
+    int dark = 0, lit = 0;
+    for (int j = 0; j < H; ++j)
+        for (int i = 0; i < W; ++i) {
+            int traced = 0;
+            shade_pixel(m, i, j, W, H, [&traced](const OpticsRay&) {
+                ++traced;
+                return Rgbt{1, 1, 1, 0};
+            });
+            EXPECT_EQ(pixel_receives_light(m, i, j, W, H), traced > 0) << "pixel " << i << "," << j;
+            (traced > 0 ? lit : dark)++;
+        }
+    EXPECT_GT(dark, 100) << "the set-up should leave pixels in the dark";
+    EXPECT_GT(lit, 100);
+}
+
 } // namespace
 } // namespace plenoptic

@@ -125,8 +125,11 @@ TEST(Stress, ExtremeParametersGiveFiniteUnitDirections)
 
 TEST(Stress, HugeCoordinatesDoNotOverflowTheLattice)
 {
-    CameraParams p = plenoptic_camera(GridType::Hexagonal, 1e-200, 1e-200, 1e-200, 50, 4, 52);
+    // The smallest lengths allowed (1e-12 mm) under a 10 um pixel: 1e20 lenses per pixel.
+    CameraParams p = plenoptic_camera(GridType::Hexagonal, kMinLengthMm, kMinLengthMm, kMinLengthMm, 50, 4, 52);
     ASSERT_EQ(check_camera(p), "");
+    EXPECT_NE(check_camera(plenoptic_camera(GridType::Hexagonal, 1e-200, 1e-200, 1e-200, 50, 4, 52)), "")
+        << "lengths below 1 nm leave double precision in products: refused";
     const Model m = make_model(p);
     for (int n = 0; n < 16; ++n) {
         OpticsRay ray;
@@ -136,7 +139,10 @@ TEST(Stress, HugeCoordinatesDoNotOverflowTheLattice)
     const double point[3] = {1, 2, 1000};
     EXPECT_TRUE(forward_project(m, 8, 8, point).size() <= 1u);
     const MicroimageLattice lattice = microimage_lattice(m, 8, 8);
-    EXPECT_FALSE(lattice.lftoolbox_valid) << "a grid of 1e200 lenses per pixel is not fitted";
+    if (lattice.lftoolbox_valid) {
+        for (double x : {lattice.h_spacing, lattice.v_spacing, lattice.h_offset, lattice.v_offset, lattice.rot})
+            EXPECT_TRUE(std::isfinite(x)) << "LFToolbox fields of a 1 nm pitch array";
+    }
 }
 
 } // namespace

@@ -3,6 +3,7 @@
 // token is current, so POV-Ray's error names the file and line; cross-field checks run
 // when a block's closing brace is read. The optics themselves live in source/plenoptic/.
 
+#include <cmath>
 #include <string>
 
 #include "backend/frame.h"
@@ -25,6 +26,17 @@ const char *kPlenopticKeywords =
 const char *kMainLensKeywords = "thin_lens, pinhole, focal_length, f_number, aperture, focus_distance, distance";
 const char *kArrayKeywords = "hexagonal, rectangular, pitch, focal_length, focal_lengths, pinhole, distance, rotate, translate";
 const char *kSensorKeywords = "pixel_size, offset";
+
+std::string Check_F_Number(const char *, DBL value) { return plenoptic::check_f_number(value); }
+std::string Check_Focus_Distance(const char *, DBL value) { return plenoptic::check_focus_distance(value); }
+std::string Check_Mm_Per_Unit(const char *, DBL value) { return plenoptic::check_mm_per_unit(value); }
+std::string Check_Confidence(const char *, DBL value) { return plenoptic::check_confidence(value); }
+std::string Check_Variance(const char *, DBL value) { return plenoptic::check_variance(value); }
+
+bool Finite(const VECTOR v) { return std::isfinite(v[X]) && std::isfinite(v[Y]) && std::isfinite(v[Z]); }
+
+// Parse_Camera marks an unset look_at, up or right with HUGE_VAL in every component.
+bool Finite_Or_Unset(const VECTOR v) { return Finite(v) || (v[X] == HUGE_VAL && v[Y] == HUGE_VAL && v[Z] == HUGE_VAL); }
 
 }
 
@@ -49,18 +61,50 @@ void Parser::Plenoptic_One_Lens_Kind(bool already_given)
 		Error("plenoptic camera: microlens_array takes one of pinhole, focal_length or focal_lengths, not several.");
 }
 
-DBL Parser::Plenoptic_Float(const char *keyword)
+// Value errors point at the keyword: once its value is read, POV-Ray's current token is
+// already the next one, which may sit on a later line.
+void Parser::Plenoptic_Check_At(const std::string& message, const pov_base::ITextStream::FilePos& position, int column)
 {
+	if (message.empty())
+		return;
+	const std::string text = "plenoptic camera: " + message + ".";
+	if (Token.FileHandle != NULL)
+		messageFactory.ErrorAt(POV_EXCEPTION(kParseErr, text.c_str()), Token.FileHandle->name(), position.lineno,
+		                       column, position.offset, "%s", text.c_str());
+	else
+		Error("%s", text.c_str());
+}
+
+// The float after the current keyword, finite and passing `check` (which may be NULL).
+DBL Parser::Plenoptic_Float(const char *keyword, Plenoptic_Value_Check check)
+{
+	const pov_base::ITextStream::FilePos position = Token.Token_File_Pos;
+	const int column = Token.Token_Col_No;
 	DBL value = Parse_Float();
-	Plenoptic_Check(plenoptic::check_finite(keyword, value));
+	Plenoptic_Check_At(plenoptic::check_finite(keyword, value), position, column);
+	if (check != NULL)
+		Plenoptic_Check_At(check(keyword, value), position, column);
 	return value;
 }
 
-DBL Parser::Plenoptic_Length(const char *keyword)
+// The vector (count 2 or 3) after the current keyword, each component finite and passing `check`.
+void Parser::Plenoptic_Values(const char *keyword, DBL *values, int count, Plenoptic_Value_Check check)
 {
-	DBL value = Plenoptic_Float(keyword);
-	Plenoptic_Check(plenoptic::check_positive_length(keyword, value));
-	return value;
+	const pov_base::ITextStream::FilePos position = Token.Token_File_Pos;
+	const int column = Token.Token_Col_No;
+	VECTOR v;
+	UV_VECT uv;
+	if (count == 2)
+		Parse_UV_Vect(uv);
+	else
+		Parse_Vector(v);
+	for (int i = 0; i < count; i++)
+	{
+		values[i] = (count == 2) ? uv[i] : v[i];
+		Plenoptic_Check_At(plenoptic::check_finite(keyword, values[i]), position, column);
+		if (check != NULL)
+			Plenoptic_Check_At(check(keyword, values[i]), position, column);
+	}
 }
 
 void Parser::Parse_Plenoptic_Main_Lens(plenoptic::CameraParams& params)
@@ -78,29 +122,27 @@ void Parser::Parse_Plenoptic_Main_Lens(plenoptic::CameraParams& params)
 		END_CASE
 
 		CASE (FOCAL_LENGTH_TOKEN)
-			lens.focal_length_mm = Plenoptic_Length("main_lens focal_length");
+			lens.focal_length_mm = Plenoptic_Float("main_lens focal_length", plenoptic::check_positive_length);
 			lens.has_focal_length = true;
 		END_CASE
 
 		CASE (F_NUMBER_TOKEN)
-			lens.f_number = Plenoptic_Float("f_number");
-			Plenoptic_Check(plenoptic::check_f_number(lens.f_number));
+			lens.f_number = Plenoptic_Float("f_number", Check_F_Number);
 			lens.has_f_number = true;
 		END_CASE
 
 		CASE (APERTURE_TOKEN)
-			lens.aperture_mm = Plenoptic_Length("aperture");
+			lens.aperture_mm = Plenoptic_Float("aperture", plenoptic::check_positive_length);
 			lens.has_aperture = true;
 		END_CASE
 
 		CASE (FOCUS_DISTANCE_TOKEN)
-			lens.focus_distance_units = Plenoptic_Float("focus_distance");
-			Plenoptic_Check(plenoptic::check_focus_distance(lens.focus_distance_units));
+			lens.focus_distance_units = Plenoptic_Float("focus_distance", Check_Focus_Distance);
 			lens.has_focus_distance = true;
 		END_CASE
 
 		CASE (DISTANCE_TOKEN)
-			lens.distance_mm = Plenoptic_Length("main_lens distance");
+			lens.distance_mm = Plenoptic_Float("main_lens distance", plenoptic::check_positive_length);
 			lens.has_distance = true;
 		END_CASE
 
@@ -125,7 +167,6 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 	plenoptic::ArrayParams& array = params.array;
 	array = plenoptic::ArrayParams();
 	array.given = true;
-	VECTOR v;
 	bool had_rotate = false, had_translate = false;
 
 	Parse_Begin();
@@ -137,13 +178,13 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 		END_CASE
 
 		CASE (PITCH_TOKEN)
-			array.pitch_mm = Plenoptic_Length("pitch");
+			array.pitch_mm = Plenoptic_Float("pitch", plenoptic::check_positive_length);
 			array.has_pitch = true;
 		END_CASE
 
 		CASE (FOCAL_LENGTH_TOKEN)
 			Plenoptic_One_Lens_Kind(array.has_lens);
-			array.focal_lengths_mm[0] = Plenoptic_Length("microlens_array focal_length");
+			array.focal_lengths_mm[0] = Plenoptic_Float("microlens_array focal_length", plenoptic::check_positive_length);
 			array.focal_length_count = 1;
 			array.lens = plenoptic::MicrolensType::ThinLens;
 			array.has_lens = true;
@@ -151,13 +192,7 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 
 		CASE (FOCAL_LENGTHS_TOKEN)
 			Plenoptic_One_Lens_Kind(array.has_lens);
-			Parse_Vector(v);
-			for (int i = 0; i < 3; i++)
-			{
-				Plenoptic_Check(plenoptic::check_finite("focal_lengths", v[i]));
-				Plenoptic_Check(plenoptic::check_positive_length("focal_lengths", v[i]));
-				array.focal_lengths_mm[i] = v[i];
-			}
+			Plenoptic_Values("focal_lengths", array.focal_lengths_mm, 3, plenoptic::check_positive_length);
 			array.focal_length_count = 3;
 			array.lens = plenoptic::MicrolensType::ThinLens;
 			array.has_lens = true;
@@ -171,7 +206,7 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 		END_CASE
 
 		CASE (DISTANCE_TOKEN)
-			array.distance_mm = Plenoptic_Length("microlens_array distance");
+			array.distance_mm = Plenoptic_Float("microlens_array distance", plenoptic::check_positive_length);
 			array.has_distance = true;
 		END_CASE
 
@@ -180,22 +215,14 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 			if (had_rotate)
 				Error("plenoptic camera: microlens_array takes rotate once (about x, then y, then z, in degrees).");
 			had_rotate = true;
-			Parse_Vector(v);
-			for (int i = 0; i < 3; i++)
-				Plenoptic_Check(plenoptic::check_angle("microlens_array rotate", v[i]));
-			for (int i = 0; i < 3; i++)
-				array.rotate_deg[i] = v[i];
+			Plenoptic_Values("microlens_array rotate", array.rotate_deg, 3, plenoptic::check_angle);
 		END_CASE
 
 		CASE (TRANSLATE_TOKEN)
 			if (had_translate)
 				Error("plenoptic camera: microlens_array takes translate once (mm, after the rotation).");
 			had_translate = true;
-			Parse_Vector(v);
-			for (int i = 0; i < 3; i++)
-				Plenoptic_Check(plenoptic::check_translation("microlens_array translate", v[i]));
-			for (int i = 0; i < 3; i++)
-				array.translate_mm[i] = v[i];
+			Plenoptic_Values("microlens_array translate", array.translate_mm, 3, plenoptic::check_translation);
 		END_CASE
 
 		CASE (RIGHT_CURLY_TOKEN)
@@ -216,27 +243,15 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 void Parser::Parse_Plenoptic_Sensor(plenoptic::CameraParams& params)
 {
 	plenoptic::SensorParams& sensor = params.sensor;
-	UV_VECT uv;
 
 	Parse_Begin();
 	EXPECT
 		CASE (PIXEL_SIZE_TOKEN)
-			Parse_UV_Vect(uv);
-			for (int i = 0; i < 2; i++)
-			{
-				Plenoptic_Check(plenoptic::check_finite("pixel_size", uv[i]));
-				Plenoptic_Check(plenoptic::check_positive_length("pixel_size", uv[i]));
-			}
-			sensor.pixel_size_mm[0] = uv[U];
-			sensor.pixel_size_mm[1] = uv[V];
+			Plenoptic_Values("pixel_size", sensor.pixel_size_mm, 2, plenoptic::check_positive_length);
 		END_CASE
 
 		CASE (OFFSET_TOKEN)
-			Parse_UV_Vect(uv);
-			for (int i = 0; i < 2; i++)
-				Plenoptic_Check(plenoptic::check_translation("sensor offset", uv[i]));
-			sensor.offset_mm[0] = uv[U];
-			sensor.offset_mm[1] = uv[V];
+			Plenoptic_Values("sensor offset", sensor.offset_mm, 2, plenoptic::check_translation);
 		END_CASE
 
 		CASE (RIGHT_CURLY_TOKEN)
@@ -259,8 +274,9 @@ void Parser::Parse_Plenoptic_Sensor(plenoptic::CameraParams& params)
 void Parser::Parse_Plenoptic_Samples(plenoptic::CameraParams& params)
 {
 	plenoptic::SamplingParams& sampling = params.sampling;
-	DBL first = Plenoptic_Float("samples");
-	Plenoptic_Check(plenoptic::check_samples("samples", first));
+	const pov_base::ITextStream::FilePos position = Token.Token_File_Pos;
+	const int column = Token.Token_Col_No;
+	DBL first = Plenoptic_Float("samples", plenoptic::check_samples);
 	Parse_Comma();
 	DBL second = Allow_Float(0.0);
 	if (second == 0.0)
@@ -269,10 +285,11 @@ void Parser::Parse_Plenoptic_Samples(plenoptic::CameraParams& params)
 		sampling.samples = (int)first;
 		return;
 	}
-	Plenoptic_Check(plenoptic::check_finite("samples maximum", second));
-	Plenoptic_Check(plenoptic::check_samples("samples maximum", second));
+	Plenoptic_Check_At(plenoptic::check_finite("samples maximum", second), position, column);
+	Plenoptic_Check_At(plenoptic::check_samples("samples maximum", second), position, column);
 	if (first > second)
-		Error("plenoptic camera: samples minimum (%g) must not be larger than the maximum (%g).", first, second);
+		Plenoptic_Check_At("samples minimum (" + plenoptic::format_number(first) + ") must not be larger than the maximum (" +
+		                   plenoptic::format_number(second) + ")", position, column);
 	sampling.adaptive = true;
 	sampling.samples_min = (int)first;
 	sampling.samples_max = (int)second;
@@ -289,13 +306,10 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 		params = New.Plenoptic->params;
 		setup->depth_map = New.Plenoptic->depth_map;
 	}
-	DBL k;
 
 	EXPECT
 		CASE (MM_PER_UNIT_TOKEN)
-			k = Plenoptic_Float("mm_per_unit");
-			Plenoptic_Check(plenoptic::check_mm_per_unit(k));
-			params.mm_per_unit = k;
+			params.mm_per_unit = Plenoptic_Float("mm_per_unit", Check_Mm_Per_Unit);
 		END_CASE
 
 		CASE (MAIN_LENS_TOKEN)
@@ -315,15 +329,11 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 		END_CASE
 
 		CASE (CONFIDENCE_TOKEN)
-			k = Plenoptic_Float("confidence");
-			Plenoptic_Check(plenoptic::check_confidence(k));
-			params.sampling.confidence = k;
+			params.sampling.confidence = Plenoptic_Float("confidence", Check_Confidence);
 		END_CASE
 
 		CASE (VARIANCE_TOKEN)
-			k = Plenoptic_Float("variance");
-			Plenoptic_Check(plenoptic::check_variance(k));
-			params.sampling.variance = k;
+			params.sampling.variance = Plenoptic_Float("variance", Check_Variance);
 		END_CASE
 
 		CASE (DEPTH_MAP_TOKEN)
@@ -352,12 +362,26 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 		END_CASE
 
 		OTHERWISE
+		{
+			const pov_base::ITextStream::FilePos position = Token.Token_File_Pos;
+			const int column = Token.Token_Col_No;
+			const TOKEN keyword = Token.Token_Id;
 			UNGET
 			if (Parse_Camera_Mods(New) == false)
 			{
 				Get_Token();
 				Plenoptic_Unknown("plenoptic camera", kPlenopticKeywords);
 			}
+			// Placement too must be finite (POV-Ray's stock cameras would render black).
+			bool finite = Finite(New.Location) && Finite(New.Sky) && Finite(New.Direction) &&
+			              Finite_Or_Unset(New.Look_At) && Finite_Or_Unset(New.Up) && Finite_Or_Unset(New.Right);
+			for (int r = 0; r < 4 && New.Trans != NULL; r++)
+				for (int c = 0; c < 4; c++)
+					finite = finite && std::isfinite(New.Trans->matrix[r][c]) && std::isfinite(New.Trans->inverse[r][c]);
+			if (!finite)
+				Plenoptic_Check_At(std::string("'") + Get_Token_String(keyword) + "' gives a value that is not a finite "
+				                   "number (NaN or infinite)", position, column);
+		}
 		END_CASE
 	END_EXPECT
 

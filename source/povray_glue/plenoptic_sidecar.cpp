@@ -30,6 +30,8 @@ Registration registration;
 std::atomic<const CameraSetup*> registered_setup(nullptr);
 std::atomic<long long> registered_size(0);  // W * 2^32 + H
 std::atomic<float*> registered_depth(nullptr);
+std::atomic<int> next_depth_row(0);
+std::atomic<int> depth_rows(0);
 
 std::string replace_extension(const std::string& path, const std::string& suffix)
 {
@@ -104,10 +106,18 @@ float* sidecar_register(const std::shared_ptr<const CameraSetup>& setup, const C
         if (setup->depth_map)
             registration.depth.assign(size_t(W) * size_t(H), -1.0f);
         registered_depth.store(registration.depth.empty() ? nullptr : registration.depth.data());
+        next_depth_row.store(0);
+        depth_rows.store(registration.depth.empty() ? 0 : H);
         registered_size.store(size);
         registered_setup.store(setup.get(), std::memory_order_release);
     }
     return registered_depth.load();
+}
+
+int sidecar_claim_depth_row()
+{
+    const int row = next_depth_row.fetch_add(1);
+    return row < depth_rows.load() ? row : -1;
 }
 
 bool sidecar_write(const std::string& image_path, int W, int H)
@@ -134,6 +144,7 @@ bool sidecar_write(const std::string& image_path, int W, int H)
     registered_setup.store(nullptr);
     registered_depth.store(nullptr);
     registered_size.store(0);
+    depth_rows.store(0);
     registration = Registration();
     return ok;
 }

@@ -24,6 +24,11 @@ std::string depth_path_for(const std::string& image_path);     // dir/name.depth
 // depth map, else nullptr.
 float* sidecar_register(const std::shared_ptr<const CameraSetup>& setup, const CameraFrame& frame, int W, int H);
 
+// The next row of the depth map for the calling thread to fill, or -1 once every row is
+// claimed. The whole map is filled at the start of a render (a continued +C render too, which
+// re-renders only some pixels), each row by the one thread that claimed it.
+int sidecar_claim_depth_row();
+
 // Writes the files for the image just written (if a plenoptic camera rendered it) and forgets
 // the registration. Returns false, with a message on stderr, when a file could not be written;
 // files are written to a temporary name and renamed, never left half-written.

@@ -3,6 +3,7 @@
 // source/plenoptic/ with POV-Ray's tracer behind each ray.
 
 #include <cmath>
+#include <limits>
 
 #include "backend/frame.h"
 #include "backend/math/vector.h"
@@ -61,7 +62,26 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 	const plenoptic::CameraFrame frame = Frame_Of(camera);
 	float *depth = plenoptic::sidecar_register(camera.Plenoptic, frame, W, H);
 
-	int traced = 0;
+	if (depth != NULL)
+	{
+		// Distance along a pixel's chief ray, from the lens it leaves to the first surface;
+		// +inf where it hits nothing, -1 where no sample of the pixel passes the apertures.
+		auto depth_of = [&](int column, int row) -> float
+		{
+			if (!plenoptic::pixel_receives_light(model, column, row, W, H))
+				return -1.0f;
+			Ray ray;
+			ray.SetFlags(Ray::PrimaryRay, false, false, false, false, pretrace);
+			To_Scene(frame, model.mm_per_unit, plenoptic::chief_ray(model, W, H, column, row), ray);
+			Intersection isect;
+			return FindIntersection(isect, ray) ? (float)isect.Depth : std::numeric_limits<float>::infinity();
+		};
+		// Every thread helps fill the whole depth map before shading its first pixel.
+		for (int row = plenoptic::sidecar_claim_depth_row(); row >= 0; row = plenoptic::sidecar_claim_depth_row())
+			for (int column = 0; column < W; column++)
+				depth[size_t(row) * W + column] = depth_of(column, row);
+	}
+
 	plenoptic::Rgbt value = plenoptic::shade_pixel(model, i, j, W, H,
 		[&](const plenoptic::OpticsRay& optics_ray) -> plenoptic::Rgbt
 		{
@@ -73,26 +93,10 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 			Colour col;
 			Trace::TraceTicket ticket(maxTraceLevel, adcBailout, sceneData->outputAlpha);
 			TraceRay(ray, col, 1.0, ticket, false, camera.Max_Ray_Distance);
-			traced++;
 			return plenoptic::Rgbt{col[pRED], col[pGREEN], col[pBLUE], col[pTRANSM]};
 		});
 	colour = Colour(value.r, value.g, value.b, 0.0, value.t);
-
-	if (depth != NULL && !pretrace && i >= 0 && i < W && j >= 0 && j < H)
-	{
-		// Distance along the chief ray from the lens it leaves to the first surface;
-		// -1 where no sample of the pixel reached the scene.
-		float d = -1.0f;
-		if (traced > 0)
-		{
-			Ray ray;
-			ray.SetFlags(Ray::PrimaryRay, false, false, false, false, pretrace);
-			To_Scene(frame, model.mm_per_unit, plenoptic::chief_ray(model, W, H, i, j), ray);
-			Intersection isect;
-			d = FindIntersection(isect, ray) ? (float)isect.Depth : std::numeric_limits<float>::infinity();
-		}
-		depth[size_t(j) * W + i] = d;
-	}
 }
+
 
 }
