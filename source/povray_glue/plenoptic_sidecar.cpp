@@ -19,7 +19,7 @@ namespace {
 
 struct Registration {
     std::shared_ptr<const CameraSetup> setup;
-    CameraFrame frame;
+    RenderState state;
     int width = 0, height = 0;
     std::vector<float> depth;
 };
@@ -29,7 +29,7 @@ Registration registration;
 // The registration as every pixel reads it, without the lock.
 std::atomic<const CameraSetup*> registered_setup(nullptr);
 std::atomic<long long> registered_size(0);  // W * 2^32 + H
-std::atomic<float*> registered_depth(nullptr);
+std::atomic<const RenderState*> registered_state(nullptr);
 std::atomic<int> next_depth_row(0);
 std::atomic<int> depth_rows(0);
 
@@ -89,29 +89,37 @@ std::string base_name(const std::string& path)
 std::string metadata_path_for(const std::string& image_path) { return replace_extension(image_path, ".plenoptic.json"); }
 std::string depth_path_for(const std::string& image_path) { return replace_extension(image_path, ".depth.exr"); }
 
-float* sidecar_register(const std::shared_ptr<const CameraSetup>& setup, const CameraFrame& frame, int W, int H)
+const RenderState* sidecar_current(const CameraSetup* setup, int W, int H)
 {
     const long long size = ((long long)W << 32) + H;
-    if (registered_setup.load(std::memory_order_acquire) == setup.get() &&
+    if (registered_setup.load(std::memory_order_acquire) == setup &&
         registered_size.load(std::memory_order_acquire) == size)
-        return registered_depth.load(std::memory_order_acquire);
+        return registered_state.load(std::memory_order_acquire);
+    return nullptr;
+}
+
+const RenderState* sidecar_register(const std::shared_ptr<const CameraSetup>& setup, const CameraFrame& frame, int W, int H)
+{
+    const long long size = ((long long)W << 32) + H;
     std::lock_guard<std::mutex> lock(registration_mutex);
     if (registered_setup.load() != setup.get() || registered_size.load() != size) {
+        registered_setup.store(nullptr);
         registration.setup = setup;
-        registration.frame = frame;
         registration.width = W;
         registration.height = H;
         registration.depth.clear();
         // -1 marks a pixel that no light reaches (and one not rendered, e.g. outside +SR/+ER).
         if (setup->depth_map)
             registration.depth.assign(size_t(W) * size_t(H), -1.0f);
-        registered_depth.store(registration.depth.empty() ? nullptr : registration.depth.data());
+        registration.state.frame = frame;
+        registration.state.depth = registration.depth.empty() ? nullptr : registration.depth.data();
+        registered_state.store(&registration.state);
         next_depth_row.store(0);
         depth_rows.store(registration.depth.empty() ? 0 : H);
         registered_size.store(size);
         registered_setup.store(setup.get(), std::memory_order_release);
     }
-    return registered_depth.load();
+    return registered_state.load();
 }
 
 int sidecar_claim_depth_row()
@@ -135,14 +143,14 @@ bool sidecar_write(const std::string& image_path, int W, int H)
             ok = false;
     }
     const std::string json = metadata_json(registration.setup->model, registration.setup->params, W, H,
-                                           registration.frame, depth_file);
+                                           registration.state.frame, depth_file);
     const std::string metadata_path = metadata_path_for(image_path);
     if (!write_text_atomically(metadata_path, json)) {
         std::fprintf(stderr, "plenoptic camera: cannot write metadata %s\n", metadata_path.c_str());
         ok = false;
     }
     registered_setup.store(nullptr);
-    registered_depth.store(nullptr);
+    registered_state.store(nullptr);
     registered_size.store(0);
     depth_rows.store(0);
     registration = Registration();

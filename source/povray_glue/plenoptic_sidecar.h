@@ -19,10 +19,18 @@ namespace plenoptic {
 std::string metadata_path_for(const std::string& image_path);  // dir/name.plenoptic.json
 std::string depth_path_for(const std::string& image_path);     // dir/name.depth.exr
 
-// Called by every render thread before its first plenoptic pixel; cheap after the first call.
-// Returns the depth buffer (W*H floats, row-major, top row first) when the camera asked for a
-// depth map, else nullptr.
-float* sidecar_register(const std::shared_ptr<const CameraSetup>& setup, const CameraFrame& frame, int W, int H);
+// What every pixel of the render needs from the registration.
+struct RenderState {
+    CameraFrame frame;  // the optics frame in the scene, as registered
+    float* depth;       // W*H floats, row-major, top row first; nullptr when no depth map was asked for
+};
+
+// The state registered for this camera and image size, or nullptr: cheap, called for every pixel.
+const RenderState* sidecar_current(const CameraSetup* setup, int W, int H);
+
+// Registers the render (first pixel of each thread; later calls for the same camera and size
+// return the same state).
+const RenderState* sidecar_register(const std::shared_ptr<const CameraSetup>& setup, const CameraFrame& frame, int W, int H);
 
 // The next row of the depth map for the calling thread to fill, or -1 once every row is
 // claimed. The whole map is filled at the start of a render (a continued +C render too, which

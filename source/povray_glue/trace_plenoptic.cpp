@@ -59,8 +59,11 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 	const int W = (int)width, H = (int)height;
 	// Antialiasing may ask for sub-pixel positions: the camera samples the whole pixel itself.
 	const int i = (int)std::floor(x + 0.5), j = (int)std::floor(y + 0.5);
-	const plenoptic::CameraFrame frame = Frame_Of(camera);
-	float *depth = plenoptic::sidecar_register(camera.Plenoptic, frame, W, H);
+	const plenoptic::RenderState *state = plenoptic::sidecar_current(camera.Plenoptic.get(), W, H);
+	if (state == NULL)
+		state = plenoptic::sidecar_register(camera.Plenoptic, Frame_Of(camera), W, H);
+	const plenoptic::CameraFrame& frame = state->frame;
+	float *depth = state->depth;
 
 	if (depth != NULL)
 	{
