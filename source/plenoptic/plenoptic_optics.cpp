@@ -620,6 +620,9 @@ void fit_lftoolbox(const Model& m, int W, int H, MicroimageLattice* lattice)
     const Vec2 reference{lattice->origin_px[0] + 1, lattice->origin_px[1] + 1};  // lens (0, 0), 1-based
     double h_proj = dot(reference, e);
     const double v_proj = dot(reference, down);
+    // Lens (0, 0) absurdly far outside the image: the row counts below would overflow.
+    if (!(std::fabs(v_proj / v_spacing) < 1e15 && std::fabs(h_proj / h_spacing) < 1e15))
+        return;
     const double new_v = wrap(v_proj, v_spacing);
     const long long v_steps = std::llround((v_proj - new_v) / v_spacing);
     int shift_row = 0;
@@ -629,8 +632,10 @@ void fit_lftoolbox(const Model& m, int W, int H, MicroimageLattice* lattice)
         if (v_steps % 2 != 0)
             h_proj += h_spacing / 2;
         new_h = wrap(h_proj, h_spacing / 2);
-        const long long h_steps = std::llround((h_proj - new_h) / (h_spacing / 2));
-        shift_row = (h_steps % 2 != 0) ? 1 : 2;
+        const double steps = std::round((h_proj - new_h) / (h_spacing / 2));
+        if (!(std::fabs(steps) < 1e15))
+            return;  // a grid this fine has no row parity LFToolbox could use
+        shift_row = (std::fmod(std::fabs(steps), 2.0) != 0) ? 1 : 2;
     } else {
         new_h = wrap(h_proj, h_spacing);
     }
@@ -642,6 +647,12 @@ void fit_lftoolbox(const Model& m, int W, int H, MicroimageLattice* lattice)
     LensIndex first;
     if (!own_lens(m, sensor_point(m, W, H, first_u + 0.5, first_v + 0.5), &first))
         return;
+    // As LFBuildLensletGridModel: UMax = floor((W - HOffset) / HSpacing) + 1, likewise VMax;
+    // counts beyond 1e15 (absurdly fine grids) are not expressible.
+    const double u_max = std::floor((W - offset.x) / h_spacing) + 1;
+    const double v_max = std::floor((H - offset.y) / v_spacing) + 1;
+    if (!(u_max >= 0 && u_max < 1e15 && v_max >= 0 && v_max < 1e15))
+        return;
 
     lattice->first_lens = first;
     lattice->h_spacing = h_spacing;
@@ -650,9 +661,8 @@ void fit_lftoolbox(const Model& m, int W, int H, MicroimageLattice* lattice)
     lattice->h_offset = offset.x;
     lattice->v_offset = offset.y;
     lattice->first_pos_shift_row = shift_row;
-    // As LFBuildLensletGridModel: UMax = floor((W - HOffset) / HSpacing) + 1, likewise VMax.
-    lattice->u_max = (long long)std::floor((W - offset.x) / h_spacing) + 1;
-    lattice->v_max = (long long)std::floor((H - offset.y) / v_spacing) + 1;
+    lattice->u_max = (long long)u_max;
+    lattice->v_max = (long long)v_max;
     lattice->lftoolbox_valid = true;
 }
 
