@@ -211,17 +211,9 @@ def check_rendered(povray, case_dir, w, h, opts, results, name):
 
 
 def check_refused(povray, case_dir, w, h, opts):
-    problems = []
     run = render(povray, case_dir, "case.pov", "t.png", w, h, ["+FN8", "+WT1"], opts.get("timeout", 60))
-    crash = rtlib.crash_reason(run)
-    if crash:
-        problems.append("crashed: " + crash)
-    if run.returncode == 0:
-        problems.append("rendered (exit 0), expected a refusal")
-    err = rtlib.parse_error(run.output)
-    if err is None:
-        problems.append("no `File ... line ...` parse error")
-    else:
+    problems, err = rtlib.refusal_problems(run)
+    if err is not None:
         missing = [w_ for w_ in opts["refuse"] if w_.lower() not in err[2].lower()]
         if missing:
             problems.append("message lacks %s: %r" % (missing, err[2]))

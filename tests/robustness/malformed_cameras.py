@@ -283,16 +283,8 @@ def check_case(povray, work, index, name, block, fragments):
     expected_lines = marked_lines(block)
     run = rtlib.run_povray(povray, "bad.pov", os.path.join(case_dir, "bad.png"), 16, 12,
                            ["+FN8", "+WT1"], timeout=30, cwd=case_dir)
-    problems = []
-    crash = rtlib.crash_reason(run)
-    if crash:
-        problems.append("crashed: " + crash)
-    if run.returncode == 0:
-        problems.append("accepted (exit 0): the scene must be refused")
-    err = rtlib.parse_error(run.output)
-    if err is None:
-        problems.append("no 'File ... line ...' parse error in the output")
-    else:
+    problems, err = rtlib.refusal_problems(run)
+    if err is not None:
         efile, eline, message = err
         if os.path.basename(efile) != "bad.pov":
             problems.append("error names file %r, expected bad.pov" % efile)

@@ -102,6 +102,21 @@ def crash_reason(run):
     return None
 
 
+def refusal_problems(run):
+    """For a run that must be refused at parse time: its problems (a crash, exit 0, no
+    `File ... line ...` parse error) and that parse error as (file, line, message), or None."""
+    problems = []
+    crash = crash_reason(run)
+    if crash:
+        problems.append("crashed: " + crash)
+    if run.returncode == 0:
+        problems.append("accepted (exit 0): the scene must be refused")
+    err = parse_error(run.output)
+    if err is None:
+        problems.append("no 'File ... line ...' parse error in the output")
+    return problems, err
+
+
 def read_exr(path):
     """The float pixels (H, W, channels) of an OpenEXR file."""
     import OpenImageIO as oiio
