@@ -167,7 +167,7 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
     const double mx = leave.x + travel * direction.x;
     const double my = leave.y + travel * direction.y;
     const double radius = 0.5 * m.aperture_mm;
-    if (check_apertures && !(std::hypot(mx, my) <= radius))
+    if (check_apertures && !(mx * mx + my * my <= radius * radius))
         return false;  // misses the main-lens aperture: carries no light
     const double wx = direction.x / direction.z - mx / m.focal_length_mm;
     const double wy = direction.y / direction.z - my / m.focal_length_mm;

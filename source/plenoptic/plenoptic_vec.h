@@ -36,7 +36,11 @@ inline bool is_finite(Vec3 a) { return std::isfinite(a.x) && std::isfinite(a.y) 
 // Unit vector; a zero or non-finite input gives a non-finite result, which callers reject.
 inline Vec3 normalized(Vec3 a)
 {
-    // Scale first so that huge components cannot overflow the squared length.
+    // The usual case directly (one square root, one division: this runs for every ray).
+    const double length_sq = dot(a, a);
+    if (length_sq > 1e-280 && length_sq < 1e280)
+        return (1.0 / std::sqrt(length_sq)) * a;
+    // Otherwise scale first, so that huge components cannot overflow the squared length.
     const double big = std::fmax(std::fabs(a.x), std::fmax(std::fabs(a.y), std::fabs(a.z)));
     const Vec3 s = (1.0 / big) * a;
     return (1.0 / length(s)) * s;

@@ -3,6 +3,7 @@
 
 #include "povray_glue/plenoptic_sidecar.h"
 
+#include <cmath>
 #include <atomic>
 #include <cstdio>
 #include <mutex>
@@ -89,6 +90,22 @@ std::string base_name(const std::string& path)
 std::string metadata_path_for(const std::string& image_path) { return replace_extension(image_path, ".plenoptic.json"); }
 std::string depth_path_for(const std::string& image_path) { return replace_extension(image_path, ".depth.exr"); }
 
+namespace {
+
+bool is_orthonormal(const CameraFrame& frame)
+{
+    const double* axes[3] = {frame.right, frame.up, frame.direction};
+    for (int a = 0; a < 3; ++a)
+        for (int b = a; b < 3; ++b) {
+            const double dot = axes[a][0] * axes[b][0] + axes[a][1] * axes[b][1] + axes[a][2] * axes[b][2];
+            if (std::fabs(dot - (a == b ? 1.0 : 0.0)) > 1e-12)
+                return false;
+        }
+    return true;
+}
+
+} // namespace
+
 const RenderState* sidecar_current(const CameraSetup* setup, int W, int H)
 {
     const long long size = ((long long)W << 32) + H;
@@ -112,6 +129,7 @@ const RenderState* sidecar_register(const std::shared_ptr<const CameraSetup>& se
         if (setup->depth_map)
             registration.depth.assign(size_t(W) * size_t(H), -1.0f);
         registration.state.frame = frame;
+        registration.state.frame_orthonormal = is_orthonormal(frame);
         registration.state.depth = registration.depth.empty() ? nullptr : registration.depth.data();
         registered_state.store(&registration.state);
         next_depth_row.store(0);

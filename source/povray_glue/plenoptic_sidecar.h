@@ -22,6 +22,7 @@ std::string depth_path_for(const std::string& image_path);     // dir/name.depth
 // What every pixel of the render needs from the registration.
 struct RenderState {
     CameraFrame frame;  // the optics frame in the scene, as registered
+    bool frame_orthonormal;  // right, up, direction orthonormal: a unit optics direction stays unit
     float* depth;       // W*H floats, row-major, top row first; nullptr when no depth map was asked for
 };
 

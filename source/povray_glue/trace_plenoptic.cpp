@@ -39,15 +39,18 @@ plenoptic::CameraFrame Frame_Of(const Camera& camera)
 	return frame;
 }
 
-void To_Scene(const plenoptic::CameraFrame& frame, double mm_per_unit, const plenoptic::OpticsRay& in, Ray& out)
+void To_Scene(const plenoptic::RenderState& state, double mm_per_unit, const plenoptic::OpticsRay& in, Ray& out)
 {
+	const plenoptic::CameraFrame& frame = state.frame;
+	const double units_per_mm = 1.0 / mm_per_unit;
 	for (int i = 0; i < 3; i++)
 	{
 		out.Origin[i] = frame.location[i] + (in.origin_mm[0] * frame.right[i] + in.origin_mm[1] * frame.up[i] +
-		                                     in.origin_mm[2] * frame.direction[i]) / mm_per_unit;
+		                                     in.origin_mm[2] * frame.direction[i]) * units_per_mm;
 		out.Direction[i] = in.dir[0] * frame.right[i] + in.dir[1] * frame.up[i] + in.dir[2] * frame.direction[i];
 	}
-	VNormalizeEq(out.Direction);
+	if (!state.frame_orthonormal)
+		VNormalizeEq(out.Direction);
 }
 
 }
@@ -62,7 +65,6 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 	const plenoptic::RenderState *state = plenoptic::sidecar_current(camera.Plenoptic.get(), W, H);
 	if (state == NULL)
 		state = plenoptic::sidecar_register(camera.Plenoptic, Frame_Of(camera), W, H);
-	const plenoptic::CameraFrame& frame = state->frame;
 	float *depth = state->depth;
 
 	if (depth != NULL)
@@ -75,7 +77,7 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 				return -1.0f;
 			Ray ray;
 			ray.SetFlags(Ray::PrimaryRay, false, false, false, false, pretrace);
-			To_Scene(frame, model.mm_per_unit, plenoptic::chief_ray(model, W, H, column, row), ray);
+			To_Scene(*state, model.mm_per_unit, plenoptic::chief_ray(model, W, H, column, row), ray);
 			Intersection isect;
 			return FindIntersection(isect, ray) ? (float)isect.Depth : std::numeric_limits<float>::infinity();
 		};
@@ -90,7 +92,7 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 		{
 			Ray ray;
 			ray.SetFlags(Ray::PrimaryRay, false, false, false, false, pretrace);
-			To_Scene(frame, model.mm_per_unit, optics_ray, ray);
+			To_Scene(*state, model.mm_per_unit, optics_ray, ray);
 			// As the perspective camera: the containing interiors are those at the main lens.
 			InitRayContainerState(ray);
 			Colour col;
