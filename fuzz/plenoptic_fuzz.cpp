@@ -304,7 +304,8 @@ void accepted_values_are_sane(const CameraParams& p)
         FUZZ_ASSERT(s.confidence > 0 && s.confidence < 1 && std::isfinite(s.variance) && s.variance > 0,
                     "confidence %.17g variance %.17g", s.confidence, s.variance);
     } else {
-        FUZZ_ASSERT(s.samples >= 1 && s.samples <= kMaxSamples, "samples %d", s.samples);
+        FUZZ_ASSERT(s.samples == kSamplesOmitted || (s.samples >= 1 && s.samples <= kMaxSamples), "samples %d",
+                    s.samples);
     }
 }
 
@@ -312,6 +313,8 @@ void model_is_sane(const Model& m)
 {
     FUZZ_ASSERT(std::isfinite(m.sensor_z_mm) && m.sensor_z_mm < 0, "sensor plane z = %.17g", m.sensor_z_mm);
     FUZZ_ASSERT(std::isfinite(m.distance_mm), "D = %.17g", m.distance_mm);
+    FUZZ_ASSERT(m.samples_min >= 1 && m.samples_min <= m.samples_max && m.samples_max <= kMaxSamples,
+                "model samples %d..%d", m.samples_min, m.samples_max);
     if (m.main_lens == MainLensType::ThinLens)
         FUZZ_ASSERT(std::isfinite(m.aperture_mm) && m.aperture_mm > 0 && std::isfinite(m.focal_length_mm),
                     "aperture %.17g F %.17g", m.aperture_mm, m.focal_length_mm);

@@ -185,8 +185,9 @@ Model make_model(const CameraParams& params)
 
     const SamplingParams& sampling = params.sampling;
     m.adaptive = sampling.adaptive;
-    m.samples_min = sampling.adaptive ? sampling.samples_min : sampling.samples;
-    m.samples_max = sampling.adaptive ? sampling.samples_max : sampling.samples;
+    const int fixed_count = sampling.samples == kSamplesOmitted ? default_samples(params) : sampling.samples;
+    m.samples_min = sampling.adaptive ? sampling.samples_min : fixed_count;
+    m.samples_max = sampling.adaptive ? sampling.samples_max : fixed_count;
     m.confidence = sampling.confidence;
     m.variance = sampling.variance;
     if (m.adaptive)

@@ -199,7 +199,24 @@ TEST(Model, AdaptiveSamplingTable)
     EXPECT_FALSE(fixed.adaptive);
     EXPECT_EQ(fixed.samples_min, 9);
     EXPECT_EQ(fixed.samples_max, 9);
-    EXPECT_EQ(make_model(thin_lens_camera(50, 4, 52)).samples_max, kDefaultSamples);
+}
+
+TEST(Model, OmittedSamplesDependOnWhetherAnApertureIsSampled)
+{
+    // A thin main lens alone, or thin microlenses: the aperture needs samples.
+    EXPECT_EQ(make_model(thin_lens_camera(50, 4, 52)).samples_max, kDefaultSamplesApertures);
+    const CameraParams thin_array = plenoptic_camera(GridType::Hexagonal, 0.1, 0.4, 0.4, 50, 4, 52);
+    EXPECT_EQ(make_model(thin_array).samples_max, kDefaultSamplesApertures);
+    EXPECT_EQ(make_model(thin_array).samples_min, kDefaultSamplesApertures);
+    EXPECT_FALSE(make_model(thin_array).adaptive);
+    // Pinhole microlenses behind a thin main lens: one ray per point of the pixel.
+    EXPECT_EQ(make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0, 0.4, 50, 4, 52)).samples_max,
+              kDefaultSamplesPinholes);
+    // A given count always wins.
+    CameraParams given = thin_array;
+    given.sampling.samples = 3;
+    EXPECT_EQ(make_model(given).samples_max, 3);
+    EXPECT_TRUE(check_camera(thin_array).empty()) << check_camera(thin_array);
 }
 
 } // namespace

@@ -265,7 +265,7 @@ std::string check_sampling(const SamplingParams& sampling)
 {
     std::string message;
     if (!sampling.adaptive)
-        return check_samples("samples", sampling.samples);
+        return sampling.samples == kSamplesOmitted ? std::string() : check_samples("samples", sampling.samples);
     if (!(message = check_samples("samples (minimum)", sampling.samples_min)).empty())
         return message;
     if (!(message = check_samples("samples (maximum)", sampling.samples_max)).empty())
@@ -352,6 +352,13 @@ std::string check_camera(const CameraParams& camera)
         }
     }
     return "";
+}
+
+int default_samples(const CameraParams& camera)
+{
+    const bool thin_microlenses = camera.array.given && camera.array.lens == MicrolensType::ThinLens;
+    const bool bare_thin_main = !camera.array.given && camera.main.given && camera.main.type == MainLensType::ThinLens;
+    return thin_microlenses || bare_thin_main ? kDefaultSamplesApertures : kDefaultSamplesPinholes;
 }
 
 } // namespace plenoptic

@@ -16,9 +16,15 @@ enum class MicrolensType { Pinhole, ThinLens };
 const double kDefaultMmPerUnit = 1000.0;     // one scene unit is one metre
 const double kDefaultPixelSizeMm = 0.01;
 const double kDefaultSensorOffsetMm = 0.0;
-// Rays per pixel when `samples` is omitted. A named constant because a benchmark will pick it;
-// 1 gives the chief ray of each pixel (pixel centre, aperture centre).
-const int kDefaultSamples = 1;
+// Rays per pixel when `samples` is omitted, chosen from the speed/accuracy curve (BENCHMARKS.md):
+// 16 where a lens aperture must be sampled (thin-lens microlenses; a thin main lens without an
+// array): one ray would show no defocus blur at all, and 16 is the smallest count that gives
+// about 30 dB PSNR there. 1 where each point of a pixel has a single ray through pinholes, as
+// the stock perspective camera without antialiasing. default_samples() applies the rule.
+const int kDefaultSamplesApertures = 16;
+const int kDefaultSamplesPinholes = 1;
+// SamplingParams::samples when the scene does not give `samples`.
+const int kSamplesOmitted = 0;
 const double kDefaultConfidence = 0.9;       // as focal_blur
 const double kDefaultVariance = 1.0 / 128.0; // as focal_blur
 // Upper bound of `samples`: keeps every count an int and a render finite.
@@ -68,7 +74,7 @@ struct SensorParams {
 // `samples N` gives adaptive = false and samples = N.
 // `samples MIN, MAX [confidence C] [variance V]` gives adaptive = true.
 struct SamplingParams {
-    int samples = kDefaultSamples;
+    int samples = kSamplesOmitted;          // kSamplesOmitted: default_samples() of the camera
     bool adaptive = false;
     int samples_min = 0;
     int samples_max = 0;
@@ -107,6 +113,9 @@ std::string check_sampling(const SamplingParams& sampling);
 // The whole camera, run when the camera's closing brace is read. Runs the block checks again
 // (cheap), then the checks that need several blocks at once.
 std::string check_camera(const CameraParams& camera);
+
+// Rays per pixel for a camera whose scene omits `samples` (see kDefaultSamplesApertures).
+int default_samples(const CameraParams& camera);
 
 // Shortest text that reads back as the same double ("0.5", "1e-300", "nan").
 std::string format_number(double value);

@@ -253,8 +253,12 @@ TEST(Params, SensorAndSamplingRefusals)
 
     SamplingParams p;
     EXPECT_EQ(check_sampling(p), "");
-    p.samples = 0;
+    p.samples = -1;
     EXPECT_TRUE(contains(check_sampling(p), "samples")) << check_sampling(p);
+    // 0 in the struct means `samples` was omitted; typed in a scene, 0 is refused.
+    p.samples = kSamplesOmitted;
+    EXPECT_EQ(check_sampling(p), "");
+    EXPECT_TRUE(contains(check_samples("samples", 0), "samples")) << check_samples("samples", 0);
     p = SamplingParams();
     p.adaptive = true;
     p.samples_min = 16;

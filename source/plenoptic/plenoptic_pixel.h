@@ -67,8 +67,9 @@ inline void estimate(const SampleSums* sums, int lenses, double value[4], double
 // Shades pixel (i, j) of a W x H image. For each sample it builds the sample, generates the ray
 // and calls trace(const OpticsRay&) -> Rgbt for unblocked rays only; a blocked sample counts as
 // black and opaque (0, 0, 0, t = 0). Fixed count: model.samples_max samples. Adaptive (as
-// focal_blur): samples_min samples, then batches of 4, stopping once the variance of the
-// estimate is below thresholds[n-1] in every channel (r, g, b, t) or samples_max is reached.
+// focal_blur): samples_min samples, then batches of 4, stopping once at least one sample has
+// passed the apertures and the variance of the estimate is below thresholds[n-1] in every
+// channel (r, g, b, t), or samples_max is reached.
 // With overlap modelling, sample n goes through the pixel's lens n mod L (L lenses from
 // overlap_lenses) and the value is the sum over lenses of each lens's mean; t is clamped to
 // [0, 1]. A pixel that no lens reaches is black and opaque, never background.
@@ -107,6 +108,7 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
     int batch = model.adaptive ? std::max(1, model.samples_min) : count;
     double value[4], variance[4];
     int n = 0;
+    int passed = 0;  // samples that passed the apertures so far
     for (;;) {
         const int stop = std::min(count, n + batch);
         for (; n < stop; ++n) {
@@ -114,18 +116,25 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
             const CameraSample sample = make_sample(i, j, n, count);
             OpticsRay ray;
             Rgbt colour{0, 0, 0, 0};
-            if (generate_ray(model, W, H, i, j, sample, model.model_overlap ? &lenses[slot] : nullptr, &ray))
+            if (generate_ray(model, W, H, i, j, sample, model.model_overlap ? &lenses[slot] : nullptr, &ray)) {
                 colour = trace(static_cast<const OpticsRay&>(ray));
+                ++passed;
+            }
             detail::add_sample(&sums[slot], colour);
         }
         if (!model.adaptive || n >= count)
             break;
+        batch = 4;
+        // While every sample so far was blocked, the zero variance says nothing: a pixel at the
+        // rim of a microimage can have its lit part missed by the first samples. Blocked samples
+        // cost no scene ray, so go on until one passes (or samples_max says the pixel is dark).
+        if (passed == 0)
+            continue;
         detail::estimate(sums, lens_count, value, variance);
         const double threshold = model.thresholds[n - 1];
         if (std::fabs(variance[0]) < threshold && std::fabs(variance[1]) < threshold &&
             std::fabs(variance[2]) < threshold && std::fabs(variance[3]) < threshold)
             break;
-        batch = 4;
     }
     detail::estimate(sums, lens_count, value, variance);
     const double t = lens_count > 1 ? std::min(1.0, std::max(0.0, value[3])) : value[3];
@@ -134,7 +143,7 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
 
 // Whether any of the samples shade_pixel would take for pixel (i, j) passes the apertures: the
 // pixels for which it is false are those no light reaches (no scene needed). With adaptive
-// sampling it looks at the first samples_min samples, where shade_pixel always starts.
+// sampling that is all samples_max samples, since shade_pixel goes on until one passes.
 inline bool pixel_receives_light(const Model& model, int i, int j, int W, int H)
 {
     bool lit = false;

@@ -86,6 +86,38 @@ TEST(Pixel, AdaptiveSamplingStopsEarlyOnFlatScenesAndGoesOnOnNoisyOnes)
     EXPECT_EQ((calls - 8) % 4 == 0 || calls == 64, true) << calls << " samples: batches of 4 after the minimum";
 }
 
+TEST(Pixel, AdaptiveSamplingDoesNotTakeAnUnluckyBlockedStartForADarkPixel)
+{
+    // Plenoptic 1.0 with f-number-matched microlenses: pixels at a microimage's rim are partly
+    // lit, and for some of them every one of the first samples is blocked.
+    const int W = 160, H = 120, minimum = 16, maximum = 256;
+    CameraParams fixed = plenoptic_camera(GridType::Hexagonal, 0.16, 0.64, 0.64, 16, 4, 16.1);
+    fixed.sensor.pixel_size_mm[0] = fixed.sensor.pixel_size_mm[1] = 0.02;
+    CameraParams adaptive = fixed;
+    fixed.sampling.samples = maximum;
+    adaptive.sampling.adaptive = true;
+    adaptive.sampling.samples_min = minimum;
+    adaptive.sampling.samples_max = maximum;
+    const Model m_fixed = make_model(fixed), m_adaptive = make_model(adaptive);
+    auto white = [](const OpticsRay&) { return Rgbt{1, 1, 1, 0}; };
+    int unlucky = 0;
+    for (int j = 0; j < H; ++j)
+        for (int i = 0; i < W; ++i) {
+            bool first_lit = false;
+            for (int n = 0; n < minimum && !first_lit; ++n) {
+                OpticsRay ray;
+                first_lit = generate_ray(m_adaptive, W, H, i, j, make_sample(i, j, n, maximum), nullptr, &ray);
+            }
+            const bool lit = shade_pixel(m_fixed, i, j, W, H, white).r > 0;
+            const Rgbt value = shade_pixel(m_adaptive, i, j, W, H, white);
+            EXPECT_EQ(value.r > 0, lit) << "pixel " << i << "," << j << ": dark exactly when no sample passes";
+            EXPECT_EQ(pixel_receives_light(m_adaptive, i, j, W, H), lit) << "pixel " << i << "," << j;
+            if (lit && !first_lit)
+                ++unlucky;
+        }
+    EXPECT_GT(unlucky, 0) << "the set-up should have rim pixels whose first samples are all blocked";
+}
+
 TEST(Pixel, DeterministicWhateverThePixelOrder)
 {
     CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.2, 1.5, 2, 50, 4, 55);
