@@ -14,6 +14,11 @@ struct Rgbt {
     double r, g, b, t;
 };
 
+// Samples looked at, per traced sample, to measure how much of a partly vignetted pixel passes
+// the apertures. They need no scene ray (a few hundred instructions each), and at a microimage's
+// rim the vignetting, not the scene, is most of a pixel's error: 4 cuts it by more than half there.
+const int kVignettingProbesPerSample = 4;
+
 namespace detail {
 
 // Running sums of one lens's samples.
@@ -62,6 +67,50 @@ inline void estimate(const SampleSums* sums, int lenses, double value[4], double
     }
 }
 
+// How many of samples 0 .. probes-1 of pixel (i, j) pass the apertures through the pixel's own
+// lenses (geometry only), and the first of them at or after `from` (-1 if none).
+inline int passing_samples(const Model& model, int i, int j, int W, int H, int probes, int from, int* first_from)
+{
+    int passing = 0;
+    *first_from = -1;
+    for (int n = 0; n < probes; ++n) {
+        OpticsRay ray;
+        if (generate_ray(model, W, H, i, j, make_sample(i, j, n, probes), nullptr, &ray)) {
+            ++passing;
+            if (n >= from && *first_from < 0)
+                *first_from = n;
+        }
+    }
+    return passing;
+}
+
+// The pixel's value from the samples traced so far when some were blocked: the mean colour of the
+// samples that passed, times the passing fraction measured over kVignettingProbesPerSample times
+// as many sample points (a ratio estimate: the vignetting is known far better than the scene).
+// `sum` holds the sums of the `passed` traced colours of samples 0 .. n-1. With none passed but
+// some probe passing, that probe's sample is traced so the pixel is not black where light lands.
+template <class TraceFn>
+Rgbt vignetted_value(const Model& model, int i, int j, int W, int H, int n, int passed, double sum[4], TraceFn& trace)
+{
+    const int probes = n * kVignettingProbesPerSample;
+    int first_untraced;
+    const int passing = passing_samples(model, i, j, W, H, probes, n, &first_untraced);
+    if (passed == 0 && first_untraced >= 0) {
+        OpticsRay ray;
+        generate_ray(model, W, H, i, j, make_sample(i, j, first_untraced, probes), nullptr, &ray);
+        const Rgbt c = trace(static_cast<const OpticsRay&>(ray));
+        sum[0] = c.r;
+        sum[1] = c.g;
+        sum[2] = c.b;
+        sum[3] = c.t;
+        passed = 1;
+    }
+    if (passed == 0)
+        return Rgbt{0, 0, 0, 0};
+    const double scale = double(passing) / probes / passed;
+    return Rgbt{sum[0] * scale, sum[1] * scale, sum[2] * scale, sum[3] * scale};
+}
+
 } // namespace detail
 
 // Shades pixel (i, j) of a W x H image. For each sample it builds the sample, generates the ray
@@ -69,7 +118,9 @@ inline void estimate(const SampleSums* sums, int lenses, double value[4], double
 // black and opaque (0, 0, 0, t = 0). Fixed count: model.samples_max samples. Adaptive (as
 // focal_blur): samples_min samples, then batches of 4, stopping once at least one sample has
 // passed the apertures and the variance of the estimate is below thresholds[n-1] in every
-// channel (r, g, b, t), or samples_max is reached.
+// channel (r, g, b, t), or samples_max is reached. When some of the n samples were blocked, the
+// value is detail::vignetted_value: the mean of the traced colours times the fraction of 4n
+// sample points that pass (no scene ray for those). With one sample, the chief ray alone.
 // With overlap modelling, sample n goes through the pixel's lens n mod L (L lenses from
 // overlap_lenses) and the value is the sum over lenses of each lens's mean; t is clamped to
 // [0, 1]. A pixel that no lens reaches is black and opaque, never background.
@@ -81,6 +132,7 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
         // Fixed count through the own lens: the plain mean, without the variance bookkeeping
         // (the common case, and the one whose cost is compared with the stock cameras).
         double sum[4] = {0, 0, 0, 0};
+        int passed = 0;
         for (int n = 0; n < count; ++n) {
             OpticsRay ray;
             if (generate_ray(model, W, H, i, j, make_sample(i, j, n, count), nullptr, &ray)) {
@@ -89,8 +141,11 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
                 sum[1] += c.g;
                 sum[2] += c.b;
                 sum[3] += c.t;
+                ++passed;
             }
         }
+        if (count > 1 && passed < count)
+            return detail::vignetted_value(model, i, j, W, H, count, passed, sum, trace);
         return Rgbt{sum[0] / count, sum[1] / count, sum[2] / count, sum[3] / count};
     }
 
@@ -136,14 +191,16 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
             std::fabs(variance[2]) < threshold && std::fabs(variance[3]) < threshold)
             break;
     }
+    if (lens_count == 1 && n > 1 && passed < n)
+        return detail::vignetted_value(model, i, j, W, H, n, passed, sums[0].sum, trace);
     detail::estimate(sums, lens_count, value, variance);
     const double t = lens_count > 1 ? std::min(1.0, std::max(0.0, value[3])) : value[3];
     return Rgbt{value[0], value[1], value[2], t};
 }
 
-// Whether any of the samples shade_pixel would take for pixel (i, j) passes the apertures: the
-// pixels for which it is false are those no light reaches (no scene needed). With adaptive
-// sampling that is all samples_max samples, since shade_pixel goes on until one passes.
+// Whether any of the sample points shade_pixel looks at for pixel (i, j) passes the apertures
+// (the traced samples and the vignetting probes): the pixels for which it is false are those
+// no light reaches (no scene needed).
 inline bool pixel_receives_light(const Model& model, int i, int j, int W, int H)
 {
     bool lit = false;

@@ -46,14 +46,18 @@ TEST(Pixel, BlockedSamplesAreBlackAndOpaqueNeverBackground)
     EXPECT_EQ(lit.r, 1.0);
     EXPECT_EQ(lit.t, 1.0);
 
-    // At the disc's edge some samples are blocked: the value is the unblocked fraction.
+    // At the disc's edge some samples are blocked: the value is the unblocked fraction of the
+    // 4 x 16 sample points looked at (the vignetting probes).
     bool partial = false;
     for (int i = 51; i < 60 && !partial; ++i) {
         const Rgbt edge = shade_pixel(m, i, 50, W, H, background);
         if (edge.r > 0 && edge.r < 1) {
             partial = true;
             EXPECT_EQ(edge.r, edge.t);
-            EXPECT_EQ(edge.r * 16, std::floor(edge.r * 16)) << "a whole number of the 16 samples";
+            const int probes = 16 * kVignettingProbesPerSample;
+            EXPECT_NEAR(edge.r * probes, std::round(edge.r * probes), 1e-9) << "a whole number of the probes";
+            int first;
+            EXPECT_EQ(edge.r, double(detail::passing_samples(m, i, 50, W, H, probes, 0, &first)) / probes);
         }
     }
     EXPECT_TRUE(partial) << "expected a partly vignetted pixel near the microimage's edge";
@@ -116,6 +120,34 @@ TEST(Pixel, AdaptiveSamplingDoesNotTakeAnUnluckyBlockedStartForADarkPixel)
                 ++unlucky;
         }
     EXPECT_GT(unlucky, 0) << "the set-up should have rim pixels whose first samples are all blocked";
+}
+
+TEST(Pixel, VignettingProbesBringRimPixelsCloserToTheirTrueLitFraction)
+{
+    // White scene: a pixel's exact value is the fraction of its (pixel x aperture) domain that
+    // passes the apertures. Compare 16 samples with and without the probes against 4096 points.
+    const int W = 160, H = 120, samples = 16, reference = 4096;
+    CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.16, 0.64, 0.64, 16, 4, 16.1);
+    params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.02;
+    params.sampling.samples = samples;
+    const Model m = make_model(params);
+    auto white = [](const OpticsRay&) { return Rgbt{1, 1, 1, 0}; };
+    double error_plain = 0, error_probed = 0;
+    int rim = 0;
+    for (int j = 0; j < H; j += 2)
+        for (int i = 0; i < W; i += 2) {
+            int first;
+            const double truth = double(detail::passing_samples(m, i, j, W, H, reference, 0, &first)) / reference;
+            if (truth == 0 || truth == 1)
+                continue;
+            ++rim;
+            const double plain = double(detail::passing_samples(m, i, j, W, H, samples, 0, &first)) / samples;
+            error_plain += (plain - truth) * (plain - truth);
+            const double probed = shade_pixel(m, i, j, W, H, white).r;
+            error_probed += (probed - truth) * (probed - truth);
+        }
+    ASSERT_GT(rim, 500) << "f-number-matched microimages: many pixels at their rims";
+    EXPECT_LT(error_probed, 0.5 * error_plain) << "squared error: " << error_probed << " vs " << error_plain;
 }
 
 TEST(Pixel, DeterministicWhateverThePixelOrder)
