@@ -34,6 +34,15 @@ double microlens_focal(const Model& m, LensIndex lens)
     return m.microlens_focal_mm[lens_type(lens, m.lens_type_count)];
 }
 
+// Whether (x, y) lies in the disc of this radius about the origin: squares where they cannot
+// overflow (cheaper than hypot: this runs for every ray), hypot for absurdly large apertures.
+bool inside_disc(double x, double y, double radius)
+{
+    if (radius < 1e150)
+        return x * x + y * y <= radius * radius;  // an overflowing x * x is +inf: outside, as it should be
+    return std::hypot(x, y) <= radius;
+}
+
 bool finish(Vec3 origin, Vec3 direction, OpticsRay* out)
 {
     const Vec3 unit = normalized(direction);
@@ -167,7 +176,7 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
     const double mx = leave.x + travel * direction.x;
     const double my = leave.y + travel * direction.y;
     const double radius = 0.5 * m.aperture_mm;
-    if (check_apertures && !(mx * mx + my * my <= radius * radius))
+    if (check_apertures && !inside_disc(mx, my, radius))
         return false;  // misses the main-lens aperture: carries no light
     const double wx = direction.x / direction.z - mx / m.focal_length_mm;
     const double wy = direction.y / direction.z - my / m.focal_length_mm;
