@@ -67,18 +67,18 @@ inline void estimate(const SampleSums* sums, int lenses, double value[4], double
     }
 }
 
-// How many of samples 0 .. probes-1 of pixel (i, j) pass the apertures through the pixel's own
-// lenses (geometry only), and the first of them at or after `from` (-1 if none).
-inline int passing_samples(const Model& model, int i, int j, int W, int H, int probes, int from, int* first_from)
+// How many of samples from .. to-1 of pixel (i, j) pass the apertures through the pixel's own
+// lenses (geometry only); *first is the first of them (-1 if none).
+inline int passing_samples(const Model& model, int i, int j, int W, int H, int from, int to, int* first)
 {
     int passing = 0;
-    *first_from = -1;
-    for (int n = 0; n < probes; ++n) {
+    *first = -1;
+    for (int n = from; n < to; ++n) {
         OpticsRay ray;
-        if (generate_ray(model, W, H, i, j, make_sample(i, j, n, probes), nullptr, &ray)) {
+        if (generate_ray(model, W, H, i, j, make_sample(i, j, n, to), nullptr, &ray)) {
             ++passing;
-            if (n >= from && *first_from < 0)
-                *first_from = n;
+            if (*first < 0)
+                *first = n;
         }
     }
     return passing;
@@ -94,7 +94,8 @@ Rgbt vignetted_value(const Model& model, int i, int j, int W, int H, int n, int 
 {
     const int probes = n * kVignettingProbesPerSample;
     int first_untraced;
-    const int passing = passing_samples(model, i, j, W, H, probes, n, &first_untraced);
+    // Samples 0 .. n-1 were generated already: only the points after them are new.
+    const int passing = passed + passing_samples(model, i, j, W, H, n, probes, &first_untraced);
     if (passed == 0 && first_untraced >= 0) {
         OpticsRay ray;
         generate_ray(model, W, H, i, j, make_sample(i, j, first_untraced, probes), nullptr, &ray);

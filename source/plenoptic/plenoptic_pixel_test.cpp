@@ -21,6 +21,15 @@ Rgbt textured(const OpticsRay& ray)
     return Rgbt{0.5 + 0.5 * a, 0.25 + 0.1 * ray.origin_mm[0], 0.5 - 0.5 * a, 0.0};
 }
 
+// Plenoptic 1.0 with f-number-matched hexagonal microlenses (f/4), 20 um pixels: tools/bench's
+// camera. Its 8-pixel microimages put many pixels at a rim, partly lit.
+CameraParams matched_plenoptic1()
+{
+    CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.16, 0.64, 0.64, 16, 4, 16.1);
+    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.02;
+    return p;
+}
+
 TEST(Pixel, BlockedSamplesAreBlackAndOpaqueNeverBackground)
 {
     // Pinhole array behind a small main aperture: small microimage discs, dark cells between.
@@ -57,7 +66,7 @@ TEST(Pixel, BlockedSamplesAreBlackAndOpaqueNeverBackground)
             const int probes = 16 * kVignettingProbesPerSample;
             EXPECT_NEAR(edge.r * probes, std::round(edge.r * probes), 1e-9) << "a whole number of the probes";
             int first;
-            EXPECT_EQ(edge.r, double(detail::passing_samples(m, i, 50, W, H, probes, 0, &first)) / probes);
+            EXPECT_EQ(edge.r, double(detail::passing_samples(m, i, 50, W, H, 0, probes, &first)) / probes);
         }
     }
     EXPECT_TRUE(partial) << "expected a partly vignetted pixel near the microimage's edge";
@@ -95,8 +104,7 @@ TEST(Pixel, AdaptiveSamplingDoesNotTakeAnUnluckyBlockedStartForADarkPixel)
     // Plenoptic 1.0 with f-number-matched microlenses: pixels at a microimage's rim are partly
     // lit, and for some of them every one of the first samples is blocked.
     const int W = 160, H = 120, minimum = 16, maximum = 256;
-    CameraParams fixed = plenoptic_camera(GridType::Hexagonal, 0.16, 0.64, 0.64, 16, 4, 16.1);
-    fixed.sensor.pixel_size_mm[0] = fixed.sensor.pixel_size_mm[1] = 0.02;
+    CameraParams fixed = matched_plenoptic1();
     CameraParams adaptive = fixed;
     fixed.sampling.samples = maximum;
     adaptive.sampling.adaptive = true;
@@ -127,8 +135,7 @@ TEST(Pixel, VignettingProbesBringRimPixelsCloserToTheirTrueLitFraction)
     // White scene: a pixel's exact value is the fraction of its (pixel x aperture) domain that
     // passes the apertures. Compare 16 samples with and without the probes against 4096 points.
     const int W = 160, H = 120, samples = 16, reference = 4096;
-    CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.16, 0.64, 0.64, 16, 4, 16.1);
-    params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.02;
+    CameraParams params = matched_plenoptic1();
     params.sampling.samples = samples;
     const Model m = make_model(params);
     auto white = [](const OpticsRay&) { return Rgbt{1, 1, 1, 0}; };
@@ -137,11 +144,11 @@ TEST(Pixel, VignettingProbesBringRimPixelsCloserToTheirTrueLitFraction)
     for (int j = 0; j < H; j += 2)
         for (int i = 0; i < W; i += 2) {
             int first;
-            const double truth = double(detail::passing_samples(m, i, j, W, H, reference, 0, &first)) / reference;
+            const double truth = double(detail::passing_samples(m, i, j, W, H, 0, reference, &first)) / reference;
             if (truth == 0 || truth == 1)
                 continue;
             ++rim;
-            const double plain = double(detail::passing_samples(m, i, j, W, H, samples, 0, &first)) / samples;
+            const double plain = double(detail::passing_samples(m, i, j, W, H, 0, samples, &first)) / samples;
             error_plain += (plain - truth) * (plain - truth);
             const double probed = shade_pixel(m, i, j, W, H, white).r;
             error_probed += (probed - truth) * (probed - truth);
