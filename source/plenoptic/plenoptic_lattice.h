@@ -11,7 +11,7 @@
 
 namespace plenoptic {
 
-// Lens indices in the contract's row form:
+// Lens indices in the row form of docs/specification.md (section 2):
 //   rectangular: centre (k p, l p)
 //   hexagonal:   centre ((k + (l mod 2)/2) p, l p sqrt(3)/2)   (odd rows shifted +x by p/2)
 struct LensIndex {

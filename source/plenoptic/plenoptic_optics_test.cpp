@@ -450,7 +450,8 @@ TEST(Optics, ForwardProjectedPositionsTurnBackIntoChiefRaysThroughThePoint)
 
 // Light from a point, traced by brute force through the main aperture (uniform in area) and
 // each microlens to the sensor: its centroid per lens is where forward_project says the point
-// images. The tracer here is written from the contract's rule w' = w - h/f, independently.
+// images. The tracer here is written from the rule w' = w - h/f of docs/specification.md
+// (section 3), independently.
 void check_forward_is_centroid(const char* name, const CameraParams& params, double max_px)
 {
     ASSERT_EQ(check_camera(params), "") << name;

@@ -2,7 +2,7 @@
 """Shared helpers of the camera render tests (tests/camera/).
 
 Everything the tests expect is computed here or in the test itself from the
-contract (/work/shared/design/plenoptic-camera.md, docs/camera.md), never by
+specification (docs/specification.md, docs/camera.md), never by
 calling the camera code: the renders are the only thing the code under test
 produces.
 """
@@ -114,7 +114,7 @@ class Checks:
         return 0
 
 
-# ---------------------------------------------------------------- geometry (the contract)
+# ---------------------------------------------------------------- geometry (docs/specification.md)
 
 SQRT3 = math.sqrt(3.0)
 
@@ -132,7 +132,7 @@ def rotation_xyz(deg):
 
 
 def lattice_point(grid, pitch, k, l):
-    """Lens centre in the array's own plane (contract, section 2), row-form indices."""
+    """Lens centre in the array's own plane (docs/specification.md, section 2), row-form indices."""
     if grid == "hexagonal":
         return np.array([(k + (l % 2) / 2.0) * pitch, l * pitch * SQRT3 / 2.0, 0.0])
     return np.array([k * pitch, l * pitch, 0.0])
@@ -146,7 +146,7 @@ def posed_lens_centre(grid, pitch, k, l, rotate, translate, D):
 
 def sensor_to_pixel(x, y, W, H, sx, sy, ox=0.0, oy=0.0):
     """Sensor point (optics frame, mm) -> continuous pixel coordinates with the centre of
-    pixel (i, j) at (i, j) (contract, section 2: x = -((i + 0.5) - W/2) sx + ox ...)."""
+    pixel (i, j) at (i, j) (docs/specification.md, section 2: x = -((i + 0.5) - W/2) sx + ox ...)."""
     u = W / 2.0 - 0.5 - (x - ox) / sx
     v = H / 2.0 - 0.5 + (y - oy) / sy
     return u, v

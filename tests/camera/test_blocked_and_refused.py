@@ -10,7 +10,7 @@ lens with a pinhole array is refused at parse time with a clear message.
 1. Plenoptic cameras with gaps between their microimages (main lens stopped down to
    f/8, well beyond f-number matching) look at an empty scene whose background is
    green, rendered with +UA (alpha). Stock POV-Ray gives background pixels alpha 0.
-   The test predicts from the contract which pixels lie wholly outside every
+   The test predicts from docs/specification.md which pixels lie wholly outside every
    microimage (further from the projection of their lens centre than the aperture's
    image plus the spread of a lens cell plus half a pixel diagonal) and which lie
    wholly inside, and requires: outside = RGB 0 and alpha 1 exactly; inside = alpha 0
@@ -43,7 +43,7 @@ def camera(grid, lens, d, pitch):
 
 
 def classify(grid, lens, d, pitch):
-    """Boolean masks (wholly dark, wholly lit) of the pixels, from the contract."""
+    """Boolean masks (wholly dark, wholly lit) of the pixels, from docs/specification.md."""
     D = camlib.thin_lens_D(F_MAIN, FOCUS * 1000.0)
     k = D / d
     g = 1 + k if lens == "pinhole" else 1 + k - D / lens

@@ -13,9 +13,9 @@ and its ray runs from the pixel through that lens's centre. So:
 2. Hexagonal arrays (one plain, one rotated about z and translated): small emissive
    discs parallel to the sensor image, through each lens centre c, to the point
    c + (c - X) d / X_z (a disc parallel to the sensor projects to a circle centred
-   there). The test predicts every image of every disc from the contract's lattice
-   and pose, measures the centroids of the blobs in the render, and compares; it also
-   checks that exactly the predicted lenses show each disc.
+   there). The test predicts every image of every disc from the lattice and pose of
+   docs/specification.md (section 2), measures the centroids of the blobs in the
+   render, and compares; it also checks that exactly the predicted lenses show each disc.
 """
 import glob
 import math

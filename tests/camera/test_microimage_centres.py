@@ -13,11 +13,11 @@ about their centres, that fraction is symmetric about s0 = c (1 + 1/k) = c (D + 
 and so is the microimage cell (the central projection of the lens cell). Hence the
 centroid of each microimage is the projection s0, whatever f and d are.
 
-The test computes s0 for every lens from the contract's lattice (section 2) and pose
+The test computes s0 for every lens from the lattice and pose of docs/specification.md (section 2)
 (rotate x, y, z, then translate, then place at z = -D), renders a scene with nothing
 but a white background, finds the microimages as connected bright regions, and
-compares their intensity centroids with s0: mean error at most 0.1 px (the contract's
-ground-truth accuracy), no single microimage off by more than 0.25 px, and exactly
+compares their intensity centroids with s0: mean error at most 0.1 px (the ground-truth
+accuracy of docs/specification.md, section 5), no single microimage off by more than 0.25 px, and exactly
 one microimage for each lens whose microimage lies inside the picture. The metadata's
 microimage lattice must give the same centres to 0.01 px.
 """
@@ -61,7 +61,7 @@ def run_case(args, checks, name, grid, lens, d, pitch, rotate, translate):
     img = camlib.load(path)[:, :, 0]
     lattice = camlib.metadata(path).get("microimage_lattice") or {}
 
-    # Expected centres, from the contract only.
+    # Expected centres, from the specification (docs/specification.md) only.
     D = camlib.thin_lens_D(F_MAIN, FOCUS_M * 1000.0)
     sensor_z = -(D + d)
     A = F_MAIN / F_NUMBER
@@ -116,7 +116,7 @@ def run_case(args, checks, name, grid, lens, d, pitch, rotate, translate):
             ks = k - (l // 2) if grid == "hexagonal" else k
             worst = max(worst, float(np.hypot(*(o + ks * a + l * b - (u, v)))))
         checks.check(worst < 0.01, name + ": metadata lattice",
-                     "largest distance between the metadata's centre and the contract's projection "
+                     "largest distance between the metadata's centre and the specification's projection "
                      "%.2g px over %d lenses (tolerance 0.01 px)" % (worst, len(inside)))
     else:
         checks.check(False, name + ": metadata lattice", "no microimage_lattice in the metadata")

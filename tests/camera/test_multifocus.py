@@ -11,10 +11,11 @@ lens cell at the array, each lens uses its whole cell (width ~ pitch p), and the
 on the sensor is p |1 - d (1/f - 1/a)|: 0 px for f = 0.40, about 3.5 px for 0.45 and
 8.5 px for 0.55 (4 um pixels, p = 0.15 mm).
 
-The contract (section 2) asks that no two neighbouring lenses share a type and that the
-metadata state the rule; docs/metadata.md gives it: with skew index k_s = k - floor(l/2),
-type(k, l) = (k_s - l) mod 3, and lens (k, l) has focal_lengths[type]. The test measures
-the sharpness (gradient energy at the middle of each microimage) and checks that
+The specification (docs/specification.md, section 2) asks that no two neighbouring lenses
+share a type and that the metadata state the rule; docs/metadata.md gives it: with skew
+index k_s = k - floor(l/2), type(k, l) = (k_s - l) mod 3, and lens (k, l) has
+focal_lengths[type]. The test measures the sharpness (gradient energy at the middle of each
+microimage) and checks that
 1. the median sharpness of the three types is ordered as the predicted blurs;
 2. classifying each microimage by its sharpness alone gives the rule's type;
 3. the measured classes never repeat between neighbours (the neighbour rule, from the

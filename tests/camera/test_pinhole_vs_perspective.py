@@ -8,7 +8,7 @@ same pixels. For each case both cameras render the same textured scene (16-bit l
 PNG, one ray per pixel) and must agree exactly; OpenImageIO's idiff is asked the same
 question with a zero tolerance.
 
-Derivation used for the cases the contract does not spell out (non-square pixels and
+Derivation used for the cases docs/specification.md does not spell out (non-square pixels and
 a sensor offset): with right R, up U (|U| = 1) and direction L (perpendicular), stock
 POV-Ray shoots pixel (i, j) along L + ((i+.5)/W - .5) R + (.5 - (j+.5)/H) U. The
 plenoptic pinhole shoots from the sensor point x = -((i+.5) - W/2) sx + ox,
@@ -55,7 +55,7 @@ def frame_vectors():
 
 def stock_camera(W, H, sx, sy, D, ox, oy):
     if ox == 0 and oy == 0 and sx == sy:
-        # The contract's form, verbatim.
+        # The form of docs/specification.md (section 3), verbatim.
         angle = 2 * math.degrees(math.atan(W * sx / (2 * D)))
         return ("camera { perspective location %s look_at %s right x*%r/%r up y angle %.17g }"
                 % (vec(LOCATION), vec(LOOK_AT), float(W), float(H), angle))

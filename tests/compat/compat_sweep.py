@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Every scene and include file of POV-Ray's own distribution that parses with Debian's
-packaged povray must parse with ours (design contract, section 6).
+packaged povray must parse with ours (docs/specification.md, section 6).
 
 Each item is parsed, not rendered: a wrapper scene #includes the file and then stops with
 `#error "<marker>"`. Reaching the marker proves that the whole file parsed; the render

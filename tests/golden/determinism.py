@@ -5,8 +5,8 @@ two, and with two threads and small render blocks (another split of the work), m
 byte-identical files: the 16-bit PNG (every chunk but the two that hold the time of the
 render), the metadata JSON and the depth EXR when there is one.
 
-The design contract (section 3) asks for the same image whatever the thread count; POV-Ray's
-own focal blur has the same property.
+The specification (docs/specification.md, section 3) asks for the same image whatever the
+thread count; POV-Ray's own focal blur has the same property.
 """
 import argparse
 import hashlib

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Shared helpers of the ground-truth tests: rendering, reading outputs, checks, and the optics
-of the contract (docs in /work/shared/design/plenoptic-camera.md, docs/metadata.md) written
+of the specification (docs/specification.md, docs/metadata.md) written
 out again here, independently of the code under test."""
 
 import argparse
@@ -100,7 +100,7 @@ class Checks:
 
 
 # --------------------------------------------------------------------------------------------
-# The contract's optics, written out again
+# The optics of docs/specification.md, written out again
 
 def image_distance(F, z):
     """Thin lens: where an object at distance z (same unit as F, z > F) is imaged behind the lens."""
@@ -108,7 +108,7 @@ def image_distance(F, z):
 
 
 def lens_centre_local(grid, pitch, k, l):
-    """Lens (k, l) in row form, in the array's own plane (contract section 2)."""
+    """Lens (k, l) in row form, in the array's own plane (docs/specification.md, section 2)."""
     k = np.asarray(k, float)
     l = np.asarray(l, float)
     if grid == "hexagonal":
@@ -149,8 +149,8 @@ def rot_z(degrees):
 
 
 def sensor_point(i, j, W, H, sx, sy, ox=0.0, oy=0.0):
-    """Sensor position (mm, optics frame) of the centre of pixel (column i, row j): contract
-    section 2, with (i + 0.5) the centre of a pixel spanning [i, i + 1)."""
+    """Sensor position (mm, optics frame) of the centre of pixel (column i, row j):
+    docs/specification.md, section 2, with (i + 0.5) the centre of a pixel spanning [i, i + 1)."""
     return -((np.asarray(i, float) + 0.5) - W / 2.0) * sx + ox, ((np.asarray(j, float) + 0.5) - H / 2.0) * sy + oy
 
 

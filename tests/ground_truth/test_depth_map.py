@@ -6,7 +6,8 @@ behind a shifted sensor) looks straight down +z at two fronto-parallel emissive 
 one at z = 0.5 covering the upper part of the view, a far one at z = 2 covering x <= 0.08, and
 nothing to the lower right (a white sky_sphere behind, which is not a surface).
 
-For every pixel the test rebuilds the chief ray from the contract: the pixel centre, the lens
+For every pixel the test rebuilds the chief ray from the specification (docs/specification.md,
+sections 2 and 3): the pixel centre, the lens
 whose cell holds the pixel's projection from the main-lens centre onto the array, the line
 through that lens's centre to the main lens (hit at m), refracted there by w' = w - m / F. Along
 it, a plane at optics-frame depth z is at distance (z - m_z) / w_z (w unit length), converted

@@ -9,7 +9,7 @@ hexagonal array behind a shifted sensor, the test checks that
   - the metadata's lattice (origin + k a + l b) is on the measured centres, 0.1 px on average;
   - the LFToolbox LensletGridModel in the metadata, built into a grid the way LFToolbox's
     LFBuildHexGrid does it (1-based pixels), lands on the same centres;
-  - the metadata's numbers equal the contract's formulas evaluated here: the principal point,
+  - the metadata's numbers equal the formulas of docs/specification.md evaluated here: the principal point,
     the lattice origin and basis (lens centres projected from the main-lens centre), and the
     diameter of the aperture's disc (A d / D, also measured from the disc's area).
 """
@@ -81,7 +81,7 @@ def lftoolbox_grid(model):
 
 
 def expected_metadata(case):
-    """Principal point, lattice origin and basis, disc diameter from the contract (section 2, 3)."""
+    """Principal point, lattice origin and basis, disc diameter from docs/specification.md (sections 2, 3)."""
     D = gt.image_distance(F, FOCUS * 1000.0)
     d, p = case["d"], case["pitch"]
     ox, oy = case["offset"]
@@ -113,10 +113,10 @@ def run_case(args, checks, case):
     m_origin = np.array(lattice["origin_px"])
     m_a, m_b = np.array(lattice["basis_px"][0]), np.array(lattice["basis_px"][1])
     checks.check(np.abs(np.array(meta["principal_point_px"]) - principal).max() < 1e-6,
-                 "%s: principal_point_px %s = contract %s" % (name, meta["principal_point_px"], principal.tolist()))
+                 "%s: principal_point_px %s = specification %s" % (name, meta["principal_point_px"], principal.tolist()))
     largest = max(np.abs(m_origin - origin).max(), np.abs(m_a - a).max(), np.abs(m_b - b).max())
     checks.check(largest < 1e-6,
-                 "%s: lattice origin %s a %s b %s = contract origin %s a %s b %s"
+                 "%s: lattice origin %s a %s b %s = specification origin %s a %s b %s"
                  % (name, m_origin.round(6).tolist(), m_a.round(6).tolist(), m_b.round(6).tolist(),
                     origin.round(6).tolist(), a.round(6).tolist(), b.round(6).tolist()))
     checks.check(abs(lattice["microimage_diameter_px"] - diameter) < 1e-6,

@@ -16,8 +16,8 @@ images, to 0.25 px, for three set-ups:
 Only lenses whose whole cell lies inside the cone of light (sphere image -> main aperture) are
 compared (a lens at the cone's rim sees the sphere cut off, which moves the centroid); this
 choice, the thin-lens image of each sphere and the camera frame are computed here from the
-contract, not by the code under test. Every other blob must still be explained by a predicted
-image, and every predicted image must show a blob.
+specification (docs/specification.md), not by the code under test. Every other blob must still
+be explained by a predicted image, and every predicted image must show a blob.
 """
 
 import math

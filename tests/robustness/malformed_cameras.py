@@ -2,8 +2,9 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Malformed plenoptic camera blocks: every one must be refused at parse time.
 
-For each case the scene is written with one keyword per line (the layout of the contract's
-own example) and the offending line marked with a `//!` comment. The render must:
+For each case the scene is written with one keyword per line (the layout of the example in
+docs/specification.md, section 1) and the offending line marked with a `//!` comment. The
+render must:
   - exit with a non-zero status, by itself (no signal, no time-out, no "Segmentation", no core);
   - print POV-Ray's parse error naming this file and the offending line
     (`File 'x.pov' line N: Parse Error: ...`; the old `File: x.pov  Line: N` form is accepted too);
@@ -16,8 +17,9 @@ closing brace; a rule across blocks at the camera's closing brace. Both are what
 docs/robustness.md promises the user.
 
 Group "placement" holds NaN and infinite values in the placement keywords every POV-Ray camera
-has (location, look_at, transforms); the contract refuses "any NaN or infinite value", while stock
-POV-Ray accepts them for its own cameras, so they are a separate ctest.
+has (location, look_at, transforms); the specification (docs/specification.md, section 4)
+refuses "any NaN or infinite value", while stock POV-Ray accepts them for its own cameras, so
+they are a separate ctest.
 """
 import argparse
 import os
