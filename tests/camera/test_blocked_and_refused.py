@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Blocked light is black and opaque; the degenerate pinhole/pinhole pair is refused.
 
-Contract, section 3: a ray that misses the main-lens aperture carries no light; a
+docs/specification.md, section 3: a ray that misses the main-lens aperture carries no light; a
 pixel's value is the mean over its samples with blocked samples black; a pixel no ray
 reaches is black and opaque, never background. Section 4 / the table: a pinhole main
 lens with a pinhole array is refused at parse time with a clear message.

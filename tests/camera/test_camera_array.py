@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Bare pinhole array (no main lens): each microimage is a pinhole camera at its lens.
 
-Contract, section 3: with no main lens, a pixel belongs to the lens straight above it,
+docs/specification.md, section 3: with no main lens, a pixel belongs to the lens straight above it,
 and its ray runs from the pixel through that lens's centre. So:
 
 1. Rectangular array whose cells cover whole blocks of n x n pixels: the block under

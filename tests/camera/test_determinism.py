@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Determinism: the same scene and options give the same image, whatever the threads.
 
-Contract, section 3. A textured scene through the most involved set-up the camera has
+docs/specification.md, section 3. A textured scene through the most involved set-up the camera has
 (thin main lens, multi-focus hexagonal array, rotated and translated, overlapping
 microimages, adaptive sampling, a depth map) is rendered with one thread, with two
 threads, and with two threads and tiny render blocks (a different order of pixels

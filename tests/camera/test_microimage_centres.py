@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Microimage centres of plenoptic cameras in a uniformly white scene.
 
-Contract, sections 2 and 3: the centre of lens k's microimage is the central
+docs/specification.md, sections 2 and 3: the centre of lens k's microimage is the central
 projection of the (posed) lens centre from the main-lens centre onto the sensor at
 z = -(D + d), with D from 1/F = 1/z + 1/D. Why the centroid is there: for a thin main
 lens of aperture radius R, a ray from sensor point s through the cell point h of

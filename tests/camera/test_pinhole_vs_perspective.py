@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Pinhole main lens, no array == POV-Ray's stock perspective camera.
 
-Contract, section 3: a pinhole at distance D from a sensor of W x H pixels of size sx
+docs/specification.md, section 3: a pinhole at distance D from a sensor of W x H pixels of size sx
 is the perspective camera with `angle 2 atan(W sx / 2D)` and `right x*W/H up y`: the
 same pixels. For each case both cameras render the same textured scene (16-bit linear
 PNG, one ray per pixel) and must agree exactly; OpenImageIO's idiff is asked the same

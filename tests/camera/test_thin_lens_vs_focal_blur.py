@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Thin main lens, no array == stock perspective camera with focal_blur.
 
-Contract, section 3: same image up to sampling noise. The stock camera gets the
+docs/specification.md, section 3: same image up to sampling noise. The stock camera gets the
 pinhole-equivalent angle 2 atan(W sx / 2D) with D from 1/F = 1/z + 1/D, its
 focal_point on the optical axis at the focus distance z (stock focal blur focuses on
 the plane at that distance along the viewing direction, as the thin lens does), and
