@@ -27,8 +27,8 @@ import re
 import subprocess
 import sys
 
-# 1. Paths outside the repository. `/work/` counts only as the start of an absolute path (not
-# after a name, as in `$BUILD/work/`).
+# 1. Paths outside the repository. The work directory counts only as the start of an absolute
+# path, not after a name (a build folder's own `work` subfolder is fine).
 _W = "work"
 OUTSIDE = [
     (re.compile(re.escape("shared" + "/design")), "names the design directory outside the repository"),
