@@ -21,11 +21,15 @@ def parse_args(description):
     parser = argparse.ArgumentParser(description=description)
     parser.add_argument("--povray", required=True, help="the povray binary under test")
     parser.add_argument("--project", required=True, help="the plenoptic-project binary")
-    parser.add_argument("--tools", required=True, help="the tools/ folder (plenoptic-decode, plenoptic_lf.py)")
+    parser.add_argument("--tools", required=True, help="the tools/ folder (the plenoptic-decode launcher)")
+    parser.add_argument("--python", default=None,
+                        help="the folder holding the plenoptic_lf package (default: python/ beside --tools)")
     parser.add_argument("--work", required=True, help="scratch folder for renders")
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
-    sys.path.insert(0, os.path.abspath(args.tools))
+    if args.python is None:
+        args.python = os.path.join(os.path.dirname(os.path.abspath(args.tools)), "python")
+    sys.path.insert(0, os.path.abspath(args.python))
     return args
 
 

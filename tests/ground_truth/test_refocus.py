@@ -3,7 +3,7 @@
 
 Scene: two emissive textured planes facing the camera, a near one (top half of the picture) and
 a far one (everywhere behind it), seen by a thin main lens focused between them and a hexagonal
-array of microlenses at d = f. Decoded with tools/plenoptic_lf.py:
+array of microlenses at d = f. Decoded with the plenoptic_lf package (python/):
 
   - disparity: a point imaged by the main lens at b (1/F = 1/z + 1/b) moves, between
     sub-aperture views whose angular samples are du pixels apart, by

@@ -1,0 +1,56 @@
+# SPDX-License-Identifier: AGPL-3.0-or-later
+"""Light fields from raw plenoptic renders: the library behind plenoptic-decode.
+
+A plenoptic render (camera { plenoptic ... }) writes a raw lenslet image and, beside it,
+<stem>.plenoptic.json (docs/metadata.md) with the microimage-centre lattice. This package
+samples every microimage on a regular grid of (u, v) offsets around its centre and arranges
+the samples as a 4-D light field L[t, s, v, u, c] (lens row and column, angular row and column,
+colour; see lightfield.py), from which it computes sub-aperture views, refocusing by
+shift-and-add and epipolar-plane images. It uses numpy, Pillow and OpenImageIO (for EXR and
+16-bit input; Pillow reads 8-bit raws when OpenImageIO is missing).
+
+    import plenoptic_lf as plf
+    raw = plf.read_raw("scene.png")                       # linear float (H, W, 3)
+    meta = plf.load_metadata("scene.plenoptic.json", (raw.shape[1], raw.shape[0]))
+    lf = plf.decode(raw, meta)                            # lf.data is L[t, s, v, u, c]
+
+Modules: metadata (reading and checking the JSON), images (image input and output),
+lightfield (raw + metadata -> LightField, views, EPI, refocus), focus (the refocus sweep),
+projection (forward projection through plenoptic-project), contact_sheet, outputs (the
+decoder's output folder), progress, errors, cli (the plenoptic-decode command).
+
+Importable with only its parent directory on sys.path: nothing here is generated at build time.
+"""
+
+__version__ = "0.1.0"
+
+from .cli import main, parse_slopes
+from .contact_sheet import contact_sheet
+from .errors import DecodeError, MetadataError
+from .focus import (box3, default_slopes, distance_to_slope, gray, laplacian_energy, pick_epi_row,
+                    pick_near_far, sharpest_slope_map, slopes_from_depth_map)
+from .images import (bilinear, linear_to_srgb, read_depth_map, read_raw, save_png, scaled_pil_image,
+                     srgb_to_linear, to_8bit)
+from .lightfield import LightField, angular_grid, decode, mosaic
+from .metadata import METADATA_FORMAT, METADATA_VERSION, Metadata, load_metadata, metadata_path_for
+from .outputs import write_outputs
+from .progress import Progress
+from .projection import find_project_tool, project_points
+
+__all__ = [
+    "__version__",
+    # metadata
+    "METADATA_FORMAT", "METADATA_VERSION", "Metadata", "MetadataError", "load_metadata", "metadata_path_for",
+    # images
+    "DecodeError", "read_raw", "read_depth_map", "save_png", "to_8bit", "srgb_to_linear", "linear_to_srgb",
+    "bilinear", "scaled_pil_image",
+    # light field
+    "LightField", "decode", "angular_grid", "mosaic",
+    # refocus sweep
+    "default_slopes", "slopes_from_depth_map", "distance_to_slope", "gray", "box3", "laplacian_energy",
+    "sharpest_slope_map", "pick_near_far", "pick_epi_row",
+    # forward projection
+    "find_project_tool", "project_points",
+    # pictures and the command
+    "contact_sheet", "write_outputs", "Progress", "parse_slopes", "main",
+]

@@ -1,0 +1,106 @@
+# SPDX-License-Identifier: AGPL-3.0-or-later
+"""The contact sheet: one labelled picture that shows the plenoptic effect."""
+
+import math
+import os
+
+import numpy as np
+
+from .images import scaled_pil_image, to_8bit
+
+
+def _font(size):
+    """DejaVu Sans at `size` px when installed, else Pillow's default bitmap font."""
+    from PIL import ImageFont
+    for path in ("/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+                 "/usr/share/fonts/truetype/dejavu/DejaVuSans-Bold.ttf"):
+        if os.path.exists(path):
+            try:
+                return ImageFont.truetype(path, size)
+            except OSError:
+                pass
+    return ImageFont.load_default()
+
+
+def _distance_label(distance):
+    """'  (~1.23 units)' for a refocus caption; empty when the distance is unknown."""
+    if distance is None:
+        return ""
+    if math.isinf(distance):
+        return "  (~ infinity)"
+    return "  (~%.3g units)" % distance
+
+
+def contact_sheet(raw, lf, slopes, refocused, near, far, epi_row, title=""):
+    """One picture that shows the plenoptic effect: raw crop with the metadata lattice, centre
+    view, views from opposite sides of the aperture, an EPI, near and far refocus.
+
+    raw: the linear raw image; lf: its LightField; refocused[i]: lf refocused at slopes[i];
+    near, far: indices into slopes; epi_row: lens row of the EPI. Returns a PIL image."""
+    from PIL import Image, ImageDraw
+    meta = lf.meta
+    panel_w, panel_h, pad = 300, 225, 12
+    title_font, label_font, small_font = _font(18), _font(14), _font(11)
+    panels = []  # (PIL image, label, caption)
+
+    # 1. Raw crop around the image centre, about five microimages across, lattice centres marked.
+    pitch = np.hypot(*meta.a)
+    H, W = raw.shape[:2]
+    crop_w = int(min(W, max(16, round(5.5 * pitch))))
+    crop_h = int(min(H, max(12, round(crop_w * panel_h / panel_w))))
+    x0, y0 = (W - crop_w) // 2, (H - crop_h) // 2
+    crop = raw[y0:y0 + crop_h, x0:x0 + crop_w]
+    im = scaled_pil_image(crop, panel_w, panel_h)
+    scale = im.size[0] / crop_w
+    draw = ImageDraw.Draw(im)
+    _, _, centres_u, centres_v = meta.all_centres()
+    for u, v in zip(centres_u, centres_v):
+        if x0 - 0.5 <= u <= x0 + crop_w - 0.5 and y0 - 0.5 <= v <= y0 + crop_h - 0.5:
+            px, py = (u - x0 + 0.5) * scale, (v - y0 + 0.5) * scale
+            draw.line([(px - 3, py), (px + 3, py)], fill=(255, 60, 60))
+            draw.line([(px, py - 3), (px, py + 3)], fill=(255, 60, 60))
+    panels.append((im, "Raw lenslet image (crop)", "%d x %d px; + = microimage centres (metadata)" % (crop_w, crop_h)))
+
+    aspect = lf.display_aspect()
+    cv, cu = lf.centre_index()
+    panels.append((scaled_pil_image(lf.view(cv, cu), panel_w, panel_h, aspect), "Centre view",
+                   "%d x %d lenses, one pixel per lens" % (lf.shape[1], lf.shape[0])))
+    usable = [iu for iu in range(len(lf.du)) if lf.mask[cv, iu]]
+    left, right = usable[0], usable[-1]
+    panels.append((scaled_pil_image(lf.view(cv, left), panel_w, panel_h, aspect), "View from the aperture's left",
+                   "u offset %+.3g px" % lf.du[left]))
+    panels.append((scaled_pil_image(lf.view(cv, right), panel_w, panel_h, aspect), "View from the aperture's right",
+                   "u offset %+.3g px (compare with the left view)" % lf.du[right]))
+
+    # EPI, stretched to fill its (double-width) panel: a tilted streak is a point off the focus plane.
+    epi, epi_u = lf.epi(epi_row, cv)
+    epi_im = Image.fromarray(to_8bit(epi)).resize((2 * panel_w + pad, panel_h), Image.NEAREST)
+    panels.append((epi_im, "Epipolar-plane image (lens row %d of the views)" % epi_row,
+                   "across: lens s; down: view u %+.3g..%+.3g px; vertical = in focus, tilt = nearer or farther"
+                   % (lf.du[epi_u[0]], lf.du[epi_u[-1]])))
+    for name, index in (("Refocused near", near), ("Refocused far", far)):
+        distance = lf.slope_to_distance(slopes[index])
+        panels.append((scaled_pil_image(refocused[index], panel_w, panel_h, aspect), name,
+                       "slope %+.3f lens/view%s" % (slopes[index], _distance_label(distance))))
+
+    # Layout: first row 4 panels, second row EPI (double width) + 2 refocus.
+    label_h, caption_h, head_h = 20, 16, 34 if title else 8
+    cell_w, cell_h = panel_w + pad, panel_h + label_h + caption_h + pad
+    sheet_w = 4 * cell_w + pad
+    sheet_h = head_h + 2 * cell_h + pad
+    sheet = Image.new("RGB", (sheet_w, sheet_h), (24, 24, 28))
+    draw = ImageDraw.Draw(sheet)
+    if title:
+        draw.text((pad, 8), title, fill=(240, 240, 240), font=title_font)
+    slots = [(0, 0, 1), (1, 0, 1), (2, 0, 1), (3, 0, 1), (0, 1, 2), (2, 1, 1), (3, 1, 1)]  # (column, row, span)
+    for (im, label, caption), (column, row, span) in zip(panels, slots):
+        x = pad + column * cell_w
+        y = head_h + row * cell_h
+        draw.text((x, y), label, fill=(255, 255, 255), font=label_font)
+        box_w = span * cell_w - pad
+        paste_x = x + (box_w - im.size[0]) // 2
+        paste_y = y + label_h + (panel_h - im.size[1]) // 2
+        draw.rectangle([x - 1, y + label_h - 1, x + box_w, y + label_h + panel_h], outline=(70, 70, 80))
+        sheet.paste(im, (paste_x, paste_y))
+        draw.text((x, y + label_h + panel_h + 3), caption, fill=(190, 190, 200), font=small_font)
+    return sheet
