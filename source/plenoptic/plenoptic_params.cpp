@@ -261,12 +261,24 @@ std::string check_sensor(const SensorParams& sensor)
     return "";
 }
 
+// The adaptive form tests the variance of the samples taken so far; one sample has none, so a
+// minimum of 1 would stop every pixel after its first ray (focal_blur's rule needs several too).
+std::string check_adaptive_minimum(double value)
+{
+    if (value < 2)
+        return "samples: the adaptive form samples MIN, MAX needs a minimum of at least 2 (got " +
+               format_number(value) + "): one sample has no variance to test; write samples N for a fixed count";
+    return "";
+}
+
 std::string check_sampling(const SamplingParams& sampling)
 {
     std::string message;
     if (!sampling.adaptive)
         return sampling.samples == kSamplesOmitted ? std::string() : check_samples("samples", sampling.samples);
     if (!(message = check_samples("samples (minimum)", sampling.samples_min)).empty())
+        return message;
+    if (!(message = check_adaptive_minimum(sampling.samples_min)).empty())
         return message;
     if (!(message = check_samples("samples (maximum)", sampling.samples_max)).empty())
         return message;
@@ -351,6 +363,28 @@ std::string check_camera(const CameraParams& camera)
                        "(1/D + 1/d = 1/f), so no light reaches the sensor; change distance or focal_length";
         }
     }
+    return "";
+}
+
+std::string check_placement(const double right[3], const double up[3], const double direction[3])
+{
+    const double* axes[3] = {right, up, direction};
+    const char* names[3] = {"right", "up", "direction"};
+    double unit[3][3];
+    for (int a = 0; a < 3; ++a) {
+        const double length = std::sqrt(axes[a][0] * axes[a][0] + axes[a][1] * axes[a][1] + axes[a][2] * axes[a][2]);
+        if (!std::isfinite(length) || !(length > 0))
+            return std::string("the camera's ") + names[a] + " vector has length " + format_number(length) +
+                   ": right, up and direction must be finite and non-zero";
+        for (int c = 0; c < 3; ++c)
+            unit[a][c] = axes[a][c] / length;
+    }
+    const double volume = unit[0][0] * (unit[1][1] * unit[2][2] - unit[1][2] * unit[2][1]) -
+                          unit[0][1] * (unit[1][0] * unit[2][2] - unit[1][2] * unit[2][0]) +
+                          unit[0][2] * (unit[1][0] * unit[2][1] - unit[1][1] * unit[2][0]);
+    if (!(std::fabs(volume) >= 1e-9))
+        return "the camera's right, up and direction vectors are parallel or lie in one plane (their unit "
+               "vectors' triple product is " + format_number(volume) + "): they must span 3-D space";
     return "";
 }
 

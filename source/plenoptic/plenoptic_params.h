@@ -102,6 +102,7 @@ std::string check_focus_distance(double value_units);
 std::string check_angle(const char* keyword, double degrees);             // rotate components
 std::string check_translation(const char* keyword, double value_mm);      // translate, offset
 std::string check_samples(const char* keyword, double value);             // a whole number 1..kMaxSamples
+std::string check_adaptive_minimum(double value);                           // samples MIN, MAX: MIN >= 2
 std::string check_confidence(double value);
 std::string check_variance(double value);
 
@@ -113,6 +114,12 @@ std::string check_sampling(const SamplingParams& sampling);
 // The whole camera, run when the camera's closing brace is read. Runs the block checks again
 // (cheap), then the checks that need several blocks at once.
 std::string check_camera(const CameraParams& camera);
+
+// The camera's placement as POV-Ray resolved it (right, up, direction in the scene, any length):
+// each must have a finite, non-zero length, and together they must span 3-D space (unit
+// vectors whose triple product is at least 1e-9 in magnitude, the rule the metadata reader
+// applies too). Empty when the placement is usable.
+std::string check_placement(const double right[3], const double up[3], const double direction[3]);
 
 // Rays per pixel for a camera whose scene omits `samples` (see kDefaultSamplesApertures).
 int default_samples(const CameraParams& camera);

@@ -336,5 +336,50 @@ TEST(Params, CameraRefusesDegenerateCombinations)
     EXPECT_TRUE(contains(check_camera(bad_scale), "mm_per_unit")) << check_camera(bad_scale);
 }
 
+
+// Issue 12, item 3: `samples 1, N` never took a second ray (one sample has no variance).
+TEST(Params, AdaptiveSamplingNeedsAMinimumOfTwo)
+{
+    SamplingParams p;
+    p.adaptive = true;
+    p.samples_min = 1;
+    p.samples_max = 64;
+    const std::string message = check_sampling(p);
+    EXPECT_TRUE(contains(message, "at least 2") && contains(message, "samples N")) << message;
+    p.samples_min = 2;
+    EXPECT_EQ(check_sampling(p), "");
+    EXPECT_NE(check_adaptive_minimum(1), "");
+    EXPECT_EQ(check_adaptive_minimum(2), "");
+    // The fixed form keeps accepting one sample.
+    p = SamplingParams();
+    p.samples = 1;
+    EXPECT_EQ(check_sampling(p), "");
+}
+
+// Issue 12, item 4: a degenerate placement wrote metadata the project's own reader refused.
+TEST(Params, PlacementMustSpanSpace)
+{
+    const double x[3] = {1, 0, 0}, y[3] = {0, 1, 0}, z[3] = {0, 0, 1}, zero[3] = {0, 0, 0};
+    const double long_x[3] = {1.33, 0, 0}, skew[3] = {1, 1, 0.5}, nan[3] = {kNaN, 0, 1};
+    const double nearly_x[3] = {1, 1e-12, 0};
+    EXPECT_EQ(check_placement(x, y, z), "");
+    EXPECT_EQ(check_placement(long_x, y, z), "");      // POV-Ray's right has the aspect ratio's length
+    EXPECT_EQ(check_placement(skew, y, z), "");        // not orthogonal, but spans space
+    std::string m = check_placement(zero, y, z);
+    EXPECT_TRUE(contains(m, "right") && contains(m, "non-zero")) << m;
+    m = check_placement(x, zero, z);
+    EXPECT_TRUE(contains(m, "up")) << m;
+    m = check_placement(x, y, zero);
+    EXPECT_TRUE(contains(m, "direction")) << m;
+    m = check_placement(x, x, z);
+    EXPECT_TRUE(contains(m, "parallel")) << m;
+    m = check_placement(x, nearly_x, z);
+    EXPECT_TRUE(contains(m, "parallel")) << m;
+    const double in_plane[3] = {1, 1, 0};
+    m = check_placement(x, y, in_plane);              // direction in the plane of right and up
+    EXPECT_TRUE(contains(m, "one plane")) << m;
+    EXPECT_NE(check_placement(nan, y, z), "");
+}
+
 } // namespace
 } // namespace plenoptic

@@ -2,13 +2,22 @@
 // Parser for the body of `camera { plenoptic ... }`. Every value is checked while its
 // token is current, so POV-Ray's error names the file and line; cross-field checks run
 // when a block's closing brace is read. The optics themselves live in source/plenoptic/.
+//
+// Only `plenoptic` is a reserved word of the scene language (patch 0001). Every other word
+// of the camera is recognised here, where the camera's parser expects a keyword, from the
+// token's text: to the rest of the language it is an ordinary identifier, so a scene that
+// declares `pitch` or `sensor` parses as with stock POV-Ray, and a declared identifier of
+// the same name can even serve as a value (`pitch pitch / 100`). New keywords go into
+// kContextWords below, never into POV-Ray's reserved-word table.
 
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "backend/frame.h"
 #include "backend/parser/parse.h"
 #include "backend/scene/camera.h"
+#include "plenoptic/plenoptic_light_check.h"
 #include "povray_glue/plenoptic_setup.h"
 
 #include "base/povdebug.h"
@@ -26,6 +35,54 @@ const char *kPlenopticKeywords =
 const char *kMainLensKeywords = "thin_lens, pinhole, focal_length, f_number, aperture, focus_distance, distance";
 const char *kArrayKeywords = "hexagonal, rectangular, pitch, focal_length, focal_lengths, pinhole, distance, rotate, translate";
 const char *kSensorKeywords = "pixel_size, offset";
+
+// A keyword as the camera's blocks see it, whether it is one of the camera's own words or a
+// stock reserved word that the blocks read too.
+enum class Word
+{
+	None,         // no keyword of the camera's blocks: a placement modifier, a value, an error
+	CloseBlock,   // }
+	// the camera's own words: identifiers everywhere else
+	MainLens, MicrolensArray, Sensor, ThinLens, Pinhole, FocalLength, FocalLengths, FNumber,
+	FocusDistance, Hexagonal, Rectangular, Pitch, PixelSize, DepthMap,
+	// stock reserved words
+	MmPerUnit, Aperture, Distance, Offset, Rotate, Translate, Samples, Confidence, Variance
+};
+
+struct ContextWord { const char *text; Word word; };
+const ContextWord kContextWords[] = {
+	{"main_lens", Word::MainLens}, {"microlens_array", Word::MicrolensArray}, {"sensor", Word::Sensor},
+	{"thin_lens", Word::ThinLens}, {"pinhole", Word::Pinhole}, {"focal_length", Word::FocalLength},
+	{"focal_lengths", Word::FocalLengths}, {"f_number", Word::FNumber}, {"focus_distance", Word::FocusDistance},
+	{"hexagonal", Word::Hexagonal}, {"rectangular", Word::Rectangular}, {"pitch", Word::Pitch},
+	{"pixel_size", Word::PixelSize}, {"depth_map", Word::DepthMap}
+};
+
+struct StockWord { TOKEN token; Word word; };
+const StockWord kStockWords[] = {
+	{RIGHT_CURLY_TOKEN, Word::CloseBlock}, {MM_PER_UNIT_TOKEN, Word::MmPerUnit}, {APERTURE_TOKEN, Word::Aperture},
+	{DISTANCE_TOKEN, Word::Distance}, {OFFSET_TOKEN, Word::Offset}, {ROTATE_TOKEN, Word::Rotate},
+	{TRANSLATE_TOKEN, Word::Translate}, {SAMPLES_TOKEN, Word::Samples}, {CONFIDENCE_TOKEN, Word::Confidence},
+	{VARIANCE_TOKEN, Word::Variance}
+};
+
+// The keyword the current token stands for. A camera word arrives as an undeclared
+// identifier, or as whatever the scene declared under that name (a float, an object, a
+// macro parameter...): its text decides. A string literal never is a keyword, and at the end
+// of the file the token's text is stale.
+Word Word_Of(const Parser::Token_Struct& token)
+{
+	for (size_t i = 0; i < sizeof(kStockWords) / sizeof(kStockWords[0]); i++)
+		if (token.Token_Id == kStockWords[i].token)
+			return kStockWords[i].word;
+	if (token.End_Of_File || token.Token_Id == END_OF_FILE_TOKEN || token.Token_Id == STRING_LITERAL_TOKEN ||
+	    token.Token_String == NULL)
+		return Word::None;
+	for (size_t i = 0; i < sizeof(kContextWords) / sizeof(kContextWords[0]); i++)
+		if (std::strcmp(token.Token_String, kContextWords[i].text) == 0)
+			return kContextWords[i].word;
+	return Word::None;
+}
 
 std::string Check_F_Number(const char *, DBL value) { return plenoptic::check_f_number(value); }
 std::string Check_Focus_Distance(const char *, DBL value) { return plenoptic::check_focus_distance(value); }
@@ -50,8 +107,41 @@ void Parser::Plenoptic_Check(const std::string& message)
 // An unknown keyword inside one of our blocks is an error that names it and what is allowed.
 void Parser::Plenoptic_Unknown(const char *block, const char *allowed)
 {
+	if (Token.End_Of_File || Token.Token_Id == END_OF_FILE_TOKEN)
+		Error("plenoptic camera: the file ends inside %s, before its closing '}'; allowed: %s.", block, allowed);
 	const char *found = (Token.Token_String != NULL && Token.Token_String[0] != '\0') ? Token.Token_String : Get_Token_String(Token.Token_Id);
 	Error("plenoptic camera: '%s' is not a %s keyword; allowed: %s.", found, block, allowed);
+}
+
+// Called by Parse_Camera once POV-Ray has resolved the placement (look_at, sky, transforms):
+// the frame the camera will use must span 3-D space. The error names the last placement
+// keyword, the one that completed the degenerate frame.
+void Parser::Plenoptic_Check_Placement(const Camera& Cam)
+{
+	const std::string message = plenoptic::check_placement(Cam.Right, Cam.Up, Cam.Direction);
+	if (message.empty() || !Cam.Plenoptic)
+	{
+		Plenoptic_Check(message);
+		return;
+	}
+	const plenoptic::CameraSetup::KeywordSource& source = Cam.Plenoptic->last_placement;
+	if (source.keyword.empty())
+		Plenoptic_Check(message);
+	pov_base::ITextStream::FilePos position;
+	position.lineno = source.line;
+	position.offset = source.offset;
+	Plenoptic_Check_At(message + " (after '" + source.keyword + "')", position, (int)source.column);
+}
+
+// Before an optional value (depth_map [off], samples N [, MAX]): whether the next token is a
+// keyword of the camera (or its closing brace), which is then not taken for the value even
+// where the scene declared an identifier of that name.
+bool Parser::Plenoptic_Keyword_Follows()
+{
+	Get_Token();
+	const bool keyword = (Word_Of(Token) != Word::None);
+	UNGET
+	return keyword;
 }
 
 // A microlens array has one kind of lens: pinhole, focal_length or focal_lengths.
@@ -114,49 +204,41 @@ void Parser::Parse_Plenoptic_Main_Lens(plenoptic::CameraParams& params)
 	lens.given = true;
 
 	Parse_Begin();
-	EXPECT
-		CASE2 (THIN_LENS_TOKEN, PINHOLE_TOKEN)
-			if (lens.type != plenoptic::MainLensType::None)
-				Error("plenoptic camera: main_lens takes one of thin_lens or pinhole, not both.");
-			lens.type = (Token.Token_Id == THIN_LENS_TOKEN) ? plenoptic::MainLensType::ThinLens : plenoptic::MainLensType::Pinhole;
-		END_CASE
-
-		CASE (FOCAL_LENGTH_TOKEN)
-			lens.focal_length_mm = Plenoptic_Float("main_lens focal_length", plenoptic::check_positive_length);
-			lens.has_focal_length = true;
-		END_CASE
-
-		CASE (F_NUMBER_TOKEN)
-			lens.f_number = Plenoptic_Float("f_number", Check_F_Number);
-			lens.has_f_number = true;
-		END_CASE
-
-		CASE (APERTURE_TOKEN)
-			lens.aperture_mm = Plenoptic_Float("aperture", plenoptic::check_positive_length);
-			lens.has_aperture = true;
-		END_CASE
-
-		CASE (FOCUS_DISTANCE_TOKEN)
-			lens.focus_distance_units = Plenoptic_Float("focus_distance", Check_Focus_Distance);
-			lens.has_focus_distance = true;
-		END_CASE
-
-		CASE (DISTANCE_TOKEN)
-			lens.distance_mm = Plenoptic_Float("main_lens distance", plenoptic::check_positive_length);
-			lens.has_distance = true;
-		END_CASE
-
-		CASE (RIGHT_CURLY_TOKEN)
-			UNGET
-			EXIT
-		END_CASE
-
-		OTHERWISE
-			Plenoptic_Unknown("main_lens", kMainLensKeywords);
-		END_CASE
-	END_EXPECT
+	for (Get_Token(); Word_Of(Token) != Word::CloseBlock; Get_Token())
+	{
+		switch (Word_Of(Token))
+		{
+			case Word::ThinLens:
+			case Word::Pinhole:
+				if (lens.type != plenoptic::MainLensType::None)
+					Error("plenoptic camera: main_lens takes one of thin_lens or pinhole, not both.");
+				lens.type = (Word_Of(Token) == Word::ThinLens) ? plenoptic::MainLensType::ThinLens : plenoptic::MainLensType::Pinhole;
+				break;
+			case Word::FocalLength:
+				lens.focal_length_mm = Plenoptic_Float("main_lens focal_length", plenoptic::check_positive_length);
+				lens.has_focal_length = true;
+				break;
+			case Word::FNumber:
+				lens.f_number = Plenoptic_Float("f_number", Check_F_Number);
+				lens.has_f_number = true;
+				break;
+			case Word::Aperture:
+				lens.aperture_mm = Plenoptic_Float("aperture", plenoptic::check_positive_length);
+				lens.has_aperture = true;
+				break;
+			case Word::FocusDistance:
+				lens.focus_distance_units = Plenoptic_Float("focus_distance", Check_Focus_Distance);
+				lens.has_focus_distance = true;
+				break;
+			case Word::Distance:
+				lens.distance_mm = Plenoptic_Float("main_lens distance", plenoptic::check_positive_length);
+				lens.has_distance = true;
+				break;
+			default:
+				Plenoptic_Unknown("main_lens", kMainLensKeywords);
+		}
+	}
 	// The closing brace is current: cross-field errors point at the end of the block.
-	Get_Token();
 	Plenoptic_Check(plenoptic::check_main_lens(lens, params.mm_per_unit));
 	UNGET
 	Parse_End();
@@ -170,71 +252,61 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 	bool had_rotate = false, had_translate = false;
 
 	Parse_Begin();
-	EXPECT
-		CASE2 (HEXAGONAL_TOKEN, RECTANGULAR_TOKEN)
-			if (array.grid != plenoptic::GridType::None)
-				Error("plenoptic camera: microlens_array takes one of hexagonal or rectangular, not both.");
-			array.grid = (Token.Token_Id == HEXAGONAL_TOKEN) ? plenoptic::GridType::Hexagonal : plenoptic::GridType::Rectangular;
-		END_CASE
-
-		CASE (PITCH_TOKEN)
-			array.pitch_mm = Plenoptic_Float("pitch", plenoptic::check_positive_length);
-			array.has_pitch = true;
-		END_CASE
-
-		CASE (FOCAL_LENGTH_TOKEN)
-			Plenoptic_One_Lens_Kind(array.has_lens);
-			array.focal_lengths_mm[0] = Plenoptic_Float("microlens_array focal_length", plenoptic::check_positive_length);
-			array.focal_length_count = 1;
-			array.lens = plenoptic::MicrolensType::ThinLens;
-			array.has_lens = true;
-		END_CASE
-
-		CASE (FOCAL_LENGTHS_TOKEN)
-			Plenoptic_One_Lens_Kind(array.has_lens);
-			Plenoptic_Values("focal_lengths", array.focal_lengths_mm, 3, plenoptic::check_positive_length);
-			array.focal_length_count = 3;
-			array.lens = plenoptic::MicrolensType::ThinLens;
-			array.has_lens = true;
-		END_CASE
-
-		CASE (PINHOLE_TOKEN)
-			Plenoptic_One_Lens_Kind(array.has_lens);
-			array.focal_length_count = 0;
-			array.lens = plenoptic::MicrolensType::Pinhole;
-			array.has_lens = true;
-		END_CASE
-
-		CASE (DISTANCE_TOKEN)
-			array.distance_mm = Plenoptic_Float("microlens_array distance", plenoptic::check_positive_length);
-			array.has_distance = true;
-		END_CASE
-
-		CASE (ROTATE_TOKEN)
-			// The pose is one rotation then one translation (contract, section 2): not a chain.
-			if (had_rotate)
-				Error("plenoptic camera: microlens_array takes rotate once (about x, then y, then z, in degrees).");
-			had_rotate = true;
-			Plenoptic_Values("microlens_array rotate", array.rotate_deg, 3, plenoptic::check_angle);
-		END_CASE
-
-		CASE (TRANSLATE_TOKEN)
-			if (had_translate)
-				Error("plenoptic camera: microlens_array takes translate once (mm, after the rotation).");
-			had_translate = true;
-			Plenoptic_Values("microlens_array translate", array.translate_mm, 3, plenoptic::check_translation);
-		END_CASE
-
-		CASE (RIGHT_CURLY_TOKEN)
-			UNGET
-			EXIT
-		END_CASE
-
-		OTHERWISE
-			Plenoptic_Unknown("microlens_array", kArrayKeywords);
-		END_CASE
-	END_EXPECT
-	Get_Token();
+	for (Get_Token(); Word_Of(Token) != Word::CloseBlock; Get_Token())
+	{
+		switch (Word_Of(Token))
+		{
+			case Word::Hexagonal:
+			case Word::Rectangular:
+				if (array.grid != plenoptic::GridType::None)
+					Error("plenoptic camera: microlens_array takes one of hexagonal or rectangular, not both.");
+				array.grid = (Word_Of(Token) == Word::Hexagonal) ? plenoptic::GridType::Hexagonal : plenoptic::GridType::Rectangular;
+				break;
+			case Word::Pitch:
+				array.pitch_mm = Plenoptic_Float("pitch", plenoptic::check_positive_length);
+				array.has_pitch = true;
+				break;
+			case Word::FocalLength:
+				Plenoptic_One_Lens_Kind(array.has_lens);
+				array.focal_lengths_mm[0] = Plenoptic_Float("microlens_array focal_length", plenoptic::check_positive_length);
+				array.focal_length_count = 1;
+				array.lens = plenoptic::MicrolensType::ThinLens;
+				array.has_lens = true;
+				break;
+			case Word::FocalLengths:
+				Plenoptic_One_Lens_Kind(array.has_lens);
+				Plenoptic_Values("focal_lengths", array.focal_lengths_mm, 3, plenoptic::check_positive_length);
+				array.focal_length_count = 3;
+				array.lens = plenoptic::MicrolensType::ThinLens;
+				array.has_lens = true;
+				break;
+			case Word::Pinhole:
+				Plenoptic_One_Lens_Kind(array.has_lens);
+				array.focal_length_count = 0;
+				array.lens = plenoptic::MicrolensType::Pinhole;
+				array.has_lens = true;
+				break;
+			case Word::Distance:
+				array.distance_mm = Plenoptic_Float("microlens_array distance", plenoptic::check_positive_length);
+				array.has_distance = true;
+				break;
+			case Word::Rotate:
+				// The pose is one rotation then one translation (docs/specification.md, section 2): not a chain.
+				if (had_rotate)
+					Error("plenoptic camera: microlens_array takes rotate once (about x, then y, then z, in degrees).");
+				had_rotate = true;
+				Plenoptic_Values("microlens_array rotate", array.rotate_deg, 3, plenoptic::check_angle);
+				break;
+			case Word::Translate:
+				if (had_translate)
+					Error("plenoptic camera: microlens_array takes translate once (mm, after the rotation).");
+				had_translate = true;
+				Plenoptic_Values("microlens_array translate", array.translate_mm, 3, plenoptic::check_translation);
+				break;
+			default:
+				Plenoptic_Unknown("microlens_array", kArrayKeywords);
+		}
+	}
 	Plenoptic_Check(plenoptic::check_array(array));
 	UNGET
 	Parse_End();
@@ -242,28 +314,25 @@ void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)
 
 void Parser::Parse_Plenoptic_Sensor(plenoptic::CameraParams& params)
 {
+	// A second sensor { } replaces the first entirely, as the other blocks do.
 	plenoptic::SensorParams& sensor = params.sensor;
+	sensor = plenoptic::SensorParams();
 
 	Parse_Begin();
-	EXPECT
-		CASE (PIXEL_SIZE_TOKEN)
-			Plenoptic_Values("pixel_size", sensor.pixel_size_mm, 2, plenoptic::check_positive_length);
-		END_CASE
-
-		CASE (OFFSET_TOKEN)
-			Plenoptic_Values("sensor offset", sensor.offset_mm, 2, plenoptic::check_translation);
-		END_CASE
-
-		CASE (RIGHT_CURLY_TOKEN)
-			UNGET
-			EXIT
-		END_CASE
-
-		OTHERWISE
-			Plenoptic_Unknown("sensor", kSensorKeywords);
-		END_CASE
-	END_EXPECT
-	Get_Token();
+	for (Get_Token(); Word_Of(Token) != Word::CloseBlock; Get_Token())
+	{
+		switch (Word_Of(Token))
+		{
+			case Word::PixelSize:
+				Plenoptic_Values("pixel_size", sensor.pixel_size_mm, 2, plenoptic::check_positive_length);
+				break;
+			case Word::Offset:
+				Plenoptic_Values("sensor offset", sensor.offset_mm, 2, plenoptic::check_translation);
+				break;
+			default:
+				Plenoptic_Unknown("sensor", kSensorKeywords);
+		}
+	}
 	Plenoptic_Check(plenoptic::check_sensor(sensor));
 	UNGET
 	Parse_End();
@@ -278,13 +347,14 @@ void Parser::Parse_Plenoptic_Samples(plenoptic::CameraParams& params)
 	const int column = Token.Token_Col_No;
 	DBL first = Plenoptic_Float("samples", plenoptic::check_samples);
 	Parse_Comma();
-	DBL second = Allow_Float(0.0);
+	DBL second = Plenoptic_Keyword_Follows() ? 0.0 : Allow_Float(0.0);
 	if (second == 0.0)
 	{
 		sampling.adaptive = false;
 		sampling.samples = (int)first;
 		return;
 	}
+	Plenoptic_Check_At(plenoptic::check_adaptive_minimum(first), position, column);
 	Plenoptic_Check_At(plenoptic::check_finite("samples maximum", second), position, column);
 	Plenoptic_Check_At(plenoptic::check_samples("samples maximum", second), position, column);
 	if (first > second)
@@ -307,90 +377,105 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 		setup->depth_map = New.Plenoptic->depth_map;
 	}
 
-	EXPECT
-		CASE (MM_PER_UNIT_TOKEN)
-			params.mm_per_unit = Plenoptic_Float("mm_per_unit", Check_Mm_Per_Unit);
-		END_CASE
-
-		CASE (MAIN_LENS_TOKEN)
-			Parse_Plenoptic_Main_Lens(params);
-		END_CASE
-
-		CASE (MICROLENS_ARRAY_TOKEN)
-			Parse_Plenoptic_Array(params);
-		END_CASE
-
-		CASE (SENSOR_TOKEN)
-			Parse_Plenoptic_Sensor(params);
-		END_CASE
-
-		CASE (SAMPLES_TOKEN)
-			Parse_Plenoptic_Samples(params);
-		END_CASE
-
-		CASE (CONFIDENCE_TOKEN)
-			params.sampling.confidence = Plenoptic_Float("confidence", Check_Confidence);
-		END_CASE
-
-		CASE (VARIANCE_TOKEN)
-			params.sampling.variance = Plenoptic_Float("variance", Check_Variance);
-		END_CASE
-
-		CASE (DEPTH_MAP_TOKEN)
-			setup->depth_map = ((int)Allow_Float(1.0) != 0);
-		END_CASE
-
-		// Focal blur and field-of-view modifiers would silently mean nothing here.
-		CASE5 (APERTURE_TOKEN, BLUR_SAMPLES_TOKEN, FOCAL_POINT_TOKEN, BOKEH_TOKEN, ANGLE_TOKEN)
-			Error("plenoptic camera: '%s' does not apply to a plenoptic camera (the aperture, focus and field "
-			      "of view come from main_lens { }, microlens_array { } and sensor { }).",
-			      Get_Token_String(Token.Token_Id));
-		END_CASE
-
-		CASE (TNORMAL_TOKEN)
-			Error("plenoptic camera: 'normal' (ray perturbation) is not supported by the plenoptic camera.");
-		END_CASE
-
-		CASE6 (PERSPECTIVE_TOKEN, ORTHOGRAPHIC_TOKEN, FISHEYE_TOKEN, ULTRA_WIDE_ANGLE_TOKEN, OMNIMAX_TOKEN, PANORAMIC_TOKEN)
-		CASE3 (SPHERICAL_TOKEN, CYLINDER_TOKEN, MESH_CAMERA_TOKEN)
-			Expectation_Error("plenoptic camera modifier");
-		END_CASE
-
-		CASE (RIGHT_CURLY_TOKEN)
-			UNGET
-			EXIT
-		END_CASE
-
-		OTHERWISE
+	for (Get_Token(); Word_Of(Token) != Word::CloseBlock; Get_Token())
+	{
+		switch (Word_Of(Token))
 		{
-			const pov_base::ITextStream::FilePos position = Token.Token_File_Pos;
-			const int column = Token.Token_Col_No;
-			const TOKEN keyword = Token.Token_Id;
-			UNGET
-			if (Parse_Camera_Mods(New) == false)
-			{
-				Get_Token();
+			case Word::MmPerUnit:
+				params.mm_per_unit = Plenoptic_Float("mm_per_unit", Check_Mm_Per_Unit);
+				continue;
+			case Word::MainLens:
+				Parse_Plenoptic_Main_Lens(params);
+				continue;
+			case Word::MicrolensArray:
+				Parse_Plenoptic_Array(params);
+				continue;
+			case Word::Sensor:
+				Parse_Plenoptic_Sensor(params);
+				continue;
+			case Word::Samples:
+				Parse_Plenoptic_Samples(params);
+				continue;
+			case Word::Confidence:
+				params.sampling.confidence = Plenoptic_Float("confidence", Check_Confidence);
+				continue;
+			case Word::Variance:
+				params.sampling.variance = Plenoptic_Float("variance", Check_Variance);
+				continue;
+			case Word::DepthMap:
+				setup->depth_map = Plenoptic_Keyword_Follows() || ((int)Allow_Float(1.0) != 0);
+				continue;
+			case Word::Aperture:
+				break;  // refused below with focal blur's other words
+			case Word::None:
+			case Word::Rotate:
+			case Word::Translate:
+				break;  // stock camera modifiers, below
+			default:
+				// A word of one of the blocks, out of its block.
 				Plenoptic_Unknown("plenoptic camera", kPlenopticKeywords);
-			}
-			// Placement too must be finite (POV-Ray's stock cameras would render black).
-			bool finite = Finite(New.Location) && Finite(New.Sky) && Finite(New.Direction) &&
-			              Finite_Or_Unset(New.Look_At) && Finite_Or_Unset(New.Up) && Finite_Or_Unset(New.Right);
-			for (int r = 0; r < 4 && New.Trans != NULL; r++)
-				for (int c = 0; c < 4; c++)
-					finite = finite && std::isfinite(New.Trans->matrix[r][c]) && std::isfinite(New.Trans->inverse[r][c]);
-			if (!finite)
-				Plenoptic_Check_At(std::string("'") + Get_Token_String(keyword) + "' gives a value that is not a finite "
-				                   "number (NaN or infinite)", position, column);
 		}
-		END_CASE
-	END_EXPECT
+
+		switch (Token.Token_Id)
+		{
+			// Focal blur and field-of-view modifiers would silently mean nothing here.
+			CASE5 (APERTURE_TOKEN, BLUR_SAMPLES_TOKEN, FOCAL_POINT_TOKEN, BOKEH_TOKEN, ANGLE_TOKEN)
+				Error("plenoptic camera: '%s' does not apply to a plenoptic camera (the aperture, focus and field "
+				      "of view come from main_lens { }, microlens_array { } and sensor { }).",
+				      Get_Token_String(Token.Token_Id));
+			END_CASE
+
+			CASE (TNORMAL_TOKEN)
+				Error("plenoptic camera: 'normal' (ray perturbation) is not supported by the plenoptic camera.");
+			END_CASE
+
+			CASE6 (PERSPECTIVE_TOKEN, ORTHOGRAPHIC_TOKEN, FISHEYE_TOKEN, ULTRA_WIDE_ANGLE_TOKEN, OMNIMAX_TOKEN, PANORAMIC_TOKEN)
+			CASE3 (SPHERICAL_TOKEN, CYLINDER_TOKEN, MESH_CAMERA_TOKEN)
+				Expectation_Error("plenoptic camera modifier");
+			END_CASE
+
+			default:
+			{
+				const pov_base::ITextStream::FilePos position = Token.Token_File_Pos;
+				const int column = Token.Token_Col_No;
+				const TOKEN keyword = Token.Token_Id;
+				UNGET
+				if (Parse_Camera_Mods(New) == false)
+				{
+					Get_Token();
+					Plenoptic_Unknown("plenoptic camera", kPlenopticKeywords);
+				}
+				// Placement too must be finite (POV-Ray's stock cameras would render black).
+				bool finite = Finite(New.Location) && Finite(New.Sky) && Finite(New.Direction) &&
+				              Finite_Or_Unset(New.Look_At) && Finite_Or_Unset(New.Up) && Finite_Or_Unset(New.Right);
+				for (int r = 0; r < 4 && New.Trans != NULL; r++)
+					for (int c = 0; c < 4; c++)
+						finite = finite && std::isfinite(New.Trans->matrix[r][c]) && std::isfinite(New.Trans->inverse[r][c]);
+				if (!finite)
+					Plenoptic_Check_At(std::string("'") + Get_Token_String(keyword) + "' gives a value that is not a finite "
+					                   "number (NaN or infinite)", position, column);
+				// A zero right, up or direction leaves the camera without a frame.
+				const DBL *given = (keyword == RIGHT_TOKEN) ? New.Right : (keyword == UP_TOKEN) ? New.Up :
+				                   (keyword == DIRECTION_TOKEN) ? New.Direction : (keyword == SKY_TOKEN) ? New.Sky : NULL;
+				if (given != NULL && !(given[X] * given[X] + given[Y] * given[Y] + given[Z] * given[Z] > 0))
+					Plenoptic_Check_At(std::string("'") + Get_Token_String(keyword) + "' is a zero vector: the camera's "
+					                   "right, up, direction and sky must have a non-zero length", position, column);
+				setup->last_placement.keyword = Get_Token_String(keyword);
+				setup->last_placement.line = position.lineno;
+				setup->last_placement.column = column;
+				setup->last_placement.offset = position.offset;
+			}
+		}
+	}
 
 	// The camera's closing brace is current for the checks across blocks.
-	Get_Token();
 	Plenoptic_Check(plenoptic::check_camera(params));
 	UNGET
 	setup->model = plenoptic::make_model(params);
 	std::vector<std::string> warnings = plenoptic::warnings(setup->model);
+	const std::string dark = plenoptic::dark_image_warning(setup->model);
+	if (!dark.empty())
+		warnings.push_back(dark);
 	for (size_t i = 0; i < warnings.size(); i++)
 		Warning(0, "plenoptic camera: %s", warnings[i].c_str());
 	New.Plenoptic = setup;

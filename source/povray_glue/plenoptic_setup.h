@@ -5,6 +5,8 @@
 #ifndef POVRAY_GLUE_PLENOPTIC_SETUP_H
 #define POVRAY_GLUE_PLENOPTIC_SETUP_H
 
+#include <string>
+
 #include "plenoptic/plenoptic_model.h"
 #include "plenoptic/plenoptic_params.h"
 
@@ -14,6 +16,16 @@ struct CameraSetup {
     CameraParams params;
     Model model;
     bool depth_map = false;  // write <output>.depth.exr beside the image
+
+    // Where the camera's last placement keyword (location, look_at, right, up, ...) stands in
+    // the scene file: the parser names it when the placement POV-Ray resolves is degenerate.
+    struct KeywordSource {
+        std::string keyword;
+        long line = 0;
+        long column = 0;
+        long long offset = 0;
+    };
+    KeywordSource last_placement;
 };
 
 } // namespace plenoptic

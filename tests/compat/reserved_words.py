@@ -121,6 +121,12 @@ def main():
     if not added:
         print("FAIL: no new reserved word found: is --patched-reswords the patched file?")
         return 1
+    # Only the camera's type word may be global; every other word of the camera is read in
+    # context (docs/specification.md, section 6; source/povray_glue/parse_plenoptic.cpp).
+    if added != ["plenoptic"]:
+        print("FAIL: our patches may add only 'plenoptic' to POV-Ray's reserved words; they add: %s"
+              % " ".join(added))
+        return 1
     added_set = set(added)
     lower = {w.lower(): w for w in added}
 

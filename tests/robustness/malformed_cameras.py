@@ -243,6 +243,9 @@ CASES = [
      ["translate", "behind the sensor"], "the array must lie between lens and sensor"),
     ("array translated in front of the main lens", camera(array=array_with(*HEX, "translate <0, 0, 30>"), close=CAMERA_BRACE),
      ["translate", "main lens"], "the array must lie between lens and sensor"),
+    # Issue 12, item 3: the adaptive form's variance test needs two samples to start from.
+    ("adaptive samples with a minimum of 1", camera(extra="  samples 1, 64  " + MARK),
+     ["samples", "at least 2", "samples N"], "one sample has no variance: the pixel would stop after one ray"),
     ("camera unterminated", camera(close=None),
      ["light_source", "plenoptic camera keyword"], "a missing brace is noticed at the next statement (no marker: the world's first line)"),
 ]
@@ -259,6 +262,19 @@ PLACEMENT_CASES = [
      ["rotate"], "no NaN"),
     ("camera translate infinite", camera(extra="  samples 2\n  translate <pow(10,400), 0, 0>  " + MARK),
      ["translate"], "no infinite value"),
+    # Issue 12, item 4: a degenerate frame wrote metadata the project's own reader refused.
+    ("right zero", camera(place=["  location <0, 0.4, -2>", "  right 0  " + MARK]),
+     ["right", "zero"], "no frame without a right vector"),
+    ("up zero", camera(place=["  location <0, 0.4, -2>", "  up 0  " + MARK]),
+     ["up", "zero"], "no frame without an up vector"),
+    ("direction zero", camera(place=["  location <0, 0.4, -2>", "  direction 0  " + MARK]),
+     ["direction", "zero"], "no frame without a viewing direction"),
+    ("right parallel to up", camera(place=["  location <0, 0.4, -2>", "  right y", "  up y  " + MARK]),
+     ["right, up and direction", "parallel", "after 'up'"], "the frame must span 3-D space"),
+    ("direction in the plane of right and up", camera(place=["  location <0, 0.4, -2>", "  direction <1, 1, 0>  " + MARK]),
+     ["right, up and direction", "span 3-D space"], "the frame must span 3-D space"),
+    ("right parallel to direction", camera(place=["  location <0, 0.4, -2>", "  direction z", "  right <0, 0, 2>  " + MARK]),
+     ["parallel or lie in one plane", "after 'right'"], "the frame must span 3-D space"),
 ]
 
 GROUPS = {"camera": CASES, "placement": PLACEMENT_CASES}
