@@ -1,0 +1,439 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Forward projection of 3-D points through ideal thin lenses and pinholes.
+
+#include "plenoptic_projection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "plenoptic_rays.h"
+#include "plenoptic_rays_internal.h"
+
+namespace plenoptic {
+
+namespace {
+
+using detail::microlens_focal;
+using detail::project_to_array;
+using detail::to_local;
+using detail::to_optics;
+
+// Homogeneous point (x, y, z, w): the point (x/w, y/w, z/w), or the direction (x, y, z) if w = 0.
+struct Homogeneous {
+    Vec3 xyz;
+    double w;
+};
+
+// Candidate lenses are enumerated in a box of array-local coordinates.
+struct Box {
+    bool valid;
+    double x0, x1, y0, y1;
+};
+
+// Bound on the lenses forward_project examines for one point, so no input can make it hang.
+const long long kMaxForwardLenses = 1LL << 24;
+
+// Sensor hit of a ray arriving at array point h (optics frame) with direction `towards_sensor`,
+// refracted by `lens` (the same rule w' = w - (h - c)/f with w normalised to unit travel along the
+// normal).
+bool sensor_hit_through_lens(const Model& m, LensIndex lens, Vec3 h, Vec3 towards_sensor, Vec3* hit)
+{
+    Vec3 direction = towards_sensor;
+    if (m.microlens == MicrolensType::ThinLens) {
+        const Vec3 w = mul_transposed(m.pose.rotation, towards_sensor);
+        if (!(w.z < 0))
+            return false;
+        const Vec3 h_local = to_local(m, h);
+        const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+        const double f = microlens_focal(m, lens);
+        const Vec3 out_local{w.x / -w.z - (h_local.x - c.x) / f, w.y / -w.z - (h_local.y - c.y) / f, -1};
+        direction = mul(m.pose.rotation, out_local);
+    }
+    if (!(direction.z < 0))
+        return false;
+    const double travel = (m.sensor_z_mm - h.z) / direction.z;
+    if (!(travel > 0))
+        return false;
+    *hit = h + travel * direction;
+    return is_finite(*hit);
+}
+
+// Line through homogeneous point a and point b, met with the plane n . x = n . point.
+bool line_meets_plane(Homogeneous a, Vec3 b, Vec3 n, Vec3 point, Homogeneous* out)
+{
+    const double alpha = dot(n, point) - dot(n, b);
+    const double beta = dot(n, a.xyz) - a.w * dot(n, point);
+    out->xyz = alpha * a.xyz + beta * b;
+    out->w = alpha * a.w + beta;
+    return out->w != 0 && is_finite(out->xyz) && std::isfinite(out->w);
+}
+
+Box intersect(Box a, Box b)
+{
+    if (!a.valid)
+        return b;
+    if (!b.valid)
+        return a;
+    Box out{true, std::max(a.x0, b.x0), std::min(a.x1, b.x1), std::max(a.y0, b.y0), std::min(a.y1, b.y1)};
+    return out;
+}
+
+Box grow(Box box, double margin)
+{
+    box.x0 -= margin;
+    box.x1 += margin;
+    box.y0 -= margin;
+    box.y1 += margin;
+    return box;
+}
+
+void include(Box* box, Vec2 p)
+{
+    if (!box->valid) {
+        *box = Box{true, p.x, p.x, p.y, p.y};
+        return;
+    }
+    box->x0 = std::min(box->x0, p.x);
+    box->x1 = std::max(box->x1, p.x);
+    box->y0 = std::min(box->y0, p.y);
+    box->y1 = std::max(box->y1, p.y);
+}
+
+// The part of the array plane whose lenses can image into the picture: the image corners
+// projected onto the array, grown by two pitches. Invalid if a corner does not project.
+Box sensor_box(const Model& m, int W, int H)
+{
+    Box box{false, 0, 0, 0, 0};
+    const double corners[4][2] = {{0, 0}, {double(W), 0}, {0, double(H)}, {double(W), double(H)}};
+    for (int i = 0; i < 4; ++i) {
+        Vec2 q;
+        if (!project_to_array(m, sensor_point(m, W, H, corners[i][0], corners[i][1]), &q))
+            return Box{false, 0, 0, 0, 0};
+        include(&box, q);
+    }
+    return grow(box, 2 * m.pitch_mm);
+}
+
+// Calls visit(lens) for every lens whose centre lies in the box (array-local), row by row.
+template <class Visit>
+void for_each_lens_in_box(const Model& m, Box box, Visit visit)
+{
+    if (!box.valid || !(box.x0 <= box.x1) || !(box.y0 <= box.y1))
+        return;
+    const double row = row_spacing(m.grid, m.pitch_mm);
+    const double rows = std::floor(box.y1 / row) - std::ceil(box.y0 / row) + 1;
+    const double columns = (box.x1 - box.x0) / m.pitch_mm + 2;
+    if (!(rows * columns <= double(kMaxForwardLenses)))
+        return;  // absurd sizes: give no hits rather than hang
+    const double limit = double(kMaxLensIndex);
+    if (!(std::fabs(box.y0 / row) < limit && std::fabs(box.y1 / row) < limit &&
+          std::fabs(box.x0 / m.pitch_mm) < limit && std::fabs(box.x1 / m.pitch_mm) < limit))
+        return;
+    const std::int64_t l0 = std::int64_t(std::ceil(box.y0 / row));
+    const std::int64_t l1 = std::int64_t(std::floor(box.y1 / row));
+    for (std::int64_t l = l0; l <= l1; ++l) {
+        const double shift = (m.grid == GridType::Hexagonal && floor_mod(l, 2) == 1) ? 0.5 : 0.0;
+        const std::int64_t k0 = std::int64_t(std::ceil(box.x0 / m.pitch_mm - shift));
+        const std::int64_t k1 = std::int64_t(std::floor(box.x1 / m.pitch_mm - shift));
+        for (std::int64_t k = k0; k <= k1; ++k)
+            visit(LensIndex{k, l});
+    }
+}
+
+// Distance from the origin to a convex polygon (0 when inside), corners in either orientation.
+double distance_to_origin(const Vec2* corner, int count)
+{
+    bool all_left = true, all_right = true;
+    double best = INFINITY;
+    for (int i = 0; i < count; ++i) {
+        const Vec2 a = corner[i];
+        const Vec2 b = corner[(i + 1) % count];
+        const double side = cross(b - a, Vec2{0, 0} - a);
+        all_left = all_left && side >= 0;
+        all_right = all_right && side <= 0;
+        const Vec2 ab = b - a;
+        const double len2 = dot(ab, ab);
+        double t = len2 > 0 ? -dot(a, ab) / len2 : 0;
+        t = std::min(1.0, std::max(0.0, t));
+        best = std::min(best, length(a + t * ab));
+    }
+    return (all_left || all_right) ? 0.0 : best;
+}
+
+// Whether some ray from the object (thin-lens image `image`) through the main aperture passes
+// through the lens's cell (its centre only, for pinholes): the cell, projected from the image
+// point onto the main-lens plane, must meet the aperture disc.
+bool lens_sees(const Model& m, Homogeneous image, LensIndex lens)
+{
+    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+    Vec2 local[6];
+    int count = 1;
+    local[0] = Vec2{0, 0};
+    if (m.microlens == MicrolensType::ThinLens)
+        count = cell_polygon(m.grid, m.pitch_mm, local);
+    Vec2 projected[6];
+    double first_sign = 0;
+    for (int i = 0; i < count; ++i) {
+        const Vec3 corner = to_optics(m, Vec3{c.x + local[i].x, c.y + local[i].y, 0});
+        Homogeneous hit;
+        if (!line_meets_plane(image, corner, Vec3{0, 0, 1}, Vec3{0, 0, 0}, &hit))
+            return m.microlens == MicrolensType::ThinLens;  // projection unbounded: keep (conservative)
+        const double sign = hit.w > 0 ? 1 : -1;
+        if (i == 0)
+            first_sign = sign;
+        else if (sign != first_sign)
+            return true;  // the cell straddles the vanishing line: unbounded, keep
+        projected[i] = Vec2{hit.xyz.x / hit.w, hit.xyz.y / hit.w};
+    }
+    const double radius = 0.5 * m.aperture_mm;
+    if (count == 1)
+        return dot(projected[0], projected[0]) <= radius * radius;
+    return distance_to_origin(projected, count) <= radius;
+}
+
+// The cone of light from the main aperture to the point's image X', met with the array plane:
+// a polygon of kFootprintSides corners in array-local coordinates. False when the cone does not
+// cross the plane as a bounded region.
+const int kFootprintSides = 96;
+
+bool cone_footprint(const Model& m, Homogeneous image, Vec2 footprint[kFootprintSides])
+{
+    const double r = 0.5 * m.aperture_mm;
+    double first_sign = 0;
+    for (int i = 0; i < kFootprintSides; ++i) {
+        const double angle = 2 * 3.14159265358979323846 * i / kFootprintSides;
+        Homogeneous hit;
+        if (!line_meets_plane(image, Vec3{r * std::cos(angle), r * std::sin(angle), 0}, m.pose.normal,
+                              m.pose.centre_mm, &hit))
+            return false;
+        const double sign = hit.w > 0 ? 1 : -1;
+        if (i == 0)
+            first_sign = sign;
+        else if (sign != first_sign)
+            return false;
+        const Vec3 local = to_local(m, (1 / hit.w) * hit.xyz);
+        footprint[i] = Vec2{local.x, local.y};
+    }
+    return true;
+}
+
+// Centroid of (convex polygon `subject`) clipped by the convex polygon `clip` (counter-clockwise);
+// false when they do not overlap. Sutherland-Hodgman, then the shoelace centroid.
+bool clipped_centroid(const Vec2* subject, int subject_count, const Vec2* clip, int clip_count, Vec2* centroid)
+{
+    std::vector<Vec2> poly(subject, subject + subject_count), next;
+    // The footprint may wind either way; the clip test below assumes counter-clockwise.
+    double area2 = 0;
+    for (size_t i = 0; i < poly.size(); ++i)
+        area2 += cross(poly[i], poly[(i + 1) % poly.size()]);
+    if (area2 < 0)
+        std::reverse(poly.begin(), poly.end());
+    for (int e = 0; e < clip_count && !poly.empty(); ++e) {
+        const Vec2 a = clip[e], b = clip[(e + 1) % clip_count];
+        next.clear();
+        for (size_t i = 0; i < poly.size(); ++i) {
+            const Vec2 p = poly[i], q = poly[(i + 1) % poly.size()];
+            const double sp = cross(b - a, p - a), sq = cross(b - a, q - a);
+            if (sp >= 0)
+                next.push_back(p);
+            if ((sp >= 0) != (sq >= 0)) {
+                const double t = sp / (sp - sq);
+                next.push_back(p + t * (q - p));
+            }
+        }
+        poly.swap(next);
+    }
+    double area = 0, cx = 0, cy = 0;
+    for (size_t i = 0; i < poly.size(); ++i) {
+        const Vec2 p = poly[i], q = poly[(i + 1) % poly.size()];
+        const double w = cross(p, q);
+        area += w;
+        cx += (p.x + q.x) * w;
+        cy += (p.y + q.y) * w;
+    }
+    if (!(std::fabs(area) > 0))
+        return false;
+    *centroid = Vec2{cx / (3 * area), cy / (3 * area)};
+    return is_finite(*centroid);
+}
+
+void add_hit_if_own(const Model& m, int W, int H, LensIndex lens, Vec3 hit, std::vector<PixelHit>* hits)
+{
+    double u, v;
+    if (!sensor_to_pixel(m, W, H, hit.x, hit.y, &u, &v))
+        return;
+    LensIndex owner;
+    if (!own_lens(m, Vec3{hit.x, hit.y, m.sensor_z_mm}, &owner) || owner != lens)
+        return;  // outside this lens's microimage cell
+    hits->push_back(PixelHit{lens, u, v});
+}
+
+void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::vector<PixelHit>* hits)
+{
+    const Homogeneous image{point, 1 - point.z / m.focal_length_mm};
+    const Vec3 n = m.pose.normal;
+    const Vec3 centre = m.pose.centre_mm;
+
+    // Footprint of the cone (main aperture -> image) on the array: project the aperture's
+    // bounding square from the image point; bounded when all four corners project to one side.
+    Box footprint{false, 0, 0, 0, 0};
+    const double r = 0.5 * m.aperture_mm;
+    const double square[4][2] = {{-r, -r}, {r, -r}, {r, r}, {-r, r}};
+    double first_sign = 0;
+    bool bounded = true;
+    for (int i = 0; i < 4 && bounded; ++i) {
+        Homogeneous hit;
+        if (!line_meets_plane(image, Vec3{square[i][0], square[i][1], 0}, n, centre, &hit)) {
+            bounded = false;
+            break;
+        }
+        const double sign = hit.w > 0 ? 1 : -1;
+        if (i == 0)
+            first_sign = sign;
+        bounded = sign == first_sign;
+        const Vec3 local = to_local(m, (1 / hit.w) * hit.xyz);
+        include(&footprint, Vec2{local.x, local.y});
+    }
+    if (!bounded)
+        footprint.valid = false;
+    else
+        footprint = grow(footprint, m.cell_circumradius_mm);
+    const Box box = intersect(footprint, sensor_box(m, W, H));
+    if (!box.valid)
+        return;
+
+    // Is the image point on the array plane? Then the chief line through a lens centre runs in
+    // the plane and the lens containing X' images the point along the main-lens chief ray.
+    const double offset = dot(n, image.xyz) - image.w * dot(n, centre);
+    const bool on_array = std::fabs(offset) <= 1e-12 * (std::fabs(dot(n, image.xyz)) + std::fabs(image.w * dot(n, centre)));
+
+    if (on_array) {
+        // The cone's footprint is the single point X' = h: only the lens containing it sees the
+        // point, and the image's centre is the main-lens chief ray O -> h, refracted there.
+        if (image.w == 0)
+            return;
+        const Vec3 h = (1 / image.w) * image.xyz;
+        const Vec3 h_local = to_local(m, h);
+        const LensIndex lens = nearest_lens(m.grid, m.pitch_mm, h_local.x, h_local.y);
+        if (m.microlens == MicrolensType::Pinhole && length(h - lens_centre_mm(m, lens)) > 1e-9 * m.pitch_mm)
+            return;  // a pinhole passes light only at its centre
+        Vec3 hit;
+        if (sensor_hit_through_lens(m, lens, h, h, &hit))
+            add_hit_if_own(m, W, H, lens, hit, hits);
+        return;
+    }
+
+    // Thin microlenses: the point's light through a lens is the part of the cone's footprint
+    // inside that lens's cell; its image is where that light lands, centred on the ray from X'
+    // through the centroid of that part (the map from array to sensor is affine, so centroids
+    // map to centroids). A whole cell gives the Institut Pascal line through the lens centre;
+    // plenoptic 1.0 cameras, whose footprints are small, need the partial cells.
+    Vec2 cone[kFootprintSides];
+    const bool thin_microlenses = m.microlens == MicrolensType::ThinLens;
+    const bool use_footprint = thin_microlenses && cone_footprint(m, image, cone);
+    Vec2 cell[6];
+    const int cell_count = thin_microlenses ? cell_polygon(m.grid, m.pitch_mm, cell) : 0;
+
+    for_each_lens_in_box(m, box, [&](LensIndex lens) {
+        if (!lens_sees(m, image, lens))
+            return;
+        if (use_footprint) {
+            const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+            Vec2 corners[6];
+            for (int i = 0; i < cell_count; ++i)
+                corners[i] = c + cell[i];
+            Vec2 centroid{0, 0};
+            if (!clipped_centroid(cone, kFootprintSides, corners, cell_count, &centroid))
+                return;
+            const Vec3 h = to_optics(m, Vec3{centroid.x, centroid.y, 0});
+            // Direction of the light at h, towards the sensor: along the line X' - h.
+            Vec3 towards = image.w == 0 ? image.xyz : (1 / image.w) * image.xyz - h;
+            if (dot(towards, m.pose.normal) > 0)
+                towards = -towards;
+            Vec3 hit;
+            if (sensor_hit_through_lens(m, lens, h, towards, &hit))
+                add_hit_if_own(m, W, H, lens, hit, hits);
+            return;
+        }
+        // Line from X' through the lens centre (its chief ray), met with the sensor plane.
+        Homogeneous meet;
+        if (!line_meets_plane(image, lens_centre_mm(m, lens), Vec3{0, 0, 1}, Vec3{0, 0, m.sensor_z_mm}, &meet))
+            return;
+        const Vec3 hit = (1 / meet.w) * meet.xyz;
+        if (is_finite(hit))
+            add_hit_if_own(m, W, H, lens, hit, hits);
+    });
+}
+
+void project_through_pinhole_main(const Model& m, int W, int H, Vec3 point, std::vector<PixelHit>* hits)
+{
+    if (m.microlens == MicrolensType::Pinhole)
+        return;
+    // The single ray: point -> pinhole -> array.
+    const Vec3 towards_sensor = -point;
+    const double along = dot(m.pose.normal, towards_sensor);
+    const double t = dot(m.pose.normal, m.pose.centre_mm) / along;
+    if (!(t > 0) || !std::isfinite(t))
+        return;
+    const Vec3 h = t * towards_sensor;
+    const Vec3 h_local = to_local(m, h);
+    const LensIndex lens = nearest_lens(m.grid, m.pitch_mm, h_local.x, h_local.y);
+    Vec3 hit;
+    if (sensor_hit_through_lens(m, lens, h, towards_sensor, &hit))
+        add_hit_if_own(m, W, H, lens, hit, hits);
+}
+
+void project_without_main(const Model& m, int W, int H, Vec3 point, std::vector<PixelHit>* hits)
+{
+    const Vec3 local = to_local(m, point);
+    if (!(local.z > 0))
+        return;  // behind the array
+    Box box = sensor_box(m, W, H);
+    if (!m.pose.tilted) {
+        // A lens images the point into its own cell only if the point is within
+        // R (z + d) / d of the lens centre, sideways.
+        const double reach = m.cell_circumradius_mm * (local.z / effective_array_distance_mm(m) + 1) +
+                             m.cell_circumradius_mm;
+        box = intersect(box, Box{true, local.x - reach, local.x + reach, local.y - reach, local.y + reach});
+    }
+    for_each_lens_in_box(m, box, [&](LensIndex lens) {
+        const Vec3 c = lens_centre_mm(m, lens);
+        Vec3 hit;
+        if (sensor_hit_through_lens(m, lens, c, c - point, &hit))
+            add_hit_if_own(m, W, H, lens, hit, hits);
+    });
+}
+
+} // namespace
+
+std::vector<PixelHit> forward_project(const Model& m, int W, int H, const double point_mm[3])
+{
+    std::vector<PixelHit> hits;
+    const Vec3 point{point_mm[0], point_mm[1], point_mm[2]};
+    if (!is_finite(point))
+        return hits;
+    if (m.grid == GridType::None) {
+        if (!(point.z > 0))
+            return hits;
+        // Pinhole, or the chief ray of a thin lens (the centre of its blur disc).
+        const double s = m.sensor_z_mm / point.z;
+        double u, v;
+        if (sensor_to_pixel(m, W, H, point.x * s, point.y * s, &u, &v))
+            hits.push_back(PixelHit{LensIndex{0, 0}, u, v});
+        return hits;
+    }
+    if (m.main_lens == MainLensType::None) {
+        project_without_main(m, W, H, point, &hits);
+        return hits;
+    }
+    if (!(point.z > 0))
+        return hits;
+    if (m.main_lens == MainLensType::Pinhole)
+        project_through_pinhole_main(m, W, H, point, &hits);
+    else
+        project_through_thin_main(m, W, H, point, &hits);
+    return hits;
+}
+
+} // namespace plenoptic
