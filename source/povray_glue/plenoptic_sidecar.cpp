@@ -3,11 +3,16 @@
 
 #include "povray_glue/plenoptic_sidecar.h"
 
+#include <cerrno>
 #include <cmath>
 #include <atomic>
 #include <cstdio>
+#include <cstring>
 #include <mutex>
 #include <vector>
+
+#include <stdlib.h>
+#include <unistd.h>
 
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
@@ -42,14 +47,47 @@ std::string replace_extension(const std::string& path, const std::string& suffix
     return (has_ext ? path.substr(0, dot) : path) + suffix;
 }
 
+std::string directory_of(const std::string& path)
+{
+    const size_t slash = path.find_last_of('/');
+    return slash == std::string::npos ? std::string(".") : (slash == 0 ? std::string("/") : path.substr(0, slash));
+}
+
+// A new, empty file with a short name in the directory of `path` (so renaming it onto `path` is
+// atomic, and a long output name does not become too long a temporary one); empty on failure.
+std::string temporary_beside(const std::string& path)
+{
+    std::string name = directory_of(path) + "/.plenoptic-XXXXXX";
+    std::vector<char> buffer(name.begin(), name.end());
+    buffer.push_back('\0');
+    const int fd = mkstemp(buffer.data());
+    if (fd < 0)
+        return "";
+    close(fd);
+    return std::string(buffer.data());
+}
+
+void report_failure(const char* what, const std::string& path, int error)
+{
+    std::fprintf(stderr, "plenoptic camera: cannot write %s %s: %s\n", what, path.c_str(), std::strerror(error));
+}
+
 bool write_text_atomically(const std::string& path, const std::string& text)
 {
-    const std::string tmp = path + ".tmp";
-    FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (f == nullptr)
+    const std::string tmp = temporary_beside(path);
+    if (tmp.empty()) {
+        report_failure("metadata", path, errno);
         return false;
+    }
+    FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (f == nullptr) {
+        report_failure("metadata", path, errno);
+        std::remove(tmp.c_str());
+        return false;
+    }
     const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
     if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
+        report_failure("metadata", path, errno);
         std::remove(tmp.c_str());
         return false;
     }
@@ -58,7 +96,11 @@ bool write_text_atomically(const std::string& path, const std::string& text)
 
 bool write_depth_exr(const std::string& path, const std::vector<float>& depth, int W, int H)
 {
-    const std::string tmp = path + ".tmp.exr";
+    const std::string tmp = temporary_beside(path);
+    if (tmp.empty()) {
+        report_failure("depth map", path, errno);
+        return false;
+    }
     try {
         Imf::Header header(W, H);
         header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
@@ -73,10 +115,21 @@ bool write_depth_exr(const std::string& path, const std::vector<float>& depth, i
         return false;
     }
     if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+        report_failure("depth map", path, errno);
         std::remove(tmp.c_str());
         return false;
     }
     return true;
+}
+
+// Called with registration_mutex held.
+void forget_registration()
+{
+    registered_setup.store(nullptr);
+    registered_state.store(nullptr);
+    registered_size.store(0);
+    depth_rows.store(0);
+    registration = Registration();
 }
 
 std::string base_name(const std::string& path)
@@ -152,6 +205,14 @@ bool sidecar_write(const std::string& image_path, int W, int H)
     if (!registration.setup)
         return true;
     bool ok = true;
+    // +O- : POV-Ray writes the image to standard output under the name "stdout"; there is no
+    // file beside which the metadata could go.
+    if (image_path == "stdout" || image_path == "stderr") {
+        std::fprintf(stderr, "plenoptic camera: the image went to standard output (+O-), so no metadata or "
+                             "depth map is written; give +O a file name to get them.\n");
+        forget_registration();
+        return true;
+    }
     std::string depth_file;
     if (!registration.depth.empty() && W == registration.width && H == registration.height) {
         const std::string depth_path = depth_path_for(image_path);
@@ -163,15 +224,9 @@ bool sidecar_write(const std::string& image_path, int W, int H)
     const std::string json = metadata_json(registration.setup->model, registration.setup->params, W, H,
                                            registration.state.frame, depth_file);
     const std::string metadata_path = metadata_path_for(image_path);
-    if (!write_text_atomically(metadata_path, json)) {
-        std::fprintf(stderr, "plenoptic camera: cannot write metadata %s\n", metadata_path.c_str());
+    if (!write_text_atomically(metadata_path, json))
         ok = false;
-    }
-    registered_setup.store(nullptr);
-    registered_state.store(nullptr);
-    registered_size.store(0);
-    depth_rows.store(0);
-    registration = Registration();
+    forget_registration();
     return ok;
 }
 

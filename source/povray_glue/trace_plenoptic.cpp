@@ -87,9 +87,11 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 				depth[size_t(row) * W + column] = depth_of(column, row);
 	}
 
+	POV_ULONG traced = 0;  // camera rays into the scene, for the render statistics' "Samples"
 	plenoptic::Rgbt value = plenoptic::shade_pixel(model, i, j, W, H,
 		[&](const plenoptic::OpticsRay& optics_ray) -> plenoptic::Rgbt
 		{
+			traced++;
 			Ray ray;
 			ray.SetFlags(Ray::PrimaryRay, false, false, false, false, pretrace);
 			To_Scene(*state, model.mm_per_unit, optics_ray, ray);
@@ -100,6 +102,7 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 			TraceRay(ray, col, 1.0, ticket, false, camera.Max_Ray_Distance);
 			return plenoptic::Rgbt{col[pRED], col[pGREEN], col[pBLUE], col[pTRANSM]};
 		});
+	threadData->Stats()[Number_Of_Samples] += traced;
 	colour = Colour(value.r, value.g, value.b, 0.0, value.t);
 }
 
