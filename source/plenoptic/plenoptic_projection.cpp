@@ -218,19 +218,26 @@ bool cone_footprint(const Model& m, Homogeneous image, Vec2 footprint[kFootprint
     return true;
 }
 
-// Centroid of (convex polygon `subject`) clipped by the convex polygon `clip` (counter-clockwise);
-// false when they do not overlap. Sutherland-Hodgman, then the shoelace centroid.
-bool clipped_centroid(const Vec2* subject, int subject_count, const Vec2* clip, int clip_count, Vec2* centroid)
+// Twice the signed area of a polygon (positive counter-clockwise).
+double signed_area2(const std::vector<Vec2>& poly)
 {
-    std::vector<Vec2> poly(subject, subject + subject_count), next;
-    // The footprint may wind either way; the clip test below assumes counter-clockwise.
     double area2 = 0;
     for (size_t i = 0; i < poly.size(); ++i)
         area2 += cross(poly[i], poly[(i + 1) % poly.size()]);
-    if (area2 < 0)
+    return area2;
+}
+
+// The convex polygon `subject` clipped by the convex polygon `clip` (Sutherland-Hodgman); both in
+// either orientation.
+std::vector<Vec2> clip_polygon(std::vector<Vec2> poly, std::vector<Vec2> clip)
+{
+    if (signed_area2(poly) < 0)
         std::reverse(poly.begin(), poly.end());
-    for (int e = 0; e < clip_count && !poly.empty(); ++e) {
-        const Vec2 a = clip[e], b = clip[(e + 1) % clip_count];
+    if (signed_area2(clip) < 0)
+        std::reverse(clip.begin(), clip.end());
+    std::vector<Vec2> next;
+    for (size_t e = 0; e < clip.size() && !poly.empty(); ++e) {
+        const Vec2 a = clip[e], b = clip[(e + 1) % clip.size()];
         next.clear();
         for (size_t i = 0; i < poly.size(); ++i) {
             const Vec2 p = poly[i], q = poly[(i + 1) % poly.size()];
@@ -244,29 +251,177 @@ bool clipped_centroid(const Vec2* subject, int subject_count, const Vec2* clip, 
         }
         poly.swap(next);
     }
+    return poly;
+}
+
+// Area (>= 0) and centroid of a simple polygon; area 0 (centroid untouched) when degenerate.
+double area_centroid(const std::vector<Vec2>& poly, Vec2* centroid)
+{
+    if (poly.size() < 3)
+        return 0;
+    // About the first corner, so that far-off polygons keep their precision.
+    const Vec2 o = poly[0];
     double area = 0, cx = 0, cy = 0;
     for (size_t i = 0; i < poly.size(); ++i) {
-        const Vec2 p = poly[i], q = poly[(i + 1) % poly.size()];
+        const Vec2 p = poly[i] - o, q = poly[(i + 1) % poly.size()] - o;
         const double w = cross(p, q);
         area += w;
         cx += (p.x + q.x) * w;
         cy += (p.y + q.y) * w;
     }
-    if (!(std::fabs(area) > 0))
-        return false;
-    *centroid = Vec2{cx / (3 * area), cy / (3 * area)};
-    return is_finite(*centroid);
+    if (!(std::fabs(area) > 0) || !std::isfinite(area))
+        return 0;
+    const Vec2 c{o.x + cx / (3 * area), o.y + cy / (3 * area)};
+    if (!is_finite(c))
+        return 0;
+    *centroid = c;
+    return 0.5 * std::fabs(area);
 }
 
-void add_hit_if_own(const Model& m, int W, int H, LensIndex lens, Vec3 hit, std::vector<PixelHit>* hits)
+// Lenses whose microimage cells may receive light through a lens: the renderer gives a sensor
+// point light through lens L only if L is its own lens (no overlap modelling: the own lens of
+// each sample's sensor point), or, with overlap modelling, if L lies within model.overlap_rings
+// rings of the own lens of the pixel's centre (overlap_lenses; its reach test is conservative,
+// so it never refuses light that arrives). Rings in skew indices: max(|dk|, |dl|) rectangular,
+// max(|dk|, |dl|, |dk + dl|) hexagonal.
+int receiving_rings(const Model& m) { return m.model_overlap ? m.overlap_rings : 0; }
+
+bool within_rings(const Model& m, LensIndex a, LensIndex b, int rings)
+{
+    const std::int64_t dk = skew_k(m.grid, a) - skew_k(m.grid, b);
+    const std::int64_t dl = a.l - b.l;
+    std::int64_t d = std::max(dk < 0 ? -dk : dk, dl < 0 ? -dl : dl);
+    if (m.grid == GridType::Hexagonal)
+        d = std::max(d, dk + dl < 0 ? -(dk + dl) : dk + dl);
+    return d <= rings;
+}
+
+// The picture on the sensor plane (x, y, mm).
+std::vector<Vec2> picture_polygon(const Model& m, int W, int H)
+{
+    const Vec3 a = sensor_point(m, W, H, 0, 0), b = sensor_point(m, W, H, W, H);
+    return std::vector<Vec2>{Vec2{a.x, a.y}, Vec2{b.x, a.y}, Vec2{b.x, b.y}, Vec2{a.x, b.y}};
+}
+
+// Lens `lens`'s microimage cell on the sensor plane: its cell seen from the main-lens centre
+// (straight down without a main lens). Empty if a corner does not project.
+std::vector<Vec2> microimage_cell(const Model& m, LensIndex lens)
+{
+    Vec2 cell[6];
+    const int count = cell_polygon(m.grid, m.pitch_mm, cell);
+    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+    std::vector<Vec2> out;
+    for (int i = 0; i < count; ++i) {
+        const Vec3 q = to_optics(m, Vec3{c.x + cell[i].x, c.y + cell[i].y, 0});
+        double s = 1;
+        if (m.main_lens != MainLensType::None) {
+            if (!(q.z < 0))
+                return std::vector<Vec2>();
+            s = m.sensor_z_mm / q.z;
+        }
+        out.push_back(Vec2{q.x * s, q.y * s});
+    }
+    return out;
+}
+
+// Whether the renderer delivers light through `lens` to sensor point s (x, y, mm): inside the
+// picture and in the microimage cell of a lens within the receiving rings of `lens`.
+bool delivered_point(const Model& m, int W, int H, LensIndex lens, Vec2 s)
 {
     double u, v;
-    if (!sensor_to_pixel(m, W, H, hit.x, hit.y, &u, &v))
-        return;
+    if (!sensor_to_pixel(m, W, H, s.x, s.y, &u, &v))
+        return false;
     LensIndex owner;
-    if (!own_lens(m, Vec3{hit.x, hit.y, m.sensor_z_mm}, &owner) || owner != lens)
-        return;  // outside this lens's microimage cell
-    hits->push_back(PixelHit{lens, u, v});
+    return own_lens(m, Vec3{s.x, s.y, m.sensor_z_mm}, &owner) && within_rings(m, owner, lens, receiving_rings(m));
+}
+
+// The part of `light` (a convex polygon on the sensor plane, x, y, mm, uniformly lit) that the
+// renderer delivers through `lens`: inside the picture and inside the microimage cells of the
+// lenses within the receiving rings. Returns its area and centroid.
+double delivered_area(const Model& m, int W, int H, LensIndex lens, const std::vector<Vec2>& light, Vec2* centroid)
+{
+    const std::vector<Vec2> inside = clip_polygon(light, picture_polygon(m, W, H));
+    if (inside.size() < 3)
+        return 0;
+    double x0 = inside[0].x, x1 = x0, y0 = inside[0].y, y1 = y0;
+    for (const Vec2& q : inside) {
+        x0 = std::min(x0, q.x);
+        x1 = std::max(x1, q.x);
+        y0 = std::min(y0, q.y);
+        y1 = std::max(y1, q.y);
+    }
+    const int rings = receiving_rings(m);
+    const std::int64_t k0 = skew_k(m.grid, lens);
+    double area = 0, cx = 0, cy = 0;
+    for (int dl = -rings; dl <= rings; ++dl) {
+        for (int dk = -rings; dk <= rings; ++dk) {
+            const LensIndex other = from_skew(m.grid, k0 + dk, lens.l + dl);
+            if (!within_rings(m, other, lens, rings))
+                continue;
+            const std::vector<Vec2> cell = microimage_cell(m, other);
+            if (cell.empty())
+                continue;
+            double cx0 = cell[0].x, cx1 = cx0, cy0 = cell[0].y, cy1 = cy0;
+            for (const Vec2& q : cell) {
+                cx0 = std::min(cx0, q.x);
+                cx1 = std::max(cx1, q.x);
+                cy0 = std::min(cy0, q.y);
+                cy1 = std::max(cy1, q.y);
+            }
+            if (cx1 < x0 || cx0 > x1 || cy1 < y0 || cy0 > y1)
+                continue;
+            Vec2 c;
+            const double a = area_centroid(clip_polygon(inside, cell), &c);
+            if (a > 0) {
+                area += a;
+                cx += a * c.x;
+                cy += a * c.y;
+            }
+        }
+    }
+    if (!(area > 0))
+        return 0;
+    *centroid = Vec2{cx / area, cy / area};
+    return is_finite(*centroid) ? area : 0;
+}
+
+// Adds the image at sensor point s if the renderer delivers light there through `lens`.
+void add_point_hit(const Model& m, int W, int H, LensIndex lens, Vec3 s, double fraction, std::vector<PixelHit>* hits)
+{
+    if (!delivered_point(m, W, H, lens, Vec2{s.x, s.y}))
+        return;
+    double u, v;
+    sensor_to_pixel(m, W, H, s.x, s.y, &u, &v);
+    hits->push_back(PixelHit{lens, u, v, fraction});
+}
+
+// Adds the image of the light `light` (sensor plane, uniformly lit, carrying `fraction` of the
+// point's light) through `lens`: the centroid of the part the renderer delivers, with the fraction
+// scaled to that part. A spot smaller than a thousandth of a pixel is a point.
+void add_spot_hit(const Model& m, int W, int H, LensIndex lens, const std::vector<Vec2>& light, double fraction,
+                  std::vector<PixelHit>* hits)
+{
+    Vec2 centre{0, 0};
+    const double area = area_centroid(light, &centre);
+    const double tiny = 1e-6 * m.pixel_size_mm[0] * m.pixel_size_mm[1];
+    if (!(area > tiny)) {
+        if (light.empty())
+            return;
+        Vec2 mean{0, 0};
+        for (const Vec2& q : light)
+            mean = mean + q;
+        mean = (1.0 / light.size()) * mean;
+        add_point_hit(m, W, H, lens, Vec3{mean.x, mean.y, m.sensor_z_mm}, fraction, hits);
+        return;
+    }
+    Vec2 centroid;
+    const double kept = delivered_area(m, W, H, lens, light, &centroid);
+    if (!(kept > 0))
+        return;
+    double u, v;
+    if (!sensor_to_pixel(m, W, H, centroid.x, centroid.y, &u, &v))
+        return;  // only by rounding, for light along the picture's edge
+    hits->push_back(PixelHit{lens, u, v, fraction * std::min(1.0, kept / area)});
 }
 
 void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::vector<PixelHit>* hits)
@@ -299,7 +454,9 @@ void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::ve
         footprint.valid = false;
     else
         footprint = grow(footprint, m.cell_circumradius_mm);
-    const Box box = intersect(footprint, sensor_box(m, W, H));
+    // With overlap modelling, light through a lens reaches the microimages of lenses up to
+    // overlap_rings rings away (each ring at most a pitch further).
+    const Box box = intersect(footprint, grow(sensor_box(m, W, H), receiving_rings(m) * m.pitch_mm));
     if (!box.valid)
         return;
 
@@ -310,59 +467,90 @@ void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::ve
 
     if (on_array) {
         // The cone's footprint is the single point X' = h: only the lens containing it sees the
-        // point, and the image's centre is the main-lens chief ray O -> h, refracted there.
+        // point. A pinhole images it along the main-lens chief ray O -> h; a thin microlens
+        // spreads the cone (every direction from the main aperture to h) over a spot, the image
+        // of the aperture through h, whose delivered part's centroid is the image.
         if (image.w == 0)
             return;
         const Vec3 h = (1 / image.w) * image.xyz;
         const Vec3 h_local = to_local(m, h);
         const LensIndex lens = nearest_lens(m.grid, m.pitch_mm, h_local.x, h_local.y);
-        if (m.microlens == MicrolensType::Pinhole && length(h - lens_centre_mm(m, lens)) > 1e-9 * m.pitch_mm)
-            return;  // a pinhole passes light only at its centre
-        Vec3 hit;
-        if (sensor_hit_through_lens(m, lens, h, h, &hit))
-            add_hit_if_own(m, W, H, lens, hit, hits);
+        if (m.microlens == MicrolensType::Pinhole) {
+            if (length(h - lens_centre_mm(m, lens)) > 1e-9 * m.pitch_mm)
+                return;  // a pinhole passes light only at its centre
+            Vec3 hit;
+            if (sensor_hit_through_lens(m, lens, h, h, &hit))
+                add_point_hit(m, W, H, lens, hit, 1.0, hits);
+            return;
+        }
+        std::vector<Vec2> spot;
+        for (int i = 0; i < kFootprintSides; ++i) {
+            const double angle = 2 * 3.14159265358979323846 * i / kFootprintSides;
+            const Vec3 on_aperture{r * std::cos(angle), r * std::sin(angle), 0};
+            Vec3 hit;
+            if (!sensor_hit_through_lens(m, lens, h, h - on_aperture, &hit))
+                return;
+            spot.push_back(Vec2{hit.x, hit.y});
+        }
+        add_spot_hit(m, W, H, lens, spot, 1.0, hits);
         return;
     }
 
     // Thin microlenses: the point's light through a lens is the part of the cone's footprint
-    // inside that lens's cell; its image is where that light lands, centred on the ray from X'
-    // through the centroid of that part (the map from array to sensor is affine, so centroids
-    // map to centroids). A whole cell gives the Institut Pascal line through the lens centre;
-    // plenoptic 1.0 cameras, whose footprints are small, need the partial cells.
+    // inside that lens's cell; it lands on the sensor as that part mapped through the lens (the
+    // map from array to sensor is affine, so uniform light stays uniform and centroids map to
+    // centroids), and the image is the centroid of what the renderer delivers of it: inside the
+    // picture, and inside that lens's own microimage cell or, where overlap is modelled, the cells
+    // of the lenses within overlap_rings rings (delivered_area). A whole cell well inside its
+    // microimage gives the Institut Pascal line through the lens centre; plenoptic 1.0 cameras,
+    // whose footprints are small, need the partial cells. The fraction is the part of the point's
+    // light through the main aperture that arrives in that image.
     Vec2 cone[kFootprintSides];
     const bool thin_microlenses = m.microlens == MicrolensType::ThinLens;
     const bool use_footprint = thin_microlenses && cone_footprint(m, image, cone);
     Vec2 cell[6];
     const int cell_count = thin_microlenses ? cell_polygon(m.grid, m.pitch_mm, cell) : 0;
+    const std::vector<Vec2> cone_polygon(cone, cone + (use_footprint ? kFootprintSides : 0));
+    Vec2 unused;
+    const double cone_area = use_footprint ? area_centroid(cone_polygon, &unused) : 0;
 
     for_each_lens_in_box(m, box, [&](LensIndex lens) {
         if (!lens_sees(m, image, lens))
             return;
-        if (use_footprint) {
+        if (use_footprint && cone_area > 0) {
             const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
-            Vec2 corners[6];
+            std::vector<Vec2> corners(cell_count);
             for (int i = 0; i < cell_count; ++i)
                 corners[i] = c + cell[i];
+            const std::vector<Vec2> part = clip_polygon(cone_polygon, corners);
             Vec2 centroid{0, 0};
-            if (!clipped_centroid(cone, kFootprintSides, corners, cell_count, &centroid))
+            const double part_area = area_centroid(part, &centroid);
+            if (!(part_area > 0))
                 return;
-            const Vec3 h = to_optics(m, Vec3{centroid.x, centroid.y, 0});
-            // Direction of the light at h, towards the sensor: along the line X' - h.
-            Vec3 towards = image.w == 0 ? image.xyz : (1 / image.w) * image.xyz - h;
-            if (dot(towards, m.pose.normal) > 0)
-                towards = -towards;
-            Vec3 hit;
-            if (sensor_hit_through_lens(m, lens, h, towards, &hit))
-                add_hit_if_own(m, W, H, lens, hit, hits);
+            // Each corner of the part, carried to the sensor along the light through it (the line
+            // X' - h, towards the sensor).
+            std::vector<Vec2> spot;
+            for (const Vec2& q : part) {
+                const Vec3 h = to_optics(m, Vec3{q.x, q.y, 0});
+                Vec3 towards = image.w == 0 ? image.xyz : (1 / image.w) * image.xyz - h;
+                if (dot(towards, m.pose.normal) > 0)
+                    towards = -towards;
+                Vec3 hit;
+                if (!sensor_hit_through_lens(m, lens, h, towards, &hit))
+                    return;
+                spot.push_back(Vec2{hit.x, hit.y});
+            }
+            add_spot_hit(m, W, H, lens, spot, std::min(1.0, part_area / cone_area), hits);
             return;
         }
-        // Line from X' through the lens centre (its chief ray), met with the sensor plane.
+        // Pinhole microlenses (or a cone that does not cross the array as a bounded region): the
+        // line from X' through the lens centre (its chief ray), met with the sensor plane.
         Homogeneous meet;
         if (!line_meets_plane(image, lens_centre_mm(m, lens), Vec3{0, 0, 1}, Vec3{0, 0, m.sensor_z_mm}, &meet))
             return;
         const Vec3 hit = (1 / meet.w) * meet.xyz;
         if (is_finite(hit))
-            add_hit_if_own(m, W, H, lens, hit, hits);
+            add_point_hit(m, W, H, lens, hit, 1.0, hits);
     });
 }
 
@@ -381,7 +569,7 @@ void project_through_pinhole_main(const Model& m, int W, int H, Vec3 point, std:
     const LensIndex lens = nearest_lens(m.grid, m.pitch_mm, h_local.x, h_local.y);
     Vec3 hit;
     if (sensor_hit_through_lens(m, lens, h, towards_sensor, &hit))
-        add_hit_if_own(m, W, H, lens, hit, hits);
+        add_point_hit(m, W, H, lens, hit, 1.0, hits);
 }
 
 void project_without_main(const Model& m, int W, int H, Vec3 point, std::vector<PixelHit>* hits)
@@ -401,7 +589,7 @@ void project_without_main(const Model& m, int W, int H, Vec3 point, std::vector<
         const Vec3 c = lens_centre_mm(m, lens);
         Vec3 hit;
         if (sensor_hit_through_lens(m, lens, c, c - point, &hit))
-            add_hit_if_own(m, W, H, lens, hit, hits);
+            add_point_hit(m, W, H, lens, hit, 1.0, hits);
     });
 }
 
@@ -420,7 +608,7 @@ std::vector<PixelHit> forward_project(const Model& m, int W, int H, const double
         const double s = m.sensor_z_mm / point.z;
         double u, v;
         if (sensor_to_pixel(m, W, H, point.x * s, point.y * s, &u, &v))
-            hits.push_back(PixelHit{LensIndex{0, 0}, u, v});
+            hits.push_back(PixelHit{LensIndex{0, 0}, u, v, 1.0});
         return hits;
     }
     if (m.main_lens == MainLensType::None) {

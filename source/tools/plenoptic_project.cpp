@@ -1,13 +1,14 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // plenoptic-project: where 3-D points image in a plenoptic render, from its metadata file.
 //
-//   plenoptic-project METADATA.json X Y Z [X Y Z ...]
-//   plenoptic-project METADATA.json - < points.txt
+//   plenoptic-project [--fraction] METADATA.json X Y Z [X Y Z ...]
+//   plenoptic-project [--fraction] METADATA.json - < points.txt
 //
 // Points are in scene units, world frame. Output: for each point, one line per image,
 // "point_index lens_k lens_l u v" (lens in row form; u, v in pixels, the centre of pixel
 // (column i, row j) at (i, j), as docs/metadata.md defines). A point that images nowhere
-// (behind the camera, outside the picture, seen by no lens) prints no line.
+// (behind the camera, outside the picture, seen by no lens) prints no line. --fraction adds a
+// sixth column: the part of the point's light through the main aperture in that image.
 
 #include <cerrno>
 #include <cmath>
@@ -22,14 +23,16 @@
 namespace {
 
 const char* kUsage =
-    "usage: plenoptic-project METADATA.json X Y Z [X Y Z ...]\n"
-    "       plenoptic-project METADATA.json -      (points from standard input, three numbers each)\n"
+    "usage: plenoptic-project [--fraction] METADATA.json X Y Z [X Y Z ...]\n"
+    "       plenoptic-project [--fraction] METADATA.json -   (points from standard input, three numbers each)\n"
     "Projects world points (scene units) into the render described by METADATA.json (the\n"
     "<image>.plenoptic.json a plenoptic render writes) and prints, for each point, one line per\n"
     "image of it: point_index lens_k lens_l u v\n"
     "  point_index  0-based, in the order given\n"
     "  lens_k lens_l the microlens in row form ((0, 0) without an array)\n"
     "  u v          pixel coordinates, centre of pixel (column i, row j) at (i, j), v downwards\n"
+    "  --fraction   adds a sixth column: the part of the point's light through the main aperture\n"
+    "               that arrives in that image (1 where each image is a single ray: pinholes)\n"
     "Exit status: 0 done, 2 bad usage, unreadable or invalid metadata, or a malformed number.\n";
 
 bool parse_number(const std::string& text, double* value)
@@ -56,6 +59,11 @@ int main(int argc, char** argv)
     if (!args.empty() && (args[0] == "-h" || args[0] == "--help")) {
         std::fputs(kUsage, stdout);
         return 0;
+    }
+    bool with_fraction = false;
+    if (!args.empty() && args[0] == "--fraction") {
+        with_fraction = true;
+        args.erase(args.begin());
     }
     if (args.empty())
         return fail("missing METADATA.json and points\n" + std::string(kUsage));
@@ -102,8 +110,13 @@ int main(int argc, char** argv)
 
     for (size_t p = 0; p < values.size() / 3; ++p) {
         const std::vector<plenoptic::PixelHit> hits = plenoptic::project_world_point(metadata, &values[3 * p]);
-        for (const plenoptic::PixelHit& hit : hits)
-            std::printf("%zu %lld %lld %.6f %.6f\n", p, (long long)hit.lens.k, (long long)hit.lens.l, hit.u, hit.v);
+        for (const plenoptic::PixelHit& hit : hits) {
+            if (with_fraction)
+                std::printf("%zu %lld %lld %.6f %.6f %.6g\n", p, (long long)hit.lens.k, (long long)hit.lens.l, hit.u,
+                            hit.v, hit.fraction);
+            else
+                std::printf("%zu %lld %lld %.6f %.6f\n", p, (long long)hit.lens.k, (long long)hit.lens.l, hit.u, hit.v);
+        }
     }
     return std::fflush(stdout) == 0 ? 0 : 2;
 }
