@@ -18,8 +18,11 @@ struct CameraFrame {
     double direction[3];  // +z, towards the scene
 };
 
-// The JSON of docs/metadata.md for a W x H render. `depth_map_file` empty writes null.
-// Numbers are written with %.17g; a number that is not finite is written as null.
+// The JSON of docs/metadata.md for a W x H render (written with nlohmann-json, members in the
+// documented order). `depth_map_file` empty writes null; a file name that is not UTF-8 has each
+// invalid byte replaced by U+FFFD. Numbers are written in the shortest form that reads back to
+// the same double (0.15), whole numbers below 2^53 without a fraction (1000); a number that is
+// not finite is written as null.
 std::string metadata_json(const Model& model, const CameraParams& params, int W, int H,
                           const CameraFrame& frame, const std::string& depth_map_file);
 

@@ -1,11 +1,15 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Tests of the metadata JSON: valid syntax, every documented field, nulls, number format.
+// Tests of the metadata JSON: valid JSON (parsed by nlohmann-json), every documented field in the
+// documented order, nulls, numbers in their shortest round-trip form, strings escaped and UTF-8.
 
-#include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "plenoptic_metadata.h"
 #include "plenoptic_optics.h"
@@ -15,148 +19,93 @@ namespace plenoptic {
 namespace {
 
 using test::plenoptic_camera;
-
-// A strict little JSON syntax checker (RFC 8259 grammar, no extensions).
-class JsonChecker {
-public:
-    explicit JsonChecker(const std::string& text) : s_(text) {}
-    bool valid()
-    {
-        skip();
-        if (!value())
-            return false;
-        skip();
-        return i_ == s_.size();
-    }
-
-private:
-    void skip()
-    {
-        while (i_ < s_.size() && std::isspace((unsigned char)s_[i_]))
-            ++i_;
-    }
-    bool literal(const char* word)
-    {
-        const std::string w(word);
-        if (s_.compare(i_, w.size(), w) != 0)
-            return false;
-        i_ += w.size();
-        return true;
-    }
-    bool string()
-    {
-        if (s_[i_] != '"')
-            return false;
-        for (++i_; i_ < s_.size(); ++i_) {
-            const unsigned char c = s_[i_];
-            if (c == '"') {
-                ++i_;
-                return true;
-            }
-            if (c < 0x20)
-                return false;
-            if (c == '\\')
-                ++i_;
-        }
-        return false;
-    }
-    bool number()
-    {
-        const size_t start = i_;
-        if (s_[i_] == '-')
-            ++i_;
-        if (i_ >= s_.size() || !std::isdigit((unsigned char)s_[i_]))
-            return false;
-        if (s_[i_] == '0')
-            ++i_;
-        else
-            while (i_ < s_.size() && std::isdigit((unsigned char)s_[i_]))
-                ++i_;
-        if (i_ < s_.size() && s_[i_] == '.') {
-            ++i_;
-            if (!std::isdigit((unsigned char)s_[i_]))
-                return false;
-            while (std::isdigit((unsigned char)s_[i_]))
-                ++i_;
-        }
-        if (i_ < s_.size() && (s_[i_] == 'e' || s_[i_] == 'E')) {
-            ++i_;
-            if (s_[i_] == '+' || s_[i_] == '-')
-                ++i_;
-            if (!std::isdigit((unsigned char)s_[i_]))
-                return false;
-            while (std::isdigit((unsigned char)s_[i_]))
-                ++i_;
-        }
-        return i_ > start;
-    }
-    bool value()
-    {
-        skip();
-        if (i_ >= s_.size())
-            return false;
-        const char c = s_[i_];
-        if (c == '{' || c == '[') {
-            const char close = c == '{' ? '}' : ']';
-            ++i_;
-            skip();
-            if (s_[i_] == close) {
-                ++i_;
-                return true;
-            }
-            for (;;) {
-                skip();
-                if (c == '{') {
-                    if (!string())
-                        return false;
-                    skip();
-                    if (s_[i_++] != ':')
-                        return false;
-                }
-                if (!value())
-                    return false;
-                skip();
-                if (s_[i_] == ',') {
-                    ++i_;
-                    continue;
-                }
-                if (s_[i_] == close) {
-                    ++i_;
-                    return true;
-                }
-                return false;
-            }
-        }
-        if (c == '"')
-            return string();
-        if (c == 't')
-            return literal("true");
-        if (c == 'f')
-            return literal("false");
-        if (c == 'n')
-            return literal("null");
-        return number();
-    }
-
-    const std::string& s_;
-    size_t i_ = 0;
-};
+using Json = nlohmann::ordered_json;
 
 const CameraFrame kFrame = {{0, 0.5, -3}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 
 bool has(const std::string& json, const std::string& part) { return json.find(part) != std::string::npos; }
 
-TEST(Metadata, PlenopticCameraWritesEveryField)
+// The document, or a test failure when the text is not strict JSON (RFC 8259, valid UTF-8).
+Json parsed(const std::string& text)
+{
+    try {
+        return Json::parse(text);
+    } catch (const Json::exception& e) {
+        ADD_FAILURE() << "not valid JSON: " << e.what() << "\n" << text;
+        return Json();
+    }
+}
+
+// The shortest decimal that reads back to `value`, as %.{precision}g gives it (the reference the
+// writer must match digit for digit; whole numbers below 2^53 without a fraction).
+std::string shortest(double value)
+{
+    char buffer[40];
+    for (int precision = 1; precision <= 17; ++precision) {
+        std::snprintf(buffer, sizeof buffer, "%.*g", precision, value);
+        if (std::strtod(buffer, nullptr) == value)
+            break;
+    }
+    return buffer;
+}
+
+// Significant digits of a number token: "0.0078125" -> "78125", "1e+300" -> "1", "-52.3" -> "523".
+std::string significant_digits(const std::string& token)
+{
+    std::string digits;
+    for (char c : token) {
+        if (c == 'e' || c == 'E')
+            break;
+        if (c >= '0' && c <= '9')
+            digits += c;
+    }
+    const size_t first = digits.find_first_not_of('0');
+    if (first == std::string::npos)
+        return "0";
+    const size_t last = digits.find_last_not_of('0');
+    return digits.substr(first, last - first + 1);
+}
+
+// Every number token of a JSON text (outside strings).
+std::vector<std::string> number_tokens(const std::string& text)
+{
+    std::vector<std::string> tokens;
+    bool in_string = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (in_string) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '-' || (c >= '0' && c <= '9')) {
+            const size_t end = text.find_first_of(",]} \n", i);
+            tokens.push_back(text.substr(i, end - i));
+            i = end - 1;
+        }
+    }
+    return tokens;
+}
+
+CameraParams documented_camera()
 {
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2.0, 2.0, 50, 4, 0);
     p.main.has_distance = false;
     p.main.has_focus_distance = true;
     p.main.focus_distance_units = 2.5;
     test::set_pose(&p, 0, 0, 0.5, 0.01, 0, 0);
+    return p;
+}
+
+TEST(Metadata, PlenopticCameraWritesEveryField)
+{
+    const CameraParams p = documented_camera();
     ASSERT_EQ(check_camera(p), "");
     const Model m = make_model(p);
     const std::string json = metadata_json(m, p, 640, 480, kFrame, "scene.depth.exr");
-    EXPECT_TRUE(JsonChecker(json).valid()) << json;
+    parsed(json);
     const char* keys[] = {"\"format\": \"povray-plenoptic-metadata\"", "\"version\": 1", "\"image\"", "\"width\": 640",
                           "\"height\": 480", "\"mm_per_unit\": 1000", "\"camera_frame\"", "\"location\": [0, 0.5, -3]",
                           "\"right\"", "\"up\"", "\"direction\"", "\"main_lens\"", "\"type\": \"thin_lens\"",
@@ -174,25 +123,104 @@ TEST(Metadata, PlenopticCameraWritesEveryField)
                           "\"depth_map\": \"scene.depth.exr\""};
     for (const char* key : keys)
         EXPECT_TRUE(has(json, key)) << "missing " << key << " in\n" << json;
-    // D is written even though focus_distance gave it; %.17g throughout.
-    char expected_d[64];
-    std::snprintf(expected_d, sizeof expected_d, "\"distance_mm\": %.17g", m.distance_mm);
-    EXPECT_TRUE(has(json, expected_d)) << expected_d << "\n" << json;
+    // D is written even though focus_distance gave it, in its shortest round-trip form.
+    EXPECT_TRUE(has(json, "\"distance_mm\": " + shortest(m.distance_mm) + ",")) << shortest(m.distance_mm) << "\n"
+                                                                                 << json;
     // Microimage diameter: A d / D / pixel size.
-    char expected_diameter[80];
-    std::snprintf(expected_diameter, sizeof expected_diameter, "\"microimage_diameter_px\": %.17g",
-                  12.5 * 2.0 / m.distance_mm / 0.01);
-    EXPECT_TRUE(has(json, expected_diameter)) << expected_diameter << "\n" << json;
+    EXPECT_TRUE(has(json, "\"microimage_diameter_px\": " + shortest(12.5 * 2.0 / m.distance_mm / 0.01))) << json;
 }
 
-TEST(Metadata, NumbersUseSeventeenDigitsAndStringsAreEscaped)
+TEST(Metadata, KeysComeInTheDocumentedOrder)
+{
+    // docs/metadata.md is the contract: these names, in this order, at every level.
+    const CameraParams p = documented_camera();
+    const Json doc = parsed(metadata_json(make_model(p), p, 640, 480, kFrame, "scene.depth.exr"));
+    auto keys = [](const Json& object) {
+        std::vector<std::string> names;
+        for (auto it = object.begin(); it != object.end(); ++it)
+            names.push_back(it.key());
+        return names;
+    };
+    typedef std::vector<std::string> Names;
+    EXPECT_EQ(keys(doc), (Names{"format", "version", "image", "mm_per_unit", "camera_frame", "main_lens",
+                                "microlens_array", "sensor", "samples", "principal_point_px", "microimage_lattice",
+                                "lftoolbox_lenslet_grid_model", "depth_map"}));
+    EXPECT_EQ(keys(doc["image"]), (Names{"width", "height"}));
+    EXPECT_EQ(keys(doc["camera_frame"]), (Names{"location", "right", "up", "direction"}));
+    EXPECT_EQ(keys(doc["main_lens"]),
+              (Names{"type", "focal_length_mm", "aperture_mm", "f_number", "distance_mm", "focus_distance"}));
+    EXPECT_EQ(keys(doc["microlens_array"]), (Names{"grid", "lens", "pitch_mm", "focal_lengths_mm", "distance_mm",
+                                                    "rotate_deg", "translate_mm"}));
+    EXPECT_EQ(keys(doc["sensor"]), (Names{"pixel_size_mm", "offset_mm", "plane_z_mm"}));
+    EXPECT_EQ(keys(doc["samples"]), (Names{"adaptive", "min", "max", "confidence", "variance"}));
+    EXPECT_EQ(keys(doc["microimage_lattice"]), (Names{"origin_px", "basis_px", "index_rule", "exact", "lens_types",
+                                                       "lens_type_rule", "microimage_diameter_px"}));
+    EXPECT_EQ(keys(doc["lftoolbox_lenslet_grid_model"]), (Names{"HSpacing", "VSpacing", "HOffset", "VOffset", "Rot",
+                                                                 "Orientation", "FirstPosShiftRow", "UMax", "VMax"}));
+}
+
+TEST(Metadata, NumbersAreWrittenInTheirShortestRoundTripForm)
+{
+    // 0.15 and 2.1 are not exact in binary: %.17g wrote 0.14999999999999999 and 2.1000000000000001.
+    CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.15, 0.6, 0.6, 16, 4, 0);
+    p.main.has_distance = false;
+    p.main.has_focus_distance = true;
+    p.main.focus_distance_units = 2;
+    p.array.focal_length_count = 3;
+    p.array.focal_lengths_mm[1] = 2.1;
+    p.array.focal_lengths_mm[2] = 2.2;
+    p.array.distance_mm = 0.6;
+    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.01;
+    test::set_pose(&p, 0, 0, 0.3, 0.01, 0, 0);
+    ASSERT_EQ(check_camera(p), "");
+    const Model m = make_model(p);
+    const std::string json = metadata_json(m, p, 640, 480, kFrame, "");
+    parsed(json);
+    EXPECT_TRUE(has(json, "\"pitch_mm\": 0.15,")) << json;
+    EXPECT_TRUE(has(json, "\"focal_lengths_mm\": [0.6, 2.1, 2.2]")) << json;
+    EXPECT_TRUE(has(json, "\"rotate_deg\": [0, 0, 0.3]")) << json;
+    EXPECT_TRUE(has(json, "\"translate_mm\": [0.01, 0, 0]")) << json;
+    EXPECT_TRUE(has(json, "\"pixel_size_mm\": [0.01, 0.01]")) << json;
+    EXPECT_TRUE(has(json, "\"mm_per_unit\": 1000,")) << json;  // a whole number stays one (no "1000.0")
+    // Every number: reads back exactly, with no more significant digits than needed.
+    const std::vector<std::string> tokens = number_tokens(json);
+    EXPECT_GT(tokens.size(), 40u);
+    for (const std::string& token : tokens) {
+        const double value = std::strtod(token.c_str(), nullptr);
+        EXPECT_EQ(significant_digits(token), significant_digits(shortest(value)))
+            << token << " is not the shortest form of " << shortest(value);
+    }
+}
+
+TEST(Metadata, ExtremeNumbersReadBackExactly)
+{
+    CameraParams p = plenoptic_camera(GridType::Rectangular, 0.1, 2.0, 2.0, 50, 4, 52);
+    p.mm_per_unit = 1e-300;
+    test::set_pose(&p, 4503599627370495.5, 0, 1e-9, 1.0 / 3, -5e-324, 0);  // below 2^52, not whole
+    Model m = make_model(p);
+    m.sensor_offset_mm[0] = 1e300;  // not from checked input; the writer must still be exact
+    m.sensor_offset_mm[1] = 9007199254740994.0;  // whole, above 2^53
+    const Json doc = parsed(metadata_json(m, p, 64, 48, kFrame, ""));
+    EXPECT_EQ(doc["mm_per_unit"].get<double>(), 1e-300);
+    EXPECT_EQ(doc["microlens_array"]["rotate_deg"][2].get<double>(), 1e-9);
+    EXPECT_EQ(doc["microlens_array"]["translate_mm"][0].get<double>(), 1.0 / 3);
+    EXPECT_EQ(doc["microlens_array"]["translate_mm"][1].get<double>(), -5e-324);
+    EXPECT_EQ(doc["sensor"]["offset_mm"][0].get<double>(), 1e300);
+    EXPECT_EQ(doc["sensor"]["offset_mm"][1].get<double>(), 9007199254740994.0);
+    EXPECT_EQ(doc["microlens_array"]["rotate_deg"][0].get<double>(), 4503599627370495.5);
+}
+
+TEST(Metadata, StringsAreEscapedAndValidUtf8)
 {
     CameraParams p = plenoptic_camera(GridType::Rectangular, 0.1, 2.0, 2.0, 50, 4, 52);
     const Model m = make_model(p);
-    const std::string json = metadata_json(m, p, 64, 48, kFrame, "dir\\name \"quoted\".exr");
-    EXPECT_TRUE(JsonChecker(json).valid()) << json;
-    EXPECT_TRUE(has(json, "\"pitch_mm\": 0.10000000000000001")) << json;
-    EXPECT_TRUE(has(json, "\"depth_map\": \"dir\\\\name \\\"quoted\\\".exr\"")) << json;
+    std::string json = metadata_json(m, p, 64, 48, kFrame, "dir\\name \"quoted\"\t\xc3\xa9.exr");
+    EXPECT_EQ(parsed(json)["depth_map"].get<std::string>(), "dir\\name \"quoted\"\t\xc3\xa9.exr");
+    EXPECT_TRUE(has(json, "\"depth_map\": \"dir\\\\name \\\"quoted\\\"\\t\xc3\xa9.exr\"")) << json;
+    // A file name that is not UTF-8 (Latin-1 bytes) cannot be JSON text: each bad byte is written
+    // as U+FFFD and the file stays valid.
+    json = metadata_json(m, p, 64, 48, kFrame, "caf\xe9\xff.exr");
+    EXPECT_EQ(parsed(json)["depth_map"].get<std::string>(), "caf\xef\xbf\xbd\xef\xbf\xbd.exr") << json;
     // A rectangular grid has no LFToolbox row shift.
     EXPECT_TRUE(has(json, "\"FirstPosShiftRow\": null")) << json;
     EXPECT_TRUE(has(json, "\"index_rule\": \"skew indices (k, l): rectangular")) << json;
@@ -202,7 +230,7 @@ TEST(Metadata, AbsentPartsAreNull)
 {
     const CameraParams lens_only = test::thin_lens_camera(50, 4, 52);
     std::string json = metadata_json(make_model(lens_only), lens_only, 64, 48, kFrame, "");
-    EXPECT_TRUE(JsonChecker(json).valid()) << json;
+    parsed(json);
     EXPECT_TRUE(has(json, "\"microlens_array\": null")) << json;
     EXPECT_TRUE(has(json, "\"microimage_lattice\": null")) << json;
     EXPECT_TRUE(has(json, "\"lftoolbox_lenslet_grid_model\": null")) << json;
@@ -212,7 +240,7 @@ TEST(Metadata, AbsentPartsAreNull)
     CameraParams bare;
     test::add_array(&bare, GridType::Hexagonal, 0.5, 0, 2);
     json = metadata_json(make_model(bare), bare, 64, 48, kFrame, "");
-    EXPECT_TRUE(JsonChecker(json).valid()) << json;
+    parsed(json);
     EXPECT_TRUE(has(json, "\"type\": \"none\"")) << json;
     EXPECT_TRUE(has(json, "\"focal_length_mm\": null")) << json;
     EXPECT_TRUE(has(json, "\"distance_mm\": null")) << json;
@@ -228,7 +256,7 @@ TEST(Metadata, AbsentPartsAreNull)
     json = metadata_json(make_model(multi), multi, 64, 48, kFrame, "");
     EXPECT_TRUE(has(json, "\"lens_types\": 3")) << json;
     EXPECT_TRUE(has(json, "\"lens_type_rule\": \"type(k, l) = (k - l) mod 3, focal_lengths_mm[type]\"")) << json;
-    EXPECT_TRUE(has(json, "\"focal_lengths_mm\": [2, 2.1000000000000001, 2.2000000000000002]")) << json;
+    EXPECT_TRUE(has(json, "\"focal_lengths_mm\": [2, 2.1, 2.2]")) << json;
 }
 
 TEST(Metadata, NonFiniteNumbersAreWrittenAsNull)
@@ -236,10 +264,23 @@ TEST(Metadata, NonFiniteNumbersAreWrittenAsNull)
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2.0, 2.0, 50, 4, 52);
     Model m = make_model(p);
     m.sensor_offset_mm[0] = NAN;  // cannot come from checked input; the writer must still cope
+    m.sensor_offset_mm[1] = -INFINITY;
     const std::string json = metadata_json(m, p, 64, 48, kFrame, "");
-    EXPECT_TRUE(JsonChecker(json).valid()) << json;
-    EXPECT_TRUE(has(json, "\"offset_mm\": [null, 0]")) << json;
+    parsed(json);
+    EXPECT_TRUE(has(json, "\"offset_mm\": [null, null]")) << json;
     EXPECT_FALSE(has(json, "nan")) << json;
+    EXPECT_FALSE(has(json, "inf")) << json;
+}
+
+TEST(Metadata, LayoutIsOneMemberPerLineWithArraysOnOneLine)
+{
+    const CameraParams p = documented_camera();
+    const std::string json = metadata_json(make_model(p), p, 640, 480, kFrame, "");
+    EXPECT_EQ(json.rfind("{\n  \"format\": \"povray-plenoptic-metadata\",\n  \"version\": 1,\n", 0), 0u) << json;
+    EXPECT_TRUE(has(json, "\n  \"image\": {\n    \"width\": 640,\n    \"height\": 480\n  },\n")) << json;
+    EXPECT_TRUE(has(json, "\n  \"samples\": {\"adaptive\": false, \"min\": ")) << json;
+    EXPECT_TRUE(has(json, "\n    \"basis_px\": [[")) << json;
+    EXPECT_EQ(json.substr(json.size() - 22), "  \"depth_map\": null\n}\n") << json;
 }
 
 TEST(Metadata, LatticeFieldsMatchTheMicroimageLattice)
@@ -248,14 +289,15 @@ TEST(Metadata, LatticeFieldsMatchTheMicroimageLattice)
     test::set_pose(&p, 0, 0, 2, 0, 0, 0);
     const Model m = make_model(p);
     const MicroimageLattice lattice = microimage_lattice(m, 640, 480);
-    const std::string json = metadata_json(m, p, 640, 480, kFrame, "");
-    char field[80];
-    std::snprintf(field, sizeof field, "\"HSpacing\": %.17g", lattice.h_spacing);
-    EXPECT_TRUE(has(json, field)) << field;
-    std::snprintf(field, sizeof field, "\"Rot\": %.17g", lattice.rot);
-    EXPECT_TRUE(has(json, field)) << field;
-    std::snprintf(field, sizeof field, "\"origin_px\": [%.17g, %.17g]", lattice.origin_px[0], lattice.origin_px[1]);
-    EXPECT_TRUE(has(json, field)) << field;
+    const Json doc = parsed(metadata_json(m, p, 640, 480, kFrame, ""));
+    const Json& grid = doc["lftoolbox_lenslet_grid_model"];
+    EXPECT_EQ(grid["HSpacing"].get<double>(), lattice.h_spacing);
+    EXPECT_EQ(grid["Rot"].get<double>(), lattice.rot);
+    EXPECT_EQ(grid["UMax"].get<long long>(), lattice.u_max);
+    EXPECT_TRUE(grid["UMax"].is_number_integer());
+    const Json& origin = doc["microimage_lattice"]["origin_px"];
+    EXPECT_EQ(origin[0].get<double>(), lattice.origin_px[0]);
+    EXPECT_EQ(origin[1].get<double>(), lattice.origin_px[1]);
     EXPECT_NEAR(lattice.h_spacing, 0.5 * (1 + 2.0 / 52) / 0.01, 1e-9);
 }
 
