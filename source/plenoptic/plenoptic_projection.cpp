@@ -351,6 +351,22 @@ double delivered_area(const Model& m, int W, int H, LensIndex lens, const std::v
         y1 = std::max(y1, q.y);
     }
     const int rings = receiving_rings(m);
+    if (!m.pose.tilted && m.main_lens != MainLensType::None) {
+        // Fast path: the cells within `rings` rings cover the disc of radius rings * row spacing
+        // about the lens centre (ring r lies at least r row spacings away, and a point that far
+        // is nearer to a lens within the rings than to any beyond), or the cell's inscribed
+        // circle without overlap; an untilted array maps to the sensor by one scale factor.
+        const Vec3 c = lens_centre_mm(m, lens);
+        if (c.z < 0) {
+            const double scale = m.sensor_z_mm / c.z;
+            const double radius = scale * (rings > 0 ? rings * row_spacing(m.grid, m.pitch_mm) : m.cell_inradius_mm);
+            bool covered = true;
+            for (const Vec2& q : inside)
+                covered = covered && length(q - Vec2{c.x * scale, c.y * scale}) <= radius * (1 - 1e-9);
+            if (covered)
+                return area_centroid(inside, centroid);
+        }
+    }
     const std::int64_t k0 = skew_k(m.grid, lens);
     double area = 0, cx = 0, cy = 0;
     for (int dl = -rings; dl <= rings; ++dl) {
@@ -358,6 +374,17 @@ double delivered_area(const Model& m, int W, int H, LensIndex lens, const std::v
             const LensIndex other = from_skew(m.grid, k0 + dk, lens.l + dl);
             if (!within_rings(m, other, lens, rings))
                 continue;
+            if (!m.pose.tilted && m.main_lens != MainLensType::None) {
+                // Cheap rejection: the cell's circumscribed circle, scaled onto the sensor.
+                const Vec3 oc = lens_centre_mm(m, other);
+                if (oc.z < 0) {
+                    const double scale = m.sensor_z_mm / oc.z;
+                    const double reach = scale * m.cell_circumradius_mm;
+                    const double ox = oc.x * scale, oy = oc.y * scale;
+                    if (ox + reach < x0 || ox - reach > x1 || oy + reach < y0 || oy - reach > y1)
+                        continue;
+                }
+            }
             const std::vector<Vec2> cell = microimage_cell(m, other);
             if (cell.empty())
                 continue;
