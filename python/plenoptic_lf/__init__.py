@@ -6,8 +6,8 @@ A plenoptic render (camera { plenoptic ... }) writes a raw lenslet image and, be
 samples every microimage on a regular grid of (u, v) offsets around its centre and arranges
 the samples as a 4-D light field L[t, s, v, u, c] (lens row and column, angular row and column,
 colour; see lightfield.py), from which it computes sub-aperture views, refocusing by
-shift-and-add and epipolar-plane images. It uses numpy, Pillow and OpenImageIO (for EXR and
-16-bit input; Pillow reads 8-bit raws when OpenImageIO is missing).
+shift-and-add and epipolar-plane images. It uses numpy, OpenImageIO (required: it reads every raw
+image and honours the file's own encoding, e.g. a linear 16-bit PNG) and Pillow (pictures out).
 
     import plenoptic_lf as plf
     raw = plf.read_raw("scene.png")                       # linear float (H, W, 3)
@@ -26,12 +26,13 @@ __version__ = "0.1.0"
 
 from .cli import main, parse_slopes
 from .contact_sheet import contact_sheet
-from .errors import DecodeError, MetadataError
+from .errors import DecodeError, DependencyError, MetadataError
 from .focus import (box3, default_slopes, distance_to_slope, gray, laplacian_energy, pick_epi_row,
                     pick_near_far, sharpest_slope_map, slopes_from_depth_map)
-from .images import (bilinear, linear_to_srgb, read_depth_map, read_raw, save_png, scaled_pil_image,
-                     srgb_to_linear, to_8bit)
-from .lightfield import LightField, angular_grid, decode, mosaic
+from .images import (RawInfo, bilinear, check_encoding, inspect_raw, linear_to_srgb, read_depth_map, read_raw,
+                     read_raw_image, require_openimageio, save_png, scaled_pil_image, srgb_to_linear, to_8bit,
+                     to_linear)
+from .lightfield import LIGHT_FIELD_LIMIT_BYTES, DecodePlan, LightField, angular_grid, decode, mosaic, plan_decode
 from .metadata import METADATA_FORMAT, METADATA_VERSION, Metadata, load_metadata, metadata_path_for
 from .outputs import write_outputs
 from .progress import Progress
@@ -42,10 +43,11 @@ __all__ = [
     # metadata
     "METADATA_FORMAT", "METADATA_VERSION", "Metadata", "MetadataError", "load_metadata", "metadata_path_for",
     # images
-    "DecodeError", "read_raw", "read_depth_map", "save_png", "to_8bit", "srgb_to_linear", "linear_to_srgb",
+    "DecodeError", "DependencyError", "read_raw", "read_raw_image", "inspect_raw", "RawInfo", "check_encoding",
+    "require_openimageio", "read_depth_map", "save_png", "to_8bit", "srgb_to_linear", "linear_to_srgb", "to_linear",
     "bilinear", "scaled_pil_image",
     # light field
-    "LightField", "decode", "angular_grid", "mosaic",
+    "LightField", "decode", "plan_decode", "DecodePlan", "LIGHT_FIELD_LIMIT_BYTES", "angular_grid", "mosaic",
     # refocus sweep
     "default_slopes", "slopes_from_depth_map", "distance_to_slope", "gray", "box3", "laplacian_energy",
     "sharpest_slope_map", "pick_near_far", "pick_epi_row",

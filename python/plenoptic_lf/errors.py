@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""The two ways decoding refuses its input; each carries one sentence for the user."""
+"""How decoding refuses: its input (metadata, image) or a missing module; each error carries one
+sentence for the user."""
 
 
 class MetadataError(Exception):
@@ -7,4 +8,10 @@ class MetadataError(Exception):
 
 
 class DecodeError(Exception):
-    """The raw image cannot be decoded with this metadata (size mismatch, no lens inside...)."""
+    """The raw image cannot be decoded with this metadata (size mismatch, no lens inside, a
+    light field too large...)."""
+
+
+class DependencyError(ImportError):
+    """A Python module the decoder needs (OpenImageIO) is not installed; the message names the
+    Debian and the pip package."""

@@ -1,11 +1,32 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Image reading and writing: raw renders and depth maps in (through OpenImageIO, with Pillow
-as a fallback for 8-bit raws), 8-bit sRGB PNGs out (through Pillow); colour encodings and
-bilinear sampling. Pixel (column i, row j) has its centre at (i, j)."""
+"""Image reading and writing: raw renders and depth maps in (through OpenImageIO, which the
+decoder requires), 8-bit sRGB PNGs out (through Pillow); colour encodings and bilinear sampling.
+Pixel (column i, row j) has its centre at (i, j)."""
+
+import math
+import re
 
 import numpy as np
 
-from .errors import DecodeError
+from .errors import DecodeError, DependencyError
+
+MISSING_OPENIMAGEIO = ("OpenImageIO's Python module is not installed; the decoder reads every raw image "
+                       "(8/16-bit PNG, EXR, ...) through it: on Debian 'apt install python3-openimageio', "
+                       "with pip 'pip install OpenImageIO'")
+
+# Formats whose files record no encoding (OpenImageIO reports a fixed guess for JPEG and PNM and
+# nothing for BMP): their 8-bit values are taken as sRGB, POV-Ray's default File_Gamma.
+_NO_ENCODING_RECORD = {"jpeg": "JPEG", "pnm": "PPM/PNM", "bmp": "BMP"}
+_FORMAT_NAMES = dict(_NO_ENCODING_RECORD, png="PNG", openexr="EXR", hdr="Radiance HDR", targa="TGA", tiff="TIFF")
+
+
+def require_openimageio():
+    """The OpenImageIO module; DependencyError naming the Debian and pip packages without it."""
+    try:
+        import OpenImageIO as oiio  # noqa: N813 (Debian's python3-openimageio, pip's OpenImageIO)
+    except ImportError as e:
+        raise DependencyError(MISSING_OPENIMAGEIO) from e
+    return oiio
 
 
 def srgb_to_linear(x):
@@ -18,50 +39,128 @@ def linear_to_srgb(x):
     return np.where(x <= 0.0031308, x * 12.92, 1.055 * np.power(x, 1 / 2.4) - 0.055).astype(np.float32)
 
 
-def read_raw(path, encoding="auto"):
-    """The raw image as float32 (H, W, 3), linear light.
-
-    encoding: 'auto' (sRGB for 8/16-bit files, linear for float files such as EXR),
-    'srgb', 'linear', or a number (a pure power-law gamma). Raises DecodeError."""
-    pixels = None
-    is_float = False
+def check_encoding(encoding):
+    """'srgb', 'linear', 'auto' or a positive gamma (number or its text) -> the normalised value
+    ('srgb', 'linear', 'auto' or a float); ValueError otherwise."""
+    if isinstance(encoding, str) and encoding.lower() in ("auto", "srgb", "linear"):
+        return encoding.lower()
     try:
-        import OpenImageIO as oiio  # noqa: N813 (Debian's python3-openimageio)
-        buf = oiio.ImageBuf(path)
-        spec = buf.spec()
-        if buf.has_error or spec.width == 0:
-            raise DecodeError("cannot read raw image %s: %s" % (path, buf.geterror().strip() or "unknown format"))
-        is_float = spec.format.basetype in (oiio.FLOAT, oiio.HALF, oiio.DOUBLE)
-        pixels = np.asarray(buf.get_pixels(oiio.FLOAT), dtype=np.float32)
-    except ImportError:
-        try:
-            from PIL import Image
-            with Image.open(path) as im:
-                mode = im.mode
-                stored = np.asarray(im.convert("RGB") if mode not in ("I;16", "I", "F") else im)
-            if stored.dtype == np.uint8:
-                pixels = stored.astype(np.float32) / 255.0
-            elif mode == "F":
-                pixels = stored.astype(np.float32)
-                is_float = True
-            else:
-                pixels = stored.astype(np.float32) / 65535.0
-        except OSError as e:
-            raise DecodeError("cannot read raw image %s: %s" % (path, e))
+        gamma = float(encoding)
+    except (TypeError, ValueError):
+        gamma = float("nan")
+    if not (gamma > 0 and math.isfinite(gamma)):
+        raise ValueError("the encoding must be auto, srgb, linear or a positive gamma, not %r" % (encoding,))
+    return "linear" if gamma == 1.0 else gamma
+
+
+class RawInfo:
+    """What the raw image's header says: width, height, channels, file_format (OpenImageIO's name),
+    sample ('8-bit integer', '16-bit integer', '16-bit float', ...), is_float, and the encoding
+    the decoder applies: 'srgb', 'linear' or a gamma (float; linear = value ** gamma), with
+    encoding_source, a phrase saying where it comes from."""
+
+    def __init__(self, path, spec, file_format, encoding="auto"):
+        oiio = require_openimageio()
+        self.path = path
+        self.width, self.height, self.channels = spec.width, spec.height, spec.nchannels
+        self.file_format = file_format
+        basetype = spec.format.basetype
+        self.is_float = basetype in (oiio.FLOAT, oiio.HALF, oiio.DOUBLE)
+        self.sample = "%d-bit %s" % (8 * spec.format.size(), "float" if self.is_float else "integer")
+        self.colour_space = spec.get_string_attribute("oiio:ColorSpace", "")
+        self.file_gamma = spec.get_float_attribute("oiio:Gamma", 0.0)
+        encoding = check_encoding(encoding)
+        if encoding != "auto":
+            self.encoding, self.encoding_source = encoding, "--encoding"
+        else:
+            self.encoding, self.encoding_source = self._file_encoding()
+
+    def _file_encoding(self):
+        """The encoding the file itself records, as OpenImageIO reports it."""
+        if self.is_float:
+            return "linear", "floating-point pixels are linear"
+        if self.file_format in _NO_ENCODING_RECORD:
+            return "srgb", ("assumed: a %s file records no encoding; sRGB is POV-Ray's default File_Gamma "
+                            "(--encoding linear for a File_Gamma=1.0 render)" % _NO_ENCODING_RECORD[self.file_format])
+        told = "the file's own, as OpenImageIO reports it: oiio:ColorSpace %r%s" % (
+            self.colour_space, ", oiio:Gamma %g" % self.file_gamma if self.file_gamma > 0 else "")
+        name = self.colour_space.lower()
+        # OpenImageIO's names: 2.4 'linear', 'sRGB', 'Gamma2.2'; older 'Linear', 'GammaCorrected';
+        # 3.x 'lin_srgb', 'lin_rec709_scene', 'srgb_rec709_scene', 'g22_rec709', 'Gamma1.8'.
+        if name in ("linear", "scene_linear") or name.startswith("lin_") or name.startswith("linear"):
+            return "linear", told
+        if "srgb" in name:
+            return "srgb", told
+        gamma = self.file_gamma
+        if not gamma > 0:
+            match = re.match(r"^gamma\s*([0-9]*\.?[0-9]+)$", name) or re.match(r"^g([0-9])([0-9])_", name)
+            if match:
+                gamma = float(match.group(1) if match.lastindex == 1 else match.group(1) + "." + match.group(2))
+        if gamma > 0:
+            return ("linear" if abs(gamma - 1.0) < 1e-3 else float(gamma)), told
+        return "srgb", ("assumed: the file records no encoding OpenImageIO names (oiio:ColorSpace %r); sRGB is "
+                        "POV-Ray's default File_Gamma" % self.colour_space)
+
+    def describe(self):
+        """'96 x 72 PNG, 16-bit integer, encoding linear (the file's own, ...)'."""
+        encoding = self.encoding if isinstance(self.encoding, str) else "gamma %g" % self.encoding
+        return "%d x %d %s, %s, encoding %s (%s)" % (
+            self.width, self.height, _FORMAT_NAMES.get(self.file_format, self.file_format), self.sample,
+            encoding, self.encoding_source)
+
+
+def _open_raw(path):
+    """OpenImageIO ImageBuf of the raw image with its header read (no pixels yet)."""
+    oiio = require_openimageio()
+    buf = oiio.ImageBuf(path)
+    spec = buf.spec()
+    if buf.has_error or spec.width == 0:
+        raise DecodeError("cannot read raw image %s: %s" % (path, buf.geterror().strip() or "unknown format"))
+    return buf
+
+
+def inspect_raw(path, encoding="auto"):
+    """The raw image's RawInfo from its header alone (size, sample type, encoding), without
+    reading its pixels. Raises DecodeError, or DependencyError without OpenImageIO."""
+    buf = _open_raw(path)
+    return RawInfo(path, buf.spec(), buf.file_format_name, encoding)
+
+
+def to_linear(pixels, encoding):
+    """Encoded values -> linear light, for encoding 'srgb', 'linear' or a gamma (float)."""
+    if encoding == "srgb":
+        return srgb_to_linear(pixels)
+    if encoding == "linear":
+        return np.asarray(pixels, dtype=np.float32)
+    return np.power(np.clip(pixels, 0, None), float(encoding)).astype(np.float32)
+
+
+def read_raw_image(path, encoding="auto"):
+    """The raw image as float32 (H, W, 3) linear light, and its RawInfo.
+
+    encoding: 'auto' (the file's own encoding: a PNG's sRGB or gAMA chunk as OpenImageIO reports
+    it, linear for float files such as EXR, sRGB for formats that record none), or an override:
+    'srgb', 'linear', or a number (a pure power-law gamma: linear = value ** gamma).
+    Raises DecodeError, or DependencyError without OpenImageIO."""
+    oiio = require_openimageio()
+    buf = _open_raw(path)
+    info = RawInfo(path, buf.spec(), buf.file_format_name, encoding)
+    pixels = np.asarray(buf.get_pixels(oiio.FLOAT), dtype=np.float32)
+    if buf.has_error or pixels.ndim < 2 or pixels.size == 0:
+        raise DecodeError("cannot read raw image %s: %s" % (path, buf.geterror().strip() or "no pixels"))
     if pixels.ndim == 2:
         pixels = pixels[:, :, None]
     if pixels.shape[2] == 1:
         pixels = np.repeat(pixels, 3, axis=2)
     elif pixels.shape[2] == 2:  # grey + alpha
         pixels = np.repeat(pixels[:, :, :1], 3, axis=2)
-    pixels = pixels[:, :, :3]
-    if encoding == "auto":
-        encoding = "linear" if is_float else "srgb"
-    if encoding == "srgb":
-        pixels = srgb_to_linear(pixels)
-    elif encoding != "linear":
-        pixels = np.power(np.clip(pixels, 0, None), float(encoding)).astype(np.float32)
-    return np.ascontiguousarray(pixels, dtype=np.float32)
+    pixels = to_linear(pixels[:, :, :3], info.encoding)
+    return np.ascontiguousarray(pixels, dtype=np.float32), info
+
+
+def read_raw(path, encoding="auto"):
+    """The raw image as float32 (H, W, 3), linear light (see read_raw_image for `encoding`)."""
+    return read_raw_image(path, encoding)[0]
 
 
 def read_depth_map(path):

@@ -128,12 +128,14 @@ def _rectangular_grid_axes(meta):
     return sa * a, rho * r, sa, rho, h
 
 
-def angular_grid(meta, n=None, step=1.0):
-    """Offsets (pixels) of the angular samples and the usable-disc mask: (du, dv, mask).
+# The largest light field the decoder builds: L in float32, refused up front beyond this (a whole
+# run needs about 1.5 times L plus the raw image; docs/ground-truth.md).
+LIGHT_FIELD_LIMIT_BYTES = 4 * 1024 ** 3
 
-    The usable radius is the smaller of the main-aperture disc (microimage_diameter_px / 2) and
-    the microimage cell's inradius, less one pixel so that every sample is fully lit.
-    n (odd) overrides the count."""
+
+def _usable_radius(meta):
+    """Radius (pixels) of the usable microimage disc: the smaller of the main-aperture disc
+    (microimage_diameter_px / 2) and the microimage cell's inradius, less one pixel."""
     # Inradius of a microimage cell: half the distance to the nearest neighbouring centre.
     if meta.grid == "rectangular":
         radius = 0.5 * min(np.hypot(*meta.a), np.hypot(*meta.b))
@@ -141,93 +143,192 @@ def angular_grid(meta, n=None, step=1.0):
         radius = 0.5 * np.hypot(*meta.a)
     if meta.diameter_px is not None and meta.diameter_px > 0:
         radius = min(radius, 0.5 * meta.diameter_px)
-    usable = radius - 1.0
+    return radius - 1.0
+
+
+def _angular_count(usable, n, step):
+    """Samples per axis: n (checked) or as many `step`-pixel steps as fit the usable radius."""
     if n is None:
-        half = max(int(math.floor(usable / step + 1e-9)), 0)
+        ratio = usable / step + 1e-9
+        half = max(int(math.floor(min(ratio, 1e12))), 0) if not math.isnan(ratio) else 0
         n = 2 * half + 1
     if n < 1 or n % 2 == 0:
         raise DecodeError("the angular sample count must be odd and positive, got %d" % n)
-    offsets = (np.arange(n) - n // 2) * float(step)
+    return n
+
+
+def _angular_offsets(n, step):
+    return (np.arange(n) - n // 2) * float(step)
+
+
+def angular_grid(meta, n=None, step=1.0):
+    """Offsets (pixels) of the angular samples and the usable-disc mask: (du, dv, mask).
+
+    The usable radius is the smaller of the main-aperture disc (microimage_diameter_px / 2) and
+    the microimage cell's inradius, less one pixel so that every sample is fully lit.
+    n (odd) overrides the count."""
+    usable = _usable_radius(meta)
+    n = _angular_count(usable, n, step)
+    offsets = _angular_offsets(n, step)
     dv, du = np.meshgrid(offsets, offsets, indexing="ij")
     mask = np.hypot(du, dv) <= max(usable, 0.0) + 1e-9
     mask[n // 2, n // 2] = True
     return offsets.copy(), offsets.copy(), mask
 
 
+def _gib(n_bytes):
+    return "%.3g GiB" % (n_bytes / 1024.0 ** 3)
+
+
+class DecodePlan:
+    """What decode() will build, computed from the metadata alone (no pixels, nothing large):
+    n (angular samples per axis), reach (largest usable offset, pixels), the rectangular lens
+    grid (A, R, its skew coefficients), the kept lenses (k0, frac, l: T x S arrays) and
+    origin_st, shape (T, S, n, n, C) and nbytes of L in float32."""
+
+    def __init__(self, meta, n=None, step=1.0, channels=3, limit_bytes=LIGHT_FIELD_LIMIT_BYTES):
+        W, H = meta.width, meta.height
+        self.step = float(step)
+        if not (self.step > 0 and math.isfinite(self.step)):
+            raise DecodeError("the angular step must be a positive number of pixels, got %r" % (step,))
+        A, R, sa, rho, h = _rectangular_grid_axes(meta)
+        self.A, self.R = A, R
+        grid_inverse = np.linalg.inv(np.column_stack([A, R]))
+        corners = np.array([[0, 0], [W - 1, 0], [0, H - 1], [W - 1, H - 1]], float) - meta.origin
+        corners_st = corners @ grid_inverse.T
+        if not np.isfinite(corners_st).all():
+            raise DecodeError("the metadata lattice puts no sensible grid of microimages on the %d x %d image" % (W, H))
+        # Microimages farther apart than the image is wide or high: at most one lens per row or
+        # column, no light field (and, unchecked, an angular grid as large as a microimage).
+        extent_s, extent_t = np.ptp(corners_st[:, 0]), np.ptp(corners_st[:, 1])
+        if extent_s < 1.0 or extent_t < 1.0:
+            raise DecodeError(
+                "field 'microimage_lattice.basis_px' puts microimages %.1f px apart along a lens row and %.1f px "
+                "between rows, more than the %d x %d px image spans (%.2f x %.2f spacings; microlens_array.pitch_mm "
+                "%s, sensor.pixel_size_mm %s): at most one lens per row or column, no light field to decode"
+                % (np.hypot(*A), np.hypot(*R), W, H, extent_s, extent_t,
+                   _number(meta.raw, "microlens_array.pitch_mm"), _number(meta.raw, "sensor.pixel_size_mm")))
+        if extent_s * extent_t > 4.0 * W * H:
+            raise DecodeError("the metadata lattice puts no sensible grid of microimages on the %d x %d image" % (W, H))
+
+        # The angular grid's size, before building it: even one lens must fit the limit.
+        usable = _usable_radius(meta)
+        self.n = n = _angular_count(usable, n, self.step)
+        self.channels = channels
+        per_lens = n * n * channels * 4
+        if per_lens > limit_bytes:
+            raise DecodeError(
+                "one microimage alone would give %d x %d angular samples (%s per lens in float32, over the "
+                "decoder's limit of %s for the light field): use a larger --step (now %g px) or a smaller --angular"
+                % (n, n, _gib(per_lens), _gib(limit_bytes), self.step))
+        offsets = _angular_offsets(n, self.step)
+        usable_offsets = np.abs(offsets)[np.abs(offsets) <= max(usable, 0.0) + 1e-9]
+        self.reach = reach = float(usable_offsets.max()) if usable_offsets.size else 0.0
+
+        s_all = np.arange(math.floor(corners_st[:, 0].min()) - 1, math.ceil(corners_st[:, 0].max()) + 2)
+        t_all = np.arange(math.floor(corners_st[:, 1].min()) - 1, math.ceil(corners_st[:, 1].max()) + 2)
+        ss, tt = np.meshgrid(s_all, t_all)
+        # Skew index of every grid point: lens (k0, l) and, for a hexagonal half-shifted row, the
+        # fraction `frac` of the way to lens (k0 + 1, l).
+        k = ss * sa - tt * rho * h
+        l = tt * rho
+        k0 = np.floor(k + 1e-9)
+        frac = k - k0
+
+        def inside(kk, ll):
+            u, v = meta.centre(kk, ll)
+            return (u - reach >= 0) & (u + reach <= W - 1) & (v - reach >= 0) & (v + reach <= H - 1)
+
+        valid = inside(k0, l) & ((frac < 1e-6) | inside(k0 + 1, l))
+        # Largest rectangle of grid points whose microimages lie wholly in the picture (greedy).
+        t_lo, t_hi, s_lo, s_hi = 0, valid.shape[0] - 1, 0, valid.shape[1] - 1
+        while t_lo <= t_hi and s_lo <= s_hi and not valid[t_lo:t_hi + 1, s_lo:s_hi + 1].all():
+            invalid = ~valid[t_lo:t_hi + 1, s_lo:s_hi + 1]
+            losses = [invalid[0].mean(), invalid[-1].mean(), invalid[:, 0].mean(), invalid[:, -1].mean()]
+            side = int(np.argmax(losses))
+            if side == 0:
+                t_lo += 1
+            elif side == 1:
+                t_hi -= 1
+            elif side == 2:
+                s_lo += 1
+            else:
+                s_hi -= 1
+        if t_lo > t_hi or s_lo > s_hi:
+            raise DecodeError("no microimage lies wholly inside the %d x %d image" % (W, H))
+        kept = (slice(t_lo, t_hi + 1), slice(s_lo, s_hi + 1))
+        self.k0, self.frac, self.l = k0[kept], frac[kept].astype(np.float32), l[kept]
+        self.origin_st = (s_all[s_lo], t_all[t_lo])
+        T, S = self.k0.shape
+        self.shape = (T, S, n, n, channels)
+        self.nbytes = T * S * per_lens
+        if self.nbytes > limit_bytes:
+            raise DecodeError(
+                "the light field would be %d x %d lenses x %d x %d angular samples x %d colours = %s in float32, "
+                "over the decoder's limit of %s: use a larger --step (now %g px) or a smaller --angular"
+                % (T, S, n, n, channels, _gib(self.nbytes), _gib(limit_bytes), self.step))
+
+
+def _number(raw, path):
+    """The value at a dotted path of the metadata, for messages ('?' when absent)."""
+    node = raw
+    for part in path.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return "?"
+        node = node[part]
+    if isinstance(node, list) and node:
+        node = node[0]
+    return "%g" % node if isinstance(node, (int, float)) and not isinstance(node, bool) else "?"
+
+
+def plan_decode(meta, n=None, step=1.0, channels=3):
+    """The DecodePlan of decode(raw, meta, n, step) from the metadata alone: the light field's
+    shape and size, checked. Raises DecodeError when the microimage spacing exceeds the image,
+    no microimage fits, or L would exceed LIGHT_FIELD_LIMIT_BYTES."""
+    return DecodePlan(meta, n, step, channels)
+
+
 def decode(raw, meta, n=None, step=1.0, progress=None):
     """Raw image (H, W, C float) + Metadata -> LightField.
 
     n: angular samples per axis (odd; default as many `step`-pixel steps as fit the usable
-    microimage disc); progress: a Progress for stage messages (default silent)."""
+    microimage disc); progress: a Progress for stage messages (default silent). The size is
+    checked first (plan_decode): DecodeError instead of an absurd allocation."""
     if progress is None:
         progress = Progress(False)
     H, W = raw.shape[:2]
     if (W, H) != (meta.width, meta.height):
         raise MetadataError("fields 'image.width' x 'image.height' are %d x %d but the raw image is %d x %d"
                             % (meta.width, meta.height, W, H))
-    du, dv, mask = angular_grid(meta, n, step)
-    A, R, sa, rho, h = _rectangular_grid_axes(meta)
-    grid_inverse = np.linalg.inv(np.column_stack([A, R]))
-    corners = np.array([[0, 0], [W - 1, 0], [0, H - 1], [W - 1, H - 1]], float) - meta.origin
-    corners_st = corners @ grid_inverse.T
-    if not (np.isfinite(corners_st).all() and np.ptp(corners_st[:, 0]) * np.ptp(corners_st[:, 1]) <= 4.0 * W * H):
-        raise DecodeError("the metadata lattice puts no sensible grid of microimages on the %d x %d image" % (W, H))
-    s_all = np.arange(math.floor(corners_st[:, 0].min()) - 1, math.ceil(corners_st[:, 0].max()) + 2)
-    t_all = np.arange(math.floor(corners_st[:, 1].min()) - 1, math.ceil(corners_st[:, 1].max()) + 2)
-    ss, tt = np.meshgrid(s_all, t_all)
-    # Skew index of every grid point: lens (k0, l) and, for a hexagonal half-shifted row, the
-    # fraction `frac` of the way to lens (k0 + 1, l).
-    k = ss * sa - tt * rho * h
-    l = tt * rho
-    k0 = np.floor(k + 1e-9)
-    frac = k - k0
-    reach_u = np.abs(du[np.any(mask, axis=0)]).max()
-    reach_v = np.abs(dv[np.any(mask, axis=1)]).max()
-
-    def inside(kk, ll):
-        u, v = meta.centre(kk, ll)
-        return (u - reach_u >= 0) & (u + reach_u <= W - 1) & (v - reach_v >= 0) & (v + reach_v <= H - 1)
-
-    valid = inside(k0, l) & ((frac < 1e-6) | inside(k0 + 1, l))
-    # Largest rectangle of grid points whose microimages lie wholly in the picture (greedy).
-    t_lo, t_hi, s_lo, s_hi = 0, valid.shape[0] - 1, 0, valid.shape[1] - 1
-    while t_lo <= t_hi and s_lo <= s_hi and not valid[t_lo:t_hi + 1, s_lo:s_hi + 1].all():
-        invalid = ~valid[t_lo:t_hi + 1, s_lo:s_hi + 1]
-        losses = [invalid[0].mean(), invalid[-1].mean(), invalid[:, 0].mean(), invalid[:, -1].mean()]
-        side = int(np.argmax(losses))
-        if side == 0:
-            t_lo += 1
-        elif side == 1:
-            t_hi -= 1
-        elif side == 2:
-            s_lo += 1
-        else:
-            s_hi -= 1
-    if t_lo > t_hi or s_lo > s_hi:
-        raise DecodeError("no microimage lies wholly inside the %d x %d image" % (W, H))
-    kept = (slice(t_lo, t_hi + 1), slice(s_lo, s_hi + 1))
-    k0, frac, l = k0[kept], frac[kept].astype(np.float32), l[kept]
+    C = raw.shape[2]
+    plan = plan_decode(meta, n, step, C)
+    du, dv, mask = angular_grid(meta, plan.n, plan.step)
+    k0, frac, l = plan.k0, plan.frac, plan.l
     T, S = k0.shape
     n_v, n_u = len(dv), len(du)
-    C = raw.shape[2]
-    progress.stage("decoding %d x %d lenses (%s grid), %d x %d angular samples %.3g px apart"
-                   % (S, T, meta.grid, n_u, n_v, step))
+    progress.stage("decoding %d x %d lenses (%s grid), %d x %d angular samples %.3g px apart (%s)"
+                   % (S, T, meta.grid, n_u, n_v, plan.step,
+                      "%.3g MiB" % (plan.nbytes / 1024.0 ** 2) if plan.nbytes < 1024 ** 3 else _gib(plan.nbytes)))
     data = np.zeros((T, S, n_v, n_u, C), np.float32)
-    offset_v, offset_u = np.meshgrid(dv, du, indexing="ij")
+    # A few angular rows at a time: the interpolation's temporaries stay small beside L.
+    rows_per_chunk = max(1, (1 << 18) // max(S * n_u, 1))
     for t in range(T):
         u0, v0 = meta.centre(k0[t], l[t])
         u1, v1 = meta.centre(k0[t] + 1, l[t])
-        x0 = u0[:, None, None] + offset_u[None]
-        y0 = v0[:, None, None] + offset_v[None]
-        x1 = u1[:, None, None] + offset_u[None]
-        y1 = v1[:, None, None] + offset_v[None]
         weight_next = frac[t][:, None, None, None]
-        row = bilinear(raw, x0, y0) * (1 - weight_next)
-        if np.any(frac[t] > 0):
-            row += bilinear(raw, x1, y1) * weight_next
-        data[t] = row
+        shifted = bool(np.any(frac[t] > 0))
+        for iv0 in range(0, n_v, rows_per_chunk):
+            offset_v, offset_u = np.meshgrid(dv[iv0:iv0 + rows_per_chunk], du, indexing="ij")
+            x0 = u0[:, None, None] + offset_u[None]
+            y0 = v0[:, None, None] + offset_v[None]
+            chunk = bilinear(raw, x0, y0) * (1 - weight_next)
+            if shifted:
+                x1 = u1[:, None, None] + offset_u[None]
+                y1 = v1[:, None, None] + offset_v[None]
+                chunk += bilinear(raw, x1, y1) * weight_next
+            data[t, :, iv0:iv0 + rows_per_chunk] = chunk
         progress.update(t + 1, T)
-    return LightField(data, du, dv, mask, A, R, (s_all[s_lo], t_all[t_lo]), meta, float(step))
+    return LightField(data, du, dv, mask, plan.A, plan.R, plan.origin_st, meta, plan.step)
 
 
 def mosaic(lf, gap=2):

@@ -1,0 +1,225 @@
+# SPDX-License-Identifier: AGPL-3.0-or-later
+"""plenoptic-decode honours the raw image's own encoding: the same scene written as a linear
+16-bit PNG, an sRGB 16-bit PNG, an 8-bit PNG (sRGB and linear), a gamma-2.2 PNG and an EXR
+decodes to the same linear light field.
+
+Scene: a flat emissive plane (finish { emission 1 diffuse 0 }, pigment rgb C, assumed_gamma 1)
+filling the view of a plenoptic 1.0 camera. Every fully lit pixel then holds exactly C in linear
+light, whatever the camera does, so every lens of the decoded centre view must be C, up to the
+file's quantisation: half a step of the stored integer, carried through the file's transfer
+curve (written out again below, not taken from the decoder), or half a unit in the last place
+of the EXR's 16-bit floats.
+
+Checks:
+  - what povray writes: the PNG chunks (read here byte by byte): +FN16 File_Gamma=1.0 has
+    gAMA 100000 and no sRGB chunk; the default (File_Gamma sRGB) has an sRGB chunk (and gAMA
+    45455); File_Gamma=2.2 has gAMA 45455 alone; and what OpenImageIO reports for each
+    (oiio:ColorSpace, oiio:Gamma);
+  - the decoder's default (--encoding auto) gives C for every file, so the central views agree
+    with each other within the sum of their quantisation bounds;
+  - it says which encoding it applied, and why, on stderr;
+  - --encoding still overrides: the linear PNG read as sRGB gives srgb_to_linear(C), the sRGB PNG
+    read as linear gives the sRGB-encoded C.
+"""
+
+import json
+import os
+import shutil
+import struct
+import subprocess
+import sys
+
+import numpy as np
+
+import gt_common as gt
+
+W, H = 96, 72
+C = (0.8, 0.35, 0.05)  # linear radiance of the plane; 0.05 is on the steep part of the sRGB curve
+
+SCENE = """camera {
+  plenoptic
+  location <0, 0, -2>
+  look_at <0, 0, 0>
+  main_lens { thin_lens focal_length 50 f_number 4 focus_distance 2 }
+  microlens_array { hexagonal pitch 0.1 focal_length 0.4 distance 0.4 }
+  sensor { pixel_size 0.01 }
+}
+plane { -z, 0 pigment { rgb <%r, %r, %r> } finish { emission 1 diffuse 0 ambient 0 } }
+""" % C
+
+# name, output file, povray options, bits (0 = float), transfer curve of the stored values,
+# and the OpenImageIO attributes and PNG chunks expected.
+CASES = [
+    ("linear16", "png", ["+FN16", "File_Gamma=1.0"], 16, "linear"),
+    ("srgb16", "png", ["+FN16"], 16, "srgb"),
+    ("srgb8", "png", ["+FN8"], 8, "srgb"),
+    ("linear8", "png", ["+FN8", "File_Gamma=1.0"], 8, "linear"),
+    ("gamma22_16", "png", ["+FN16", "File_Gamma=2.2"], 16, 2.2),
+    ("exr", "exr", ["+FE"], 0, "linear"),
+]
+
+
+# The transfer curves, written out again (IEC 61966-2-1 for sRGB).
+def encode(linear, curve):
+    x = np.asarray(linear, dtype=np.float64)
+    if curve == "linear":
+        return x
+    if curve == "srgb":
+        return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
+    return np.power(x, 1.0 / curve)
+
+
+def decode_curve(stored, curve):
+    y = np.asarray(stored, dtype=np.float64)
+    if curve == "linear":
+        return y
+    if curve == "srgb":
+        return np.where(y <= 0.04045, y / 12.92, np.power((y + 0.055) / 1.055, 2.4))
+    return np.power(np.clip(y, 0, None), curve)
+
+
+def quantisation_bound(value, bits, curve):
+    """Largest linear error of storing `value` (per channel): half a step of a `bits`-bit integer
+    through the curve, or half an ulp of a half float (relative 2**-11) for bits == 0."""
+    value = np.asarray(value, dtype=np.float64)
+    if bits == 0:
+        return value * 2.0 ** -11 + 1e-7
+    half_step = 0.5 / (2 ** bits - 1)
+    e = encode(value, curve)
+    return np.maximum(np.abs(decode_curve(e + half_step, curve) - value),
+                      np.abs(decode_curve(np.clip(e - half_step, 0, None), curve) - value)) * 1.02 + 1e-7
+
+
+def png_chunks(path):
+    """{chunk type: [payloads]} of a PNG file, read byte by byte."""
+    data = open(path, "rb").read()
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        raise SystemExit("FAIL: %s is not a PNG file" % path)
+    chunks, i = {}, 8
+    while i + 8 <= len(data):
+        length, kind = struct.unpack(">I4s", data[i:i + 8])
+        chunks.setdefault(kind.decode("latin-1"), []).append(data[i + 8:i + 8 + length])
+        i += 12 + length
+    return chunks
+
+
+def oiio_attributes(path):
+    import OpenImageIO as oiio
+    spec = oiio.ImageBuf(path).spec()
+    return spec.get_string_attribute("oiio:ColorSpace", ""), spec.get_float_attribute("oiio:Gamma", 0.0)
+
+
+def render(args, name, ext, options):
+    for stale in (name + "." + ext, name + ".plenoptic.json"):
+        if os.path.exists(os.path.join(args.work, stale)):
+            os.remove(os.path.join(args.work, stale))
+    with open(os.path.join(args.work, "encoding.pov"), "w") as f:
+        f.write(gt.SCENE_HEADER + SCENE)
+    cmd = [args.povray, "+Iencoding.pov", "+O%s.%s" % (name, ext), "+W%d" % W, "+H%d" % H, "-D", "-P"] + options
+    run = subprocess.run(cmd, cwd=args.work, capture_output=True, text=True)
+    if run.returncode != 0:
+        sys.stderr.write(run.stderr[-3000:])
+        raise SystemExit("FAIL: rendering %s exited with status %d" % (name, run.returncode))
+    return os.path.join(args.work, name + "." + ext)
+
+
+def decode(args, image, out, extra=()):
+    """Runs plenoptic-decode; (exit status, stderr, centre view (T, S, 3) or None)."""
+    shutil.rmtree(out, ignore_errors=True)
+    run = subprocess.run([sys.executable, os.path.join(args.tools, "plenoptic-decode"), image, "-o", out,
+                          "--no-gif"] + list(extra), capture_output=True, text=True)
+    npy = os.path.join(out, "lightfield.npy")
+    if run.returncode != 0 or not os.path.exists(npy):
+        return run.returncode, run.stderr, None
+    data = np.load(npy)
+    description = json.load(open(os.path.join(out, "lightfield.json")))
+    n_v, n_u = data.shape[2:4]
+    if not description["usable_mask"][n_v // 2][n_u // 2]:
+        raise SystemExit("FAIL: the centre angular sample of %s is not usable" % image)
+    return run.returncode, run.stderr, data[:, :, n_v // 2, n_u // 2, :].astype(np.float64)
+
+
+def main():
+    args = gt.parse_args(__doc__)
+    checks = gt.Checks("ground_truth_decode_encoding")
+    expected = np.array(C)
+
+    # What povray writes and OpenImageIO reports.
+    files = {}
+    for name, ext, options, bits, curve in CASES:
+        files[name] = render(args, name, ext, options)
+    chunks = {name: png_chunks(files[name]) for name, ext, _, _, _ in CASES if ext == "png"}
+
+    def gama(name):
+        return [struct.unpack(">I", c)[0] for c in chunks[name].get("gAMA", [])]
+
+    for name in ("linear16", "linear8"):
+        checks.check(gama(name) == [100000] and "sRGB" not in chunks[name] and "iCCP" not in chunks[name],
+                     "%s (File_Gamma=1.0): gAMA %s, sRGB chunk %s, iCCP %s (want gAMA 100000 alone)"
+                     % (name, gama(name), "sRGB" in chunks[name], "iCCP" in chunks[name]))
+    for name in ("srgb16", "srgb8"):
+        checks.check("sRGB" in chunks[name] and gama(name) == [45455],
+                     "%s (default File_Gamma, sRGB): sRGB chunk %s, gAMA %s (want an sRGB chunk and gAMA 45455)"
+                     % (name, "sRGB" in chunks[name], gama(name)))
+    checks.check(gama("gamma22_16") == [45455] and "sRGB" not in chunks["gamma22_16"],
+                 "gamma22_16 (File_Gamma=2.2): gAMA %s, sRGB chunk %s (want gAMA 45455 alone)"
+                 % (gama("gamma22_16"), "sRGB" in chunks["gamma22_16"]))
+    for name, ext, options, bits, curve in CASES:
+        print("      %-11s %s %-28s OpenImageIO: oiio:ColorSpace %r, oiio:Gamma %g"
+              % (name, ext, " ".join(options), *oiio_attributes(files[name])))
+
+    # Decode each with the default encoding: the centre view is C everywhere.
+    centres = {}
+    for name, ext, options, bits, curve in CASES:
+        status, stderr, centre = decode(args, files[name], os.path.join(args.work, "encoding_%s.lightfield" % name))
+        if not checks.check(status == 0 and centre is not None, "%s: plenoptic-decode exits 0 (got %d%s)"
+                            % (name, status, "; stderr %r" % stderr[-400:] if status else "")):
+            continue
+        want_word = "encoding %s" % (curve if isinstance(curve, str) else "gamma %g" % curve)
+        checks.check(want_word in stderr, "%s: the decoder says which encoding it applied: %r in %r"
+                     % (name, want_word, [l for l in stderr.splitlines() if "encoding" in l]))
+        bound = quantisation_bound(expected, bits, curve)
+        error = np.abs(centre - expected).reshape(-1, 3).max(axis=0)
+        checks.check(np.all(error <= bound),
+                     "%s (%s, %s %s): centre view of %d lenses = C within the quantisation bound: mean %s, "
+                     "worst error %s <= %s" % (name, ext, "%d-bit" % bits if bits else "half float", curve,
+                                              centre.shape[0] * centre.shape[1],
+                                              np.round(centre.reshape(-1, 3).mean(axis=0), 6), error, bound))
+        centres[name] = (centre, bound)
+    names = sorted(centres)
+    worst = []
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            if centres[a][0].shape != centres[b][0].shape:
+                worst.append((a, b, "shapes differ"))
+                continue
+            difference = np.abs(centres[a][0] - centres[b][0]).reshape(-1, 3).max(axis=0)
+            if np.any(difference > centres[a][1] + centres[b][1]):
+                worst.append((a, b, difference))
+    checks.check(len(names) == len(CASES) and not worst,
+                 "the %d central views agree pairwise within the sum of their quantisation bounds%s"
+                 % (len(names), "; not: %s" % worst if worst else ""))
+
+    # --encoding overrides the file.
+    for name, option, want, bits, curve in (
+            ("linear16", "srgb", decode_curve(expected, "srgb"), 16, "linear"),
+            ("srgb16", "linear", encode(expected, "srgb"), 16, "srgb")):
+        status, stderr, centre = decode(args, files[name], os.path.join(args.work, "encoding_%s_as_%s.lightfield"
+                                                                        % (name, option)), ["--encoding", option])
+        if not checks.check(status == 0 and centre is not None, "%s --encoding %s: exit 0 (got %d%s)"
+                            % (name, option, status, "; stderr %r" % stderr[-400:] if status else "")):
+            continue
+        # The stored value's error, carried through the override's curve instead of the file's.
+        bound = np.abs(decode_curve(encode(expected, curve) + 0.5 / 65535, option) - want) * 1.05 + 1e-6
+        error = np.abs(centre - want).reshape(-1, 3).max(axis=0)
+        checks.check(np.all(error <= bound),
+                     "%s --encoding %s overrides the file: centre %s, want %s (worst error %s <= %s)"
+                     % (name, option, np.round(centre.reshape(-1, 3).mean(axis=0), 6), np.round(want, 6), error,
+                        bound))
+        checks.check("encoding %s (--encoding)" % option in stderr, "%s --encoding %s: the decoder says so: %r"
+                     % (name, option, [l for l in stderr.splitlines() if "encoding" in l]))
+    checks.finish()
+
+
+if __name__ == "__main__":
+    main()
