@@ -200,6 +200,34 @@ class Metadata:
         return b * F / (b - F) / self.mm_per_unit
 
 
+def _unique_keys(pairs):
+    """object_pairs_hook: a key twice in one object is refused, as plenoptic-project refuses it
+    (Python's json would keep the last value silently; docs/metadata.md, "Reading it")."""
+    obj = {}
+    for key, value in pairs:
+        if key in obj:
+            raise MetadataError("not valid JSON: duplicate key %r in one object (a key may appear only once)" % key)
+        obj[key] = value
+    return obj
+
+
+def _refuse_lone_surrogates(value):
+    """Python's json decodes "\ud800" into a string that is not Unicode text: refused."""
+    if isinstance(value, str):
+        try:
+            value.encode("utf-8")
+        except UnicodeEncodeError:
+            raise MetadataError("not valid JSON: a string holds a lone surrogate escape (\\ud800-\\udfff), "
+                                "which encodes no character")
+    elif isinstance(value, dict):
+        for k, v in value.items():
+            _refuse_lone_surrogates(k)
+            _refuse_lone_surrogates(v)
+    elif isinstance(value, list):
+        for v in value:
+            _refuse_lone_surrogates(v)
+
+
 def load_metadata(path, image_size=None):
     """Reads and checks a metadata file; image_size (width, height) is compared with it.
     Raises MetadataError with one sentence naming the file's problem."""
@@ -209,11 +237,12 @@ def load_metadata(path, image_size=None):
     except OSError as e:
         raise MetadataError("cannot read the metadata file: %s" % (e.strerror or e))
     try:
-        raw = json.loads(text.decode("utf-8"))
+        raw = json.loads(text.decode("utf-8"), object_pairs_hook=_unique_keys)
     except UnicodeDecodeError as e:
         raise MetadataError("not valid JSON: not UTF-8 text (%s)" % e.reason)
     except ValueError as e:
         raise MetadataError("not valid JSON: %s" % e)
+    _refuse_lone_surrogates(raw)
     meta = Metadata(raw, path)
     if image_size is not None and (meta.width, meta.height) != tuple(image_size):
         raise MetadataError("fields 'image.width' x 'image.height' are %d x %d but the raw image is %d x %d: "

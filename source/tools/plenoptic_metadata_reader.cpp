@@ -1,32 +1,73 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Metadata JSON -> CameraParams -> Model, with a message naming the field for every refusal.
+// Metadata JSON (parsed by nlohmann-json) -> CameraParams -> Model, with a message naming the
+// field for every refusal.
 
 #include "plenoptic_metadata_reader.h"
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 namespace plenoptic {
 
 namespace {
 
-// Thrown inside this file only; read_* turn it into `error`.
+using Json = nlohmann::json;
+
+// Thrown inside this file only; parse_metadata turns it into `error`.
 struct FieldError : std::runtime_error {
     explicit FieldError(const std::string& message) : std::runtime_error(message) {}
 };
 
-std::string describe(const json::Value& v)
+// Printable ASCII as is; any other byte as \xNN, so that a message is one line of valid text
+// whatever the file held.
+std::string printable(const std::string& text)
 {
-    if (v.type == json::Type::Number)
-        return "the number " + format_number(v.number);
-    if (v.type == json::Type::String)
-        return "the string \"" + v.string + "\"";
-    return json::type_name(v.type);
+    std::string out;
+    for (unsigned char c : text) {
+        if (c >= 0x20 && c < 0x7f) {
+            out += char(c);
+        } else {
+            char buffer[8];
+            std::snprintf(buffer, sizeof buffer, "\\x%02x", c);
+            out += buffer;
+        }
+    }
+    return out;
 }
 
-[[noreturn]] void refuse(const std::string& path, const std::string& must, const json::Value& found)
+const char* type_name(const Json& v)
+{
+    switch (v.type()) {
+    case Json::value_t::null: return "null";
+    case Json::value_t::boolean: return "a boolean";
+    case Json::value_t::number_integer:
+    case Json::value_t::number_unsigned:
+    case Json::value_t::number_float: return "a number";
+    case Json::value_t::string: return "a string";
+    case Json::value_t::array: return "an array";
+    case Json::value_t::object: return "an object";
+    default: return "a value of another kind";
+    }
+}
+
+std::string describe(const Json& v)
+{
+    if (v.is_number())
+        return "the number " + format_number(v.get<double>());
+    if (v.is_string())
+        return "the string " + printable(v.dump());  // quoted and escaped
+    return type_name(v);
+}
+
+[[noreturn]] void refuse(const std::string& path, const std::string& must, const Json& found)
 {
     throw FieldError("field '" + path + "' must be " + must + ", found " + describe(found));
 }
@@ -36,67 +77,68 @@ std::string join(const std::string& parent, const std::string& key)
     return parent.empty() ? key : parent + "." + key;
 }
 
-const json::Value& member(const json::Value& object, const std::string& parent, const std::string& key)
+const Json& member(const Json& object, const std::string& parent, const std::string& key)
 {
-    const json::Value* v = object.member(key);
-    if (v == nullptr)
+    const auto it = object.find(key);
+    if (it == object.end())
         throw FieldError("field '" + join(parent, key) + "' is missing");
-    return *v;
+    return *it;
 }
 
-const json::Value& object_member(const json::Value& object, const std::string& parent, const std::string& key)
+const Json& object_member(const Json& object, const std::string& parent, const std::string& key)
 {
-    const json::Value& v = member(object, parent, key);
-    if (v.type != json::Type::Object)
+    const Json& v = member(object, parent, key);
+    if (!v.is_object())
         refuse(join(parent, key), "an object", v);
     return v;
 }
 
-double finite_number(const json::Value& v, const std::string& path)
+double finite_number(const Json& v, const std::string& path)
 {
-    if (v.type != json::Type::Number || !std::isfinite(v.number))
+    if (!v.is_number() || !std::isfinite(v.get<double>()))
         refuse(path, "a finite number", v);
-    return v.number;
+    return v.get<double>();
 }
 
-double positive_number(const json::Value& v, const std::string& path)
+double positive_number(const Json& v, const std::string& path)
 {
-    if (v.type != json::Type::Number || !std::isfinite(v.number) || !(v.number > 0))
+    if (!v.is_number() || !std::isfinite(v.get<double>()) || !(v.get<double>() > 0))
         refuse(path, "a positive number", v);
-    return v.number;
+    return v.get<double>();
 }
 
-std::string string_member(const json::Value& object, const std::string& parent, const std::string& key)
+std::string string_member(const Json& object, const std::string& parent, const std::string& key)
 {
-    const json::Value& v = member(object, parent, key);
-    if (v.type != json::Type::String)
+    const Json& v = member(object, parent, key);
+    if (!v.is_string())
         refuse(join(parent, key), "a string", v);
-    return v.string;
+    return v.get<std::string>();
 }
 
 // A fixed-length array of finite numbers (positive ones when `positive`).
-void numbers(const json::Value& object, const std::string& parent, const std::string& key, int count,
-             bool positive, double* out)
+void numbers(const Json& object, const std::string& parent, const std::string& key, int count, bool positive,
+             double* out)
 {
     const std::string path = join(parent, key);
-    const json::Value& v = member(object, parent, key);
+    const Json& v = member(object, parent, key);
     const std::string must = "an array of " + std::to_string(count) + (positive ? " positive numbers" : " finite numbers");
-    if (v.type != json::Type::Array || v.items.size() != size_t(count))
+    if (!v.is_array() || v.size() != size_t(count))
         refuse(path, must, v);
     for (int i = 0; i < count; ++i) {
-        const json::Value& item = v.items[i];
-        if (item.type != json::Type::Number || !std::isfinite(item.number) || (positive && !(item.number > 0)))
+        const Json& item = v[size_t(i)];
+        if (!item.is_number() || !std::isfinite(item.get<double>()) || (positive && !(item.get<double>() > 0)))
             refuse(path + "[" + std::to_string(i) + "]", positive ? "a positive number" : "a finite number", item);
-        out[i] = item.number;
+        out[i] = item.get<double>();
     }
 }
 
-int positive_integer(const json::Value& object, const std::string& parent, const std::string& key)
+// A whole number written without fraction or exponent ("640", not "640.0" or "6.4e2").
+int positive_integer(const Json& object, const std::string& parent, const std::string& key)
 {
-    const json::Value& v = member(object, parent, key);
-    if (v.type != json::Type::Number || !v.integral || !(v.number >= 1) || !(v.number <= 1e9))
+    const Json& v = member(object, parent, key);
+    if (!v.is_number_integer() || !(v.get<double>() >= 1) || !(v.get<double>() <= 1e9))
         refuse(join(parent, key), "a positive whole number", v);
-    return int(v.number);
+    return int(v.get<double>());
 }
 
 void check_close(const std::string& path, double stored, double derived, double scale, const std::string& from)
@@ -106,10 +148,100 @@ void check_close(const std::string& path, double stored, double derived, double 
                          format_number(derived) + ": the metadata file is inconsistent (edited?)");
 }
 
-void read_main_lens(const json::Value& root, CameraParams* params)
+// Duplicate keys: RFC 8259 leaves their meaning open (Python's json takes the last, others the
+// first), so a file with one is refused rather than read one way or the other. The parser's
+// callback sees every key; one set of keys per open object.
+class DuplicateKeyCheck {
+public:
+    bool operator()(int /*depth*/, Json::parse_event_t event, Json& parsed)
+    {
+        switch (event) {
+        case Json::parse_event_t::object_start:
+        case Json::parse_event_t::array_start:
+            open(event == Json::parse_event_t::object_start);
+            break;
+        case Json::parse_event_t::object_end:
+        case Json::parse_event_t::array_end:
+            if (!frames_.empty())
+                frames_.pop_back();
+            break;
+        case Json::parse_event_t::key: {
+            Frame& frame = frames_.back();
+            const std::string key = parsed.get<std::string>();
+            if (!frame.keys.insert(key).second) {
+                const std::string where = path();
+                throw FieldError("duplicate key '" + printable(key) + "' in " +
+                                 (where.empty() ? std::string("the top-level object") : "the object '" + where + "'") +
+                                 ": a key may appear only once in an object");
+            }
+            frame.last_key = key;
+            break;
+        }
+        default:
+            break;
+        }
+        return true;  // keep everything
+    }
+
+private:
+    struct Frame {
+        bool object;
+        bool in_array = false; // an element of an array (else `name` is its key in the parent)
+        std::string name;
+        std::string last_key;  // objects: the key being read
+        std::set<std::string> keys;
+    };
+
+    void open(bool object)
+    {
+        Frame frame;
+        frame.object = object;
+        if (!frames_.empty()) {
+            frame.in_array = !frames_.back().object;
+            frame.name = frames_.back().last_key;
+        }
+        frames_.push_back(std::move(frame));
+    }
+
+    // "microlens_array", "a.b[]", ... of the innermost open object (built only for a message).
+    std::string path() const
+    {
+        std::string out;
+        for (size_t i = 1; i < frames_.size(); ++i) {
+            if (frames_[i].in_array) {
+                out += "[]";
+                continue;
+            }
+            if (!out.empty())
+                out += '.';
+            out += printable(frames_[i].name);
+        }
+        return out;
+    }
+
+    std::vector<Frame> frames_;
+};
+
+// nlohmann's message without its "[json.exception.parse_error.101] parse error at " prefix:
+// "line 3, column 7: syntax error while parsing value - invalid string: ...".
+std::string parse_message(const std::string& what)
+{
+    std::string message = what;
+    if (message.compare(0, 1, "[") == 0) {
+        const size_t close = message.find("] ");
+        if (close != std::string::npos)
+            message.erase(0, close + 2);
+    }
+    const std::string prefix = "parse error at ";
+    if (message.compare(0, prefix.size(), prefix) == 0)
+        message.erase(0, prefix.size());
+    return printable(message);
+}
+
+void read_main_lens(const Json& root, CameraParams* params)
 {
     const std::string parent = "main_lens";
-    const json::Value& main = object_member(root, "", parent);
+    const Json& main = object_member(root, "", parent);
     const std::string type = string_member(main, parent, "type");
     MainLensParams& m = params->main;
     if (type == "none")
@@ -123,7 +255,7 @@ void read_main_lens(const json::Value& root, CameraParams* params)
         m.focal_length_mm = positive_number(member(main, parent, "focal_length_mm"), parent + ".focal_length_mm");
         m.has_aperture = true;
         m.aperture_mm = positive_number(member(main, parent, "aperture_mm"), parent + ".aperture_mm");
-        const json::Value& n = member(main, parent, "f_number");
+        const Json& n = member(main, parent, "f_number");
         const double f_number = positive_number(n, parent + ".f_number");
         check_close(parent + ".f_number", f_number, m.focal_length_mm / m.aperture_mm, f_number,
                     "focal_length_mm / aperture_mm");
@@ -135,13 +267,13 @@ void read_main_lens(const json::Value& root, CameraParams* params)
     m.distance_mm = positive_number(member(main, parent, "distance_mm"), parent + ".distance_mm");
 }
 
-void read_array(const json::Value& root, CameraParams* params)
+void read_array(const Json& root, CameraParams* params)
 {
     const std::string parent = "microlens_array";
-    const json::Value& v = member(root, "", parent);
-    if (v.type == json::Type::Null)
+    const Json& v = member(root, "", parent);
+    if (v.is_null())
         return;
-    if (v.type != json::Type::Object)
+    if (!v.is_object())
         refuse(parent, "an object or null", v);
     ArrayParams& a = params->array;
     a.given = true;
@@ -153,18 +285,18 @@ void read_array(const json::Value& root, CameraParams* params)
     else
         refuse(parent + ".grid", "\"hexagonal\" or \"rectangular\"", member(v, parent, "grid"));
     const std::string lens = string_member(v, parent, "lens");
-    const json::Value& focal = member(v, parent, "focal_lengths_mm");
-    if (focal.type != json::Type::Array)
+    const Json& focal = member(v, parent, "focal_lengths_mm");
+    if (!focal.is_array())
         refuse(parent + ".focal_lengths_mm", "an array", focal);
     a.has_lens = true;
     if (lens == "pinhole") {
         a.lens = MicrolensType::Pinhole;
-        if (!focal.items.empty())
+        if (!focal.empty())
             refuse(parent + ".focal_lengths_mm", "empty for pinhole microlenses", focal);
         a.focal_length_count = 0;
     } else if (lens == "thin_lens") {
         a.lens = MicrolensType::ThinLens;
-        const size_t count = focal.items.size();
+        const size_t count = focal.size();
         if (count != 1 && (count != 3 || a.grid != GridType::Hexagonal))
             refuse(parent + ".focal_lengths_mm",
                    a.grid == GridType::Hexagonal ? "an array of 1 or 3 positive numbers" : "an array of 1 positive number",
@@ -172,7 +304,7 @@ void read_array(const json::Value& root, CameraParams* params)
         a.focal_length_count = int(count);
         for (size_t i = 0; i < count; ++i)
             a.focal_lengths_mm[i] =
-                positive_number(focal.items[i], parent + ".focal_lengths_mm[" + std::to_string(i) + "]");
+                positive_number(focal[i], parent + ".focal_lengths_mm[" + std::to_string(i) + "]");
     } else {
         refuse(parent + ".lens", "\"thin_lens\" or \"pinhole\"", member(v, parent, "lens"));
     }
@@ -184,10 +316,10 @@ void read_array(const json::Value& root, CameraParams* params)
     numbers(v, parent, "translate_mm", 3, false, a.translate_mm);
 }
 
-void read_frame(const json::Value& root, CameraFrame* frame)
+void read_frame(const Json& root, CameraFrame* frame)
 {
     const std::string parent = "camera_frame";
-    const json::Value& f = object_member(root, "", parent);
+    const Json& f = object_member(root, "", parent);
     numbers(f, parent, "location", 3, false, frame->location);
     numbers(f, parent, "right", 3, false, frame->right);
     numbers(f, parent, "up", 3, false, frame->up);
@@ -201,18 +333,18 @@ void read_frame(const json::Value& root, CameraFrame* frame)
                          "(they must span 3-D space)");
 }
 
-void read_all(const json::Value& root, RenderMetadata* out)
+void read_all(const Json& root, RenderMetadata* out)
 {
-    if (root.type != json::Type::Object)
+    if (!root.is_object())
         refuse("(top level)", "an object", root);
-    const json::Value& format = member(root, "", "format");
-    if (format.type != json::Type::String || format.string != "povray-plenoptic-metadata")
+    const Json& format = member(root, "", "format");
+    if (!format.is_string() || format.get<std::string>() != "povray-plenoptic-metadata")
         refuse("format", "\"povray-plenoptic-metadata\"", format);
-    const json::Value& version = member(root, "", "version");
-    if (version.type != json::Type::Number || version.number != 1)
+    const Json& version = member(root, "", "version");
+    if (!version.is_number() || version.get<double>() != 1)
         refuse("version", "1 (the only version this tool reads)", version);
 
-    const json::Value& image = object_member(root, "", "image");
+    const Json& image = object_member(root, "", "image");
     out->width = positive_integer(image, "image", "width");
     out->height = positive_integer(image, "image", "height");
 
@@ -223,15 +355,15 @@ void read_all(const json::Value& root, RenderMetadata* out)
     read_main_lens(root, &p);
     read_array(root, &p);
 
-    const json::Value& sensor = object_member(root, "", "sensor");
+    const Json& sensor = object_member(root, "", "sensor");
     numbers(sensor, "sensor", "pixel_size_mm", 2, true, p.sensor.pixel_size_mm);
     numbers(sensor, "sensor", "offset_mm", 2, false, p.sensor.offset_mm);
     const double plane_z = finite_number(member(sensor, "sensor", "plane_z_mm"), "sensor.plane_z_mm");
 
-    const json::Value& depth = member(root, "", "depth_map");
-    if (depth.type == json::Type::String)
-        out->depth_map = depth.string;
-    else if (depth.type != json::Type::Null)
+    const Json& depth = member(root, "", "depth_map");
+    if (depth.is_string())
+        out->depth_map = depth.get<std::string>();
+    else if (!depth.is_null())
         refuse("depth_map", "a file name or null", depth);
 
     // Sampling does not change where points image; any legal value will do.
@@ -251,12 +383,15 @@ void read_all(const json::Value& root, RenderMetadata* out)
     const Vec2 pp = principal_point_px(m, out->width, out->height);
     check_close("principal_point_px[0]", principal[0], pp.x, out->width + 1.0, "image.width and sensor.offset_mm");
     check_close("principal_point_px[1]", principal[1], pp.y, out->height + 1.0, "image.height and sensor.offset_mm");
-    const json::Value& lattice = member(root, "", "microimage_lattice");
+    const Json& lattice = member(root, "", "microimage_lattice");
     if (m.grid == GridType::None) {
-        if (lattice.type != json::Type::Null)
+        if (!lattice.is_null())
             refuse("microimage_lattice", "null when microlens_array is null", lattice);
     } else {
-        if (lattice.type != json::Type::Object)
+        // null only where the writer writes null: a lattice whose numbers overflow (absurd poses).
+        if (lattice.is_null() && !microimage_lattice(m, out->width, out->height).valid)
+            return;
+        if (!lattice.is_object())
             refuse("microimage_lattice", "an object (the file has a microlens array)", lattice);
         double origin[2];
         numbers(lattice, "microimage_lattice", "origin_px", 2, false, origin);
@@ -271,14 +406,28 @@ void read_all(const json::Value& root, RenderMetadata* out)
 
 } // namespace
 
-bool metadata_from_json(const json::Value& root, RenderMetadata* out, std::string* error)
+bool parse_metadata(const std::string& text, RenderMetadata* out, std::string* error)
 {
+    *out = RenderMetadata();
+    Json root;
     try {
-        *out = RenderMetadata();
+        // Strict JSON: no comments; invalid UTF-8 and lone surrogates are parse errors.
+        root = Json::parse(text, DuplicateKeyCheck());
+    } catch (const FieldError& e) {
+        *error = e.what();
+        return false;
+    } catch (const Json::exception& e) {
+        *error = "not valid JSON (" + parse_message(e.what()) + ")";
+        return false;
+    }
+    try {
         read_all(root, out);
         return true;
     } catch (const FieldError& e) {
         *error = e.what();
+        return false;
+    } catch (const Json::exception& e) {  // not expected: every access above checks its type
+        *error = "unexpected value (" + parse_message(e.what()) + ")";
         return false;
     }
 }
@@ -296,13 +445,7 @@ bool read_metadata_file(const std::string& path, RenderMetadata* out, std::strin
         *error = "cannot read the metadata file";
         return false;
     }
-    json::Value root;
-    std::string parse_error;
-    if (!json::parse(text.str(), &root, &parse_error)) {
-        *error = "not valid JSON (" + parse_error + ")";
-        return false;
-    }
-    return metadata_from_json(root, out, error);
+    return parse_metadata(text.str(), out, error);
 }
 
 bool world_to_optics_mm(const RenderMetadata& md, const double world[3], double optics_mm[3])

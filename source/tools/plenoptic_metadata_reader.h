@@ -8,7 +8,6 @@
 #include <string>
 #include <vector>
 
-#include "plenoptic_json.h"
 #include "plenoptic_metadata.h"
 #include "plenoptic_model.h"
 #include "plenoptic_optics.h"
@@ -25,14 +24,17 @@ struct RenderMetadata {
     std::string depth_map;// file name of the depth EXR, empty when none
 };
 
-// Rebuilds the camera from parsed metadata. On failure returns false and sets `error` to one
-// sentence naming the offending field, e.g. "field 'main_lens.focal_length_mm' must be a
-// positive number, found null". Also checks that the stored derived values (sensor plane,
-// principal point, lattice origin) agree with the parameters, to catch edited files.
-bool metadata_from_json(const json::Value& root, RenderMetadata* out, std::string* error);
+// Rebuilds the camera from the text of a metadata file. The text must be strict JSON (RFC 8259,
+// parsed by nlohmann-json) in UTF-8: invalid UTF-8, an escaped lone surrogate (\ud800) and a key
+// that appears twice in one object are refused. On failure returns false and sets `error` to
+// one sentence with the cause first: "not valid JSON (line 3, column 7: ...)", "duplicate key
+// 'mm_per_unit' ...", or naming the offending field, e.g. "field 'main_lens.focal_length_mm'
+// must be a positive number, found null". Also checks that the stored derived values (sensor
+// plane, principal point, lattice origin) agree with the parameters, to catch edited files.
+bool parse_metadata(const std::string& text, RenderMetadata* out, std::string* error);
 
-// Reads and parses the file, then metadata_from_json. Errors start with the cause
-// ("cannot open", "not valid JSON (line 3, column 7: ...)", "field ...").
+// Reads the file, then parse_metadata. Errors start with the cause ("cannot open", "not valid
+// JSON (...)", "field ..."); the caller names the file.
 bool read_metadata_file(const std::string& path, RenderMetadata* out, std::string* error);
 
 // World point (scene units) -> optics frame (mm): solves location + (x right + y up + z direction)

@@ -99,6 +99,13 @@ def main():
         ("missing file", os.path.join(bad_dir, "absent.plenoptic.json"), ["cannot read"], True),
         ("truncated", broken("truncated", text=text[:len(text) // 2]), ["not valid JSON"], True),
         ("not JSON at all", broken("binary", text=b"\x89PNG\r\n\x1a\n\x00\x00garbage"), ["not valid JSON"], True),
+        # Both readers are strict where Python's json is lax (docs/metadata.md, "Reading it").
+        ("duplicate key", broken("dupkey", text=text.replace('"mm_per_unit":', '"mm_per_unit": 10, "mm_per_unit":', 1)),
+         ["duplicate key 'mm_per_unit'"], True),
+        ("lone surrogate", broken("surrogate", text=text.replace('"format":', '"depth": "\\ud800", "format":', 1)),
+         ["surrogate"], True),
+        ("Latin-1 byte", broken("latin1", text=text.encode("utf-8").replace(b'"format":', b'"depth": "caf\xe9", "format":', 1)),
+         ["UTF-8"], True),
         ("a JSON array", broken("array", text="[1, 2, 3]"), ["object"], True),
         ("wrong format", broken("format", setter("format", "something-else")), ["format"], True),
         ("wrong version", broken("version", setter("version", 7)), ["version"], True),
