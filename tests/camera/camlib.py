@@ -71,9 +71,14 @@ def load(path):
 
 
 def metadata(image_path):
+    """The render's metadata, read strictly and checked against docs/metadata.schema.json
+    (tests/metadata/metadata_schema.py); a MetadataError (ValueError) when it does not match."""
+    shared = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "metadata")
+    if shared not in sys.path:
+        sys.path.insert(0, shared)
+    import metadata_schema
     stem = os.path.splitext(image_path)[0]
-    with open(stem + ".plenoptic.json") as f:
-        return json.load(f)
+    return metadata_schema.load(stem + ".plenoptic.json")
 
 
 def save_png(path, array):

@@ -30,6 +30,9 @@ REF_DIR = os.path.join(HERE, "references")
 TABLE = os.path.join(HERE, "scenes.json")
 UPDATE_VARIABLE = "PLENOPTIC_UPDATE_GOLDEN"
 
+sys.path.insert(0, os.path.join(HERE, "..", "metadata"))
+import metadata_schema  # noqa: E402  (tests/metadata: the strict reader and the schema check)
+
 
 def load_table(path=TABLE):
     with open(path) as f:
@@ -207,10 +210,13 @@ def run(povray, name, work, update):
         os.remove(diff_png)
 
     if expect_meta:
-        with open(ref_meta) as f:
-            r = json.load(f)
-        with open(meta) as f:
-            m = json.load(f)
+        # Both read strictly and checked against docs/metadata.schema.json.
+        try:
+            r = metadata_schema.load(ref_meta)
+            m = metadata_schema.load(meta)
+        except metadata_schema.MetadataError as e:
+            print("FAIL %s: %s" % (name, e))
+            return 1
         mt = s["metadata"]
         diffs = compare_json(r, m, mt["rel"], mt["abs"])
         print("metadata: %d field difference(s) beyond abs %g + rel %g" % (len(diffs), mt["abs"], mt["rel"]))

@@ -71,6 +71,17 @@ def read_linear(png):
 
 
 def read_json(path):
+    """A JSON file; a render's metadata (*.plenoptic.json) is read strictly and checked against
+    docs/metadata.schema.json (tests/metadata/metadata_schema.py)."""
+    if path.endswith(".plenoptic.json"):
+        shared = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "metadata")
+        if shared not in sys.path:
+            sys.path.insert(0, shared)
+        import metadata_schema
+        try:
+            return metadata_schema.load(path)
+        except metadata_schema.MetadataError as e:
+            raise SystemExit("FAIL: %s" % e)
     with open(path) as f:
         return json.load(f)
 

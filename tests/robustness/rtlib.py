@@ -1,11 +1,11 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Shared helpers of the robustness tests: scenes around a camera block, running povray with a
 time limit, reading POV-Ray's parse errors, spotting crashes, reading OpenEXR floats."""
-import json
 import os
 import re
 import signal
 import subprocess
+import sys
 import time
 
 # The world every robustness scene shows; only the camera changes from case to case.
@@ -132,11 +132,14 @@ def read_image(path):
 
 
 def load_json_strict(path):
-    """The metadata JSON, refusing NaN and Infinity (which Python's json would otherwise accept)."""
-    def refuse(token):
-        raise ValueError("non-finite number %s in %s" % (token, path))
-    with open(path) as f:
-        return json.load(f, parse_constant=refuse)
+    """The metadata JSON, read strictly (no NaN or Infinity, which Python's json would otherwise
+    accept, no duplicate key, UTF-8 only) and checked against docs/metadata.schema.json
+    (tests/metadata/metadata_schema.py); a ValueError naming the file and the problem."""
+    shared = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "metadata")
+    if shared not in sys.path:
+        sys.path.insert(0, shared)
+    import metadata_schema
+    return metadata_schema.load(path)
 
 
 def tail(text, n=15):
