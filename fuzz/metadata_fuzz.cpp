@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// libFuzzer target over the metadata reader (source/tools/plenoptic_metadata_reader.cpp): the
+// input bytes are a whole <image>.plenoptic.json. Invariants (else abort()):
+//   - a refused file gives a non-empty message of one line of printable ASCII, whatever the bytes;
+//   - an accepted file describes a camera check_camera accepts, with a positive image size;
+//   - writing the camera read back (metadata_json) gives a file the reader accepts again, with
+//     the same camera bit for bit, and writing that one gives the very same text (the writer's
+//     numbers read back exactly);
+//   - forward projection of a few points gives finite pixel positions inside the image.
+//
+// Built with clang -fsanitize=fuzzer,address,undefined by fuzz/CMakeLists.txt and run by
+// fuzz/run-ci from the seeds in fuzz/corpus-metadata/ (real files, and broken ones: duplicate
+// keys, a lone surrogate, invalid UTF-8, truncations); replayed over those seeds with the ordinary
+// compiler by tests/robustness (fuzz/replay_main.cpp).
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "plenoptic_metadata.h"
+#include "plenoptic_metadata_reader.h"
+#include "plenoptic_optics.h"
+#include "plenoptic_params.h"
+
+namespace {
+
+using namespace plenoptic;
+
+const std::string* g_text = nullptr;
+
+#define FUZZ_ASSERT(cond, ...)                                                             \
+    do {                                                                                   \
+        if (!(cond)) {                                                                     \
+            std::fprintf(stderr, "plenoptic_metadata_fuzz: invariant failed: %s\n  ", #cond); \
+            std::fprintf(stderr, __VA_ARGS__);                                             \
+            std::fprintf(stderr, "\n");                                                    \
+            if (g_text)                                                                    \
+                std::fprintf(stderr, "input (%zu bytes):\n%.4000s\n", g_text->size(),      \
+                             g_text->c_str());                                             \
+            std::abort();                                                                  \
+        }                                                                                  \
+    } while (0)
+
+bool one_printable_line(const std::string& message)
+{
+    if (message.empty())
+        return false;
+    for (unsigned char c : message)
+        if (c < 0x20 || c >= 0x7f)
+            return false;
+    return true;
+}
+
+// Values the reader accepted are finite: equal, 0 and -0 alike.
+bool same_double(double a, double b) { return a == b; }
+
+// The camera values the reader fills, compared exactly (0 and -0 alike).
+void expect_same_camera(const RenderMetadata& a, const RenderMetadata& b)
+{
+    FUZZ_ASSERT(a.width == b.width && a.height == b.height, "image %dx%d read back as %dx%d", a.width, a.height,
+                b.width, b.height);
+    const Model& m = a.model;
+    const Model& n = b.model;
+    FUZZ_ASSERT(m.main_lens == n.main_lens && m.grid == n.grid && m.microlens == n.microlens &&
+                    m.lens_type_count == n.lens_type_count,
+                "kinds differ after a round trip");
+    FUZZ_ASSERT(same_double(m.mm_per_unit, n.mm_per_unit), "mm_per_unit %.17g -> %.17g", m.mm_per_unit, n.mm_per_unit);
+    FUZZ_ASSERT(same_double(m.distance_mm, n.distance_mm), "D %.17g -> %.17g", m.distance_mm, n.distance_mm);
+    FUZZ_ASSERT(same_double(m.sensor_z_mm, n.sensor_z_mm), "sensor z %.17g -> %.17g", m.sensor_z_mm, n.sensor_z_mm);
+    if (m.main_lens == MainLensType::ThinLens) {
+        FUZZ_ASSERT(same_double(m.focal_length_mm, n.focal_length_mm) && same_double(m.aperture_mm, n.aperture_mm),
+                    "main lens F %.17g A %.17g -> F %.17g A %.17g", m.focal_length_mm, m.aperture_mm,
+                    n.focal_length_mm, n.aperture_mm);
+    }
+    if (m.grid != GridType::None) {
+        FUZZ_ASSERT(same_double(m.pitch_mm, n.pitch_mm) && same_double(m.array_distance_mm, n.array_distance_mm),
+                    "pitch %.17g d %.17g -> pitch %.17g d %.17g", m.pitch_mm, m.array_distance_mm, n.pitch_mm,
+                    n.array_distance_mm);
+        for (int i = 0; i < 3; ++i)
+            FUZZ_ASSERT(same_double(a.params.array.rotate_deg[i], b.params.array.rotate_deg[i]) &&
+                            same_double(a.params.array.translate_mm[i], b.params.array.translate_mm[i]),
+                        "array pose [%d] differs after a round trip", i);
+    }
+    for (int i = 0; i < 2; ++i)
+        FUZZ_ASSERT(same_double(m.pixel_size_mm[i], n.pixel_size_mm[i]) &&
+                        same_double(m.sensor_offset_mm[i], n.sensor_offset_mm[i]),
+                    "sensor [%d] differs after a round trip", i);
+    for (int i = 0; i < 3; ++i)
+        FUZZ_ASSERT(same_double(a.frame.location[i], b.frame.location[i]) &&
+                        same_double(a.frame.right[i], b.frame.right[i]) && same_double(a.frame.up[i], b.frame.up[i]) &&
+                        same_double(a.frame.direction[i], b.frame.direction[i]),
+                    "camera frame [%d] differs after a round trip", i);
+    FUZZ_ASSERT(a.depth_map == b.depth_map, "depth_map '%s' -> '%s'", a.depth_map.c_str(), b.depth_map.c_str());
+}
+
+} // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
+{
+    const std::string text(reinterpret_cast<const char*>(data), size);
+    g_text = &text;
+    RenderMetadata metadata;
+    std::string error;
+    if (!parse_metadata(text, &metadata, &error)) {
+        FUZZ_ASSERT(one_printable_line(error), "refusal message not one printable line: '%s'", error.c_str());
+        g_text = nullptr;
+        return 0;
+    }
+    FUZZ_ASSERT(metadata.width >= 1 && metadata.height >= 1, "image %dx%d accepted", metadata.width, metadata.height);
+    const std::string problem = check_camera(metadata.params);
+    FUZZ_ASSERT(problem.empty(), "accepted a camera check_camera refuses: %s", problem.c_str());
+    const Model& m = metadata.model;
+    FUZZ_ASSERT(std::isfinite(m.sensor_z_mm) && m.sensor_z_mm < 0, "sensor plane z = %.17g", m.sensor_z_mm);
+
+    // Write what was read, read it again: the same camera, and the same text when written again.
+    const std::string written =
+        metadata_json(m, metadata.params, metadata.width, metadata.height, metadata.frame, metadata.depth_map);
+    RenderMetadata again;
+    std::string again_error;
+    FUZZ_ASSERT(parse_metadata(written, &again, &again_error), "the writer's own file is refused: %s\n%s",
+                again_error.c_str(), written.c_str());
+    expect_same_camera(metadata, again);
+    const std::string rewritten =
+        metadata_json(again.model, again.params, again.width, again.height, again.frame, again.depth_map);
+    FUZZ_ASSERT(rewritten == written, "writing the re-read camera changed the text:\n%s\n---\n%s", written.c_str(),
+                rewritten.c_str());
+
+    // Forward projection visits every lens that can image into the picture: only where that is a
+    // few thousand lenses, to keep the fuzzer fast.
+    const double span_mm = std::max(metadata.width * m.pixel_size_mm[0], metadata.height * m.pixel_size_mm[1]);
+    if (m.grid == GridType::None || span_mm <= 64 * m.pitch_mm) {
+        const double points[3][3] = {{0, 0, 1}, {0.1, -0.05, 2}, {-3, 2, 50}};
+        for (const auto& point : points) {
+            for (const PixelHit& hit : project_world_point(metadata, point)) {
+                FUZZ_ASSERT(std::isfinite(hit.u) && std::isfinite(hit.v), "projection hit (%g, %g)", hit.u, hit.v);
+                FUZZ_ASSERT(hit.u >= -0.5 && hit.u < metadata.width - 0.5 && hit.v >= -0.5 &&
+                                hit.v < metadata.height - 0.5,
+                            "projection hit (%.17g, %.17g) outside the %dx%d image", hit.u, hit.v, metadata.width,
+                            metadata.height);
+            }
+        }
+    }
+    g_text = nullptr;
+    return 0;
+}
