@@ -438,7 +438,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
                         "shade_pixel (%d, %d) = (%g, %g, %g, %g)", i, j, v.r, v.g, v.b, v.t);
         }
     }
-    // forward_project visits every lens that can image into the picture (bounded at 2^24 lenses);
+    // forward_project visits every lens that can image into the picture (bounded at 2^22 lenses);
     // skip sizes where that is millions of lenses, to keep the fuzzer fast.
     const double span_mm = std::max(W * m.pixel_size_mm[0], H * m.pixel_size_mm[1]);
     if (m.grid == GridType::None || span_mm <= 64 * m.pitch_mm) {
