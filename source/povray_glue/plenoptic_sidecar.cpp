@@ -3,12 +3,12 @@
 
 #include "povray_glue/plenoptic_sidecar.h"
 
+#include "povray_glue/plenoptic_render.h"
+
 #include <cerrno>
 #include <cmath>
-#include <atomic>
 #include <cstdio>
 #include <cstring>
-#include <mutex>
 #include <vector>
 
 #include <stdlib.h>
@@ -22,22 +22,6 @@
 namespace plenoptic {
 
 namespace {
-
-struct Registration {
-    std::shared_ptr<const CameraSetup> setup;
-    RenderState state;
-    int width = 0, height = 0;
-    std::vector<float> depth;
-};
-
-std::mutex registration_mutex;
-Registration registration;
-// The registration as every pixel reads it, without the lock.
-std::atomic<const CameraSetup*> registered_setup(nullptr);
-std::atomic<long long> registered_size(0);  // W * 2^32 + H
-std::atomic<const RenderState*> registered_state(nullptr);
-std::atomic<int> next_depth_row(0);
-std::atomic<int> depth_rows(0);
 
 std::string replace_extension(const std::string& path, const std::string& suffix)
 {
@@ -94,21 +78,29 @@ bool write_text_atomically(const std::string& path, const std::string& text)
     return true;
 }
 
-bool write_depth_exr(const std::string& path, const std::vector<float>& depth, int W, int H)
+// Writes the depth map row by row (memory: one row), -1 in rows never rendered.
+bool write_depth_exr(const std::string& path, const DepthMap& depth)
 {
     const std::string tmp = temporary_beside(path);
     if (tmp.empty()) {
         report_failure("depth map", path, errno);
         return false;
     }
+    const int W = depth.width(), H = depth.height();
     try {
         Imf::Header header(W, H);
         header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
         Imf::OutputFile file(tmp.c_str(), header);
-        Imf::FrameBuffer buffer;
-        buffer.insert("Z", Imf::Slice(Imf::FLOAT, (char*)depth.data(), sizeof(float), sizeof(float) * W));
-        file.setFrameBuffer(buffer);
-        file.writePixels(H);
+        const std::vector<float> unrendered(size_t(W), -1.0f);
+        for (int j = 0; j < H; ++j) {
+            const float* row = depth.row(j) != nullptr ? depth.row(j) : unrendered.data();
+            // The slice's base is where pixel (0, 0) would be, so that row j starts at `row`.
+            Imf::FrameBuffer buffer;
+            buffer.insert("Z", Imf::Slice(Imf::FLOAT, (char*)(row) - sizeof(float) * size_t(W) * j, sizeof(float),
+                                          sizeof(float) * W));
+            file.setFrameBuffer(buffer);
+            file.writePixels(1);
+        }
     } catch (const std::exception& e) {
         std::fprintf(stderr, "plenoptic camera: cannot write depth map %s: %s\n", path.c_str(), e.what());
         std::remove(tmp.c_str());
@@ -122,16 +114,6 @@ bool write_depth_exr(const std::string& path, const std::vector<float>& depth, i
     return true;
 }
 
-// Called with registration_mutex held.
-void forget_registration()
-{
-    registered_setup.store(nullptr);
-    registered_state.store(nullptr);
-    registered_size.store(0);
-    depth_rows.store(0);
-    registration = Registration();
-}
-
 std::string base_name(const std::string& path)
 {
     const size_t slash = path.find_last_of('/');
@@ -143,90 +125,35 @@ std::string base_name(const std::string& path)
 std::string metadata_path_for(const std::string& image_path) { return replace_extension(image_path, ".plenoptic.json"); }
 std::string depth_path_for(const std::string& image_path) { return replace_extension(image_path, ".depth.exr"); }
 
-namespace {
-
-bool is_orthonormal(const CameraFrame& frame)
-{
-    const double* axes[3] = {frame.right, frame.up, frame.direction};
-    for (int a = 0; a < 3; ++a)
-        for (int b = a; b < 3; ++b) {
-            const double dot = axes[a][0] * axes[b][0] + axes[a][1] * axes[b][1] + axes[a][2] * axes[b][2];
-            if (std::fabs(dot - (a == b ? 1.0 : 0.0)) > 1e-12)
-                return false;
-        }
-    return true;
-}
-
-} // namespace
-
-const RenderState* sidecar_current(const CameraSetup* setup, int W, int H)
-{
-    const long long size = ((long long)W << 32) + H;
-    if (registered_setup.load(std::memory_order_acquire) == setup &&
-        registered_size.load(std::memory_order_acquire) == size)
-        return registered_state.load(std::memory_order_acquire);
-    return nullptr;
-}
-
-const RenderState* sidecar_register(const std::shared_ptr<const CameraSetup>& setup, const CameraFrame& frame, int W, int H)
-{
-    const long long size = ((long long)W << 32) + H;
-    std::lock_guard<std::mutex> lock(registration_mutex);
-    if (registered_setup.load() != setup.get() || registered_size.load() != size) {
-        registered_setup.store(nullptr);
-        registration.setup = setup;
-        registration.width = W;
-        registration.height = H;
-        registration.depth.clear();
-        // -1 marks a pixel that no light reaches (and one not rendered, e.g. outside +SR/+ER).
-        if (setup->depth_map)
-            registration.depth.assign(size_t(W) * size_t(H), -1.0f);
-        registration.state.frame = frame;
-        registration.state.frame_orthonormal = is_orthonormal(frame);
-        registration.state.depth = registration.depth.empty() ? nullptr : registration.depth.data();
-        registered_state.store(&registration.state);
-        next_depth_row.store(0);
-        depth_rows.store(registration.depth.empty() ? 0 : H);
-        registered_size.store(size);
-        registered_setup.store(setup.get(), std::memory_order_release);
-    }
-    return registered_state.load();
-}
-
-int sidecar_claim_depth_row()
-{
-    const int row = next_depth_row.fetch_add(1);
-    return row < depth_rows.load() ? row : -1;
-}
-
 bool sidecar_write(const std::string& image_path, int W, int H)
 {
-    std::lock_guard<std::mutex> lock(registration_mutex);
-    if (!registration.setup)
+    const std::shared_ptr<Render> render = take_published_render();
+    if (!render)
         return true;
-    bool ok = true;
     // +O- : POV-Ray writes the image to standard output under the name "stdout"; there is no
     // file beside which the metadata could go.
     if (image_path == "stdout" || image_path == "stderr") {
         std::fprintf(stderr, "plenoptic camera: the image went to standard output (+O-), so no metadata or "
                              "depth map is written; give +O a file name to get them.\n");
-        forget_registration();
         return true;
     }
+    bool ok = true;
     std::string depth_file;
-    if (!registration.depth.empty() && W == registration.width && H == registration.height) {
+    if (render->depth() != nullptr && W == render->width() && H == render->height()) {
+        const long long unknown = render->backfill() ? render->backfill()->pixels_not_handed_out() : 0;
+        if (unknown > 0)
+            std::fprintf(stderr, "plenoptic camera: the depth of %lld pixels rendered before the render was "
+                                 "continued (+C) is unknown: this render traced no pixel that could compute it; "
+                                 "they read -1 in the depth map.\n", unknown);
         const std::string depth_path = depth_path_for(image_path);
-        if (write_depth_exr(depth_path, registration.depth, W, H))
+        if (write_depth_exr(depth_path, *render->depth()))
             depth_file = base_name(depth_path);
         else
             ok = false;
     }
-    const std::string json = metadata_json(registration.setup->model, registration.setup->params, W, H,
-                                           registration.state.frame, depth_file);
-    const std::string metadata_path = metadata_path_for(image_path);
-    if (!write_text_atomically(metadata_path, json))
+    const std::string json = metadata_json(render->model(), render->setup().params, W, H, render->frame(), depth_file);
+    if (!write_text_atomically(metadata_path_for(image_path), json))
         ok = false;
-    forget_registration();
     return ok;
 }
 

@@ -9,9 +9,10 @@
 #include "backend/math/vector.h"
 #include "backend/render/tracepixel.h"
 #include "backend/scene/camera.h"
+#include "backend/support/task.h"
 #include "plenoptic/plenoptic_pixel.h"
 #include "povray_glue/plenoptic_setup.h"
-#include "povray_glue/plenoptic_sidecar.h"
+#include "povray_glue/plenoptic_render.h"
 
 #include "base/povdebug.h"
 
@@ -21,35 +22,17 @@ namespace pov
 namespace
 {
 
-// The optics frame in the scene: +x right, +y up, +z towards the scene, all unit length.
-plenoptic::CameraFrame Frame_Of(const Camera& camera)
+void To_Scene(const plenoptic::Render& render, const plenoptic::OpticsRay& in, Ray& out)
 {
-	plenoptic::CameraFrame frame;
-	Vector3d right(camera.Right), up(camera.Up), direction(camera.Direction);
-	right.normalize();
-	up.normalize();
-	direction.normalize();
-	for (int i = 0; i < 3; i++)
-	{
-		frame.location[i] = camera.Location[i];
-		frame.right[i] = right[i];
-		frame.up[i] = up[i];
-		frame.direction[i] = direction[i];
-	}
-	return frame;
-}
-
-void To_Scene(const plenoptic::RenderState& state, double mm_per_unit, const plenoptic::OpticsRay& in, Ray& out)
-{
-	const plenoptic::CameraFrame& frame = state.frame;
-	const double units_per_mm = 1.0 / mm_per_unit;
+	const plenoptic::CameraFrame& frame = render.frame();
+	const double units_per_mm = 1.0 / render.model().mm_per_unit;
 	for (int i = 0; i < 3; i++)
 	{
 		out.Origin[i] = frame.location[i] + (in.origin_mm[0] * frame.right[i] + in.origin_mm[1] * frame.up[i] +
 		                                     in.origin_mm[2] * frame.direction[i]) * units_per_mm;
 		out.Direction[i] = in.dir[0] * frame.right[i] + in.dir[1] * frame.up[i] + in.dir[2] * frame.direction[i];
 	}
-	if (!state.frame_orthonormal)
+	if (!render.frame_orthonormal())
 		VNormalizeEq(out.Direction);
 }
 
@@ -57,17 +40,17 @@ void To_Scene(const plenoptic::RenderState& state, double mm_per_unit, const ple
 
 void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DBL height)
 {
-	const plenoptic::CameraSetup& setup = *camera.Plenoptic;
-	const plenoptic::Model& model = setup.model;
+	// Made once by View::StartRender (Plenoptic_Start_Render) and carried in the copied camera.
+	if (!camera.PlenopticRender)
+		throw POV_EXCEPTION_STRING("plenoptic camera: the render has no plenoptic state (internal error).");
+	plenoptic::Render& render = *camera.PlenopticRender;
+	const plenoptic::Model& model = render.model();
 	const int W = (int)width, H = (int)height;
 	// Antialiasing may ask for sub-pixel positions: the camera samples the whole pixel itself.
 	const int i = (int)std::floor(x + 0.5), j = (int)std::floor(y + 0.5);
-	const plenoptic::RenderState *state = plenoptic::sidecar_current(camera.Plenoptic.get(), W, H);
-	if (state == NULL)
-		state = plenoptic::sidecar_register(camera.Plenoptic, Frame_Of(camera), W, H);
-	float *depth = state->depth;
 
-	if (depth != NULL)
+	plenoptic::DepthMap *depth = render.depth();
+	if (depth != NULL && !pretrace && W == render.width() && H == render.height())
 	{
 		// Distance along a pixel's chief ray, from the lens it leaves to the first surface;
 		// +inf where it hits nothing, -1 where no sample of the pixel passes the apertures.
@@ -77,14 +60,21 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 				return -1.0f;
 			Ray ray;
 			ray.SetFlags(Ray::PrimaryRay, false, false, false, false, pretrace);
-			To_Scene(*state, model.mm_per_unit, plenoptic::chief_ray(model, W, H, column, row), ray);
+			To_Scene(render, plenoptic::chief_ray(model, W, H, column, row), ray);
 			Intersection isect;
 			return FindIntersection(isect, ray) ? (float)isect.Depth : std::numeric_limits<float>::infinity();
 		};
-		// Every thread helps fill the whole depth map before shading its first pixel.
-		for (int row = plenoptic::sidecar_claim_depth_row(); row >= 0; row = plenoptic::sidecar_claim_depth_row())
-			for (int column = 0; column < W; column++)
-				depth[size_t(row) * W + column] = depth_of(column, row);
+		depth->set(i, j, depth_of(i, j));
+		// A continued render (+C) owes the depth of the blocks it does not trace: a share of it
+		// with each traced pixel, a row of a block at a time, stopping promptly when asked to.
+		plenoptic::DepthBackfill *backfill = render.backfill();
+		backfill->pixel_traced();
+		for (plenoptic::PixelRun run = backfill->next_due(); !run.none(); run = backfill->next_due())
+		{
+			for (int column = run.left; column <= run.right; column++)
+				depth->set(column, run.row, depth_of(column, run.row));
+			Task::CurrentTaskCooperate();
+		}
 	}
 
 	POV_ULONG traced = 0;  // camera rays into the scene, for the render statistics' "Samples"
@@ -94,7 +84,7 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 			traced++;
 			Ray ray;
 			ray.SetFlags(Ray::PrimaryRay, false, false, false, false, pretrace);
-			To_Scene(*state, model.mm_per_unit, optics_ray, ray);
+			To_Scene(render, optics_ray, ray);
 			// As the perspective camera: the containing interiors are those at the main lens.
 			InitRayContainerState(ray);
 			Colour col;
