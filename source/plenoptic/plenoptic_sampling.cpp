@@ -1,11 +1,15 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Deterministic low-discrepancy camera samples, the concentric disc map and chi-square quantiles.
+// Deterministic low-discrepancy camera samples, the concentric disc map and the adaptive
+// thresholds (chi-square quantiles from Boost.Math).
 
 #include "plenoptic_sampling.h"
 
 #include <cmath>
 #include <cstdint>
 #include <limits>
+
+#include <boost/math/distributions/chi_squared.hpp>
+#include <boost/math/distributions/normal.hpp>
 
 namespace plenoptic {
 
@@ -84,87 +88,19 @@ Vec2 concentric_disc(double u, double v)
     return Vec2{r * std::cos(phi), r * std::sin(phi)};
 }
 
-double log_gamma(double a)
-{
-    // Shift up to a >= 15, then Stirling's series; no global state (unlike lgamma's signgam).
-    double shift = 0;
-    while (a < 15) {
-        shift += std::log(a);
-        a += 1;
-    }
-    const double inv = 1 / a;
-    const double inv2 = inv * inv;
-    const double series = inv * (1.0 / 12 - inv2 * (1.0 / 360 - inv2 * (1.0 / 1260 - inv2 * (1.0 / 1680))));
-    return (a - 0.5) * std::log(a) - a + 0.91893853320467274178 + series - shift;
-}
-
-double regularized_lower_gamma(double a, double x)
-{
-    if (!(x > 0))
-        return 0;
-    if (std::isinf(x))
-        return 1;
-    const double log_prefix = a * std::log(x) - x - log_gamma(a);
-    if (x < a + 1) {
-        // Series: P = x^a e^-x / Gamma(a+1) * sum x^n / ((a+1)...(a+n)).
-        double term = 1 / a;
-        double sum = term;
-        for (int n = 1; n < 100000; ++n) {
-            term *= x / (a + n);
-            sum += term;
-            if (std::fabs(term) < std::fabs(sum) * 1e-17)
-                break;
-        }
-        return sum * std::exp(log_prefix);
-    }
-    // Continued fraction for Q = 1 - P (modified Lentz).
-    const double tiny = 1e-300;
-    double b = x + 1 - a;
-    double c = 1 / tiny;
-    double d = 1 / b;
-    double h = d;
-    for (int n = 1; n < 100000; ++n) {
-        const double an = -n * (n - a);
-        b += 2;
-        d = an * d + b;
-        if (std::fabs(d) < tiny)
-            d = tiny;
-        c = b + an / c;
-        if (std::fabs(c) < tiny)
-            c = tiny;
-        d = 1 / d;
-        const double delta = d * c;
-        h *= delta;
-        if (std::fabs(delta - 1) < 1e-17)
-            break;
-    }
-    return 1 - std::exp(log_prefix) * h;
-}
-
-double normal_quantile(double p)
-{
-    if (!(p > 0))
-        return -std::numeric_limits<double>::infinity();
-    if (!(p < 1))
-        return std::numeric_limits<double>::infinity();
-    // Bisection on the normal CDF, 0.5 erfc(-z / sqrt 2), over a bracket wide enough for doubles.
-    double low = -40, high = 40;
-    for (int iteration = 0; iteration < 200; ++iteration) {
-        const double mid = 0.5 * (low + high);
-        if (mid <= low || mid >= high)
-            break;
-        if (0.5 * std::erfc(-mid / 1.41421356237309504880) < p)
-            low = mid;
-        else
-            high = mid;
-    }
-    return 0.5 * (low + high);
-}
-
 namespace {
 
-// Wilson-Hilferty approximation of the chi-square quantile from the normal quantile z: relative
-// error far below 1e-5 above kExactChi2Dof degrees of freedom.
+// Boost.Math without its default promotion of double arguments to long double (x87 arithmetic,
+// about 5 times slower here, for digits a threshold does not need), and with domain errors
+// and overflow reported as NaN and infinity rather than thrown: the callers check their
+// arguments first anyway.
+typedef boost::math::policies::policy<boost::math::policies::promote_double<false>,
+                                      boost::math::policies::domain_error<boost::math::policies::ignore_error>,
+                                      boost::math::policies::overflow_error<boost::math::policies::ignore_error>>
+    QuantilePolicy;
+
+// Wilson-Hilferty approximation of the upper-tail chi-square quantile from the normal quantile
+// z of the upper tail: see kExactChi2Dof for its error.
 double wilson_hilferty(double z, double dof)
 {
     const double c = 2 / (9 * dof);
@@ -174,45 +110,28 @@ double wilson_hilferty(double z, double dof)
 
 } // namespace
 
-double chi2_quantile(double p, double dof)
+double chi2_upper_quantile(double q, double dof)
 {
-    if (!(p > 0))
-        return 0;
-    if (!(p < 1))
+    if (!(q > 0))
         return std::numeric_limits<double>::infinity();
-    if (dof > kExactChi2Dof)
-        return wilson_hilferty(normal_quantile(p), dof);
-    const double a = dof / 2;
-    // Bracket, then bisect on the CDF, which is monotonic: robust, and fast enough for a table
-    // computed once per render.
-    double low = 0;
-    double high = dof + 10;
-    while (regularized_lower_gamma(a, high / 2) < p)
-        high *= 2;
-    for (int iteration = 0; iteration < 200; ++iteration) {
-        const double mid = 0.5 * (low + high);
-        if (mid <= low || mid >= high || high - low <= 1e-15 * high)
-            break;
-        if (regularized_lower_gamma(a, mid / 2) < p)
-            low = mid;
-        else
-            high = mid;
-    }
-    return 0.5 * (low + high);
+    if (!(q < 1))
+        return 0;
+    const boost::math::chi_squared_distribution<double, QuantilePolicy> chi2(dof);
+    return boost::math::quantile(boost::math::complement(chi2, q));
 }
-
-double chi2_upper_quantile(double q, double dof) { return chi2_quantile(1 - q, dof); }
 
 std::vector<double> adaptive_thresholds(int samples_max, double confidence, double variance)
 {
     std::vector<double> threshold(samples_max > 0 ? samples_max : 1, 0.0);
     if (samples_max <= 1)
         return threshold;
-    // POV-Ray calls cephes' chdtri, the complemented (upper-tail) inverse: the lower-tail quantile
-    // at 1 - confidence. The normal quantile is computed once for the large-dof approximation.
-    const double p = 1 - confidence;
-    const double z = normal_quantile(p);
-    auto quantile = [&](double dof) { return dof > kExactChi2Dof ? wilson_hilferty(z, dof) : chi2_quantile(p, dof); };
+    // POV-Ray calls cephes' chdtri, the complemented (upper-tail) inverse. Above kExactChi2Dof
+    // degrees of freedom, Wilson-Hilferty from the normal quantile, computed once.
+    const boost::math::normal_distribution<double, QuantilePolicy> normal;
+    const double z = boost::math::quantile(boost::math::complement(normal, confidence));
+    auto quantile = [&](int dof) {
+        return dof > kExactChi2Dof ? wilson_hilferty(z, dof) : chi2_upper_quantile(confidence, dof);
+    };
     const double scale = variance / quantile(samples_max - 1);
     for (int n = 1; n <= samples_max; ++n)
         threshold[n - 1] = scale * quantile(n);
