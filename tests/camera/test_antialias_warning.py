@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """`+A` on a plenoptic render: one warning, and the image is the one without `+A`.
 
@@ -8,7 +7,7 @@ A stock perspective render with +A must print no such warning.
 """
 import numpy as np
 
-import camlib
+import plenoptic_testing as pt
 
 WARNING = "antialiasing (+A) is ignored"
 
@@ -30,31 +29,22 @@ PLENOPTIC = """plenoptic
 PERSPECTIVE = "perspective location <0, 0.5, -2> look_at <0, 0.3, 0>"
 
 
-def main():
-    args = camlib.common_args(__doc__).parse_args()
-    checks = camlib.Checks("+A on a plenoptic render")
-    # camlib.render passes -A; a later +A on the command line wins (POV-Ray reads options in order).
-    plain = camlib.render(args.povray, args.work, "plain", SCENE % PLENOPTIC, 80, 60)
-    rc, text = camlib.render(args.povray, args.work, "antialiased", SCENE % PLENOPTIC, 80, 60,
+def test_antialias_warning(args):
+    # pt.render passes -A; a later +A on the command line wins (POV-Ray reads options in order).
+    plain = pt.render(args.povray, args.work, "plain", SCENE % PLENOPTIC, 80, 60)
+    rc, text = pt.render(args.povray, args.work, "antialiased", SCENE % PLENOPTIC, 80, 60,
                              extra=["+A0.1", "+AM2", "+R3"], expect_failure=True)
-    checks.check(rc == 0, "render with +A succeeds", "exit %d" % rc)
+    assert rc == 0, "render with +A succeeds" + ": " + ("exit %d" % rc)
     text = " ".join(text.split())  # POV-Ray wraps its messages
     count = text.count(WARNING)
-    checks.check(count == 1, "one warning", "'%s' printed %d time(s)" % (WARNING, count))
-    checks.check("samples" in text[text.find(WARNING):text.find(WARNING) + 200],
-                 "the warning names samples", text[text.find(WARNING) - 20:text.find(WARNING) + 120].strip())
+    assert count == 1, "one warning" + ": " + ("'%s' printed %d time(s)" % (WARNING, count))
+    assert "samples" in text[text.find(WARNING):text.find(WARNING) + 200], "the warning names samples" + ": " + (text[text.find(WARNING) - 20:text.find(WARNING) + 120].strip())
     if rc == 0:
-        a = camlib.load(plain)
-        b = camlib.load(plain.replace("plain", "antialiased"))
-        checks.check(np.array_equal(a, b), "+A changes nothing in the image",
-                     "largest difference %g" % float(np.abs(a - b).max()))
-    rc, text = camlib.render(args.povray, args.work, "perspective", SCENE % PERSPECTIVE, 80, 60,
+        a = pt.load(plain)
+        b = pt.load(plain.replace("plain", "antialiased"))
+        assert np.array_equal(a, b), "+A changes nothing in the image" + ": " + ("largest difference %g" % float(np.abs(a - b).max()))
+    rc, text = pt.render(args.povray, args.work, "perspective", SCENE % PERSPECTIVE, 80, 60,
                              extra=["+A0.1"], expect_failure=True)
     text = " ".join(text.split())
-    checks.check(rc == 0 and WARNING not in text, "no warning for a stock camera",
-                 "exit %d, warning %s" % (rc, "printed" if WARNING in text else "absent"))
-    return checks.finish()
+    assert (rc == 0 and WARNING not in text), "no warning for a stock camera" + ": " + ("exit %d, warning %s" % (rc, "printed" if WARNING in text else "absent"))
 
-
-if __name__ == "__main__":
-    raise SystemExit(main())

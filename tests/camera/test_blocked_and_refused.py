@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Blocked light is black and opaque; the degenerate pinhole/pinhole pair is refused.
 
@@ -22,11 +21,11 @@ lens with a pinhole array is refused at parse time with a clear message.
 """
 import math
 import re
-import sys
 
 import numpy as np
+import pytest
 
-import camlib
+import plenoptic_testing as pt
 
 W, H = 160, 120
 SX = 0.006
@@ -44,7 +43,7 @@ def camera(grid, lens, d, pitch):
 
 def classify(grid, lens, d, pitch):
     """Boolean masks (wholly dark, wholly lit) of the pixels, from docs/specification.md."""
-    D = camlib.thin_lens_D(F_MAIN, FOCUS * 1000.0)
+    D = pt.thin_lens_D(F_MAIN, FOCUS * 1000.0)
     k = D / d
     g = 1 + k if lens == "pinhole" else 1 + k - D / lens
     circ = pitch / math.sqrt(3) if grid == "hexagonal" else pitch / math.sqrt(2)
@@ -54,9 +53,9 @@ def classify(grid, lens, d, pitch):
     centres = []
     for l in range(-20, 21):
         for kk in range(-20, 21):
-            c = camlib.posed_lens_centre(grid, pitch, kk, l, (0, 0, 0), (0, 0, 0), D)
+            c = pt.posed_lens_centre(grid, pitch, kk, l, (0, 0, 0), (0, 0, 0), D)
             s = -(D + d) / c[2]
-            centres.append(camlib.sensor_to_pixel(c[0] * s, c[1] * s, W, H, SX, SX))
+            centres.append(pt.sensor_to_pixel(c[0] * s, c[1] * s, W, H, SX, SX))
     centres = np.array(centres)
     vv, uu = np.mgrid[0:H, 0:W]
     nearest = np.full((H, W), np.inf)
@@ -67,33 +66,35 @@ def classify(grid, lens, d, pitch):
     return dark, lit, disc, spread
 
 
-def blocked_case(args, checks, name, grid, lens, d, pitch):
+@pytest.mark.parametrize("name, grid, lens, d, pitch", [
+    ("plenoptic1_hex", "hexagonal", 0.5, 0.5, 0.12),
+    ("chief_ray_rect", "rectangular", "pinhole", 0.5, 0.12),
+    ("focused2_hex", "hexagonal", 0.42, 0.5, 0.12),
+])
+def test_blocked_pixels(args, name, grid, lens, d, pitch):
     head = "#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\n"
     transparent = head + "background { rgbt <%r, %r, %r, 1> }\n" % BACKGROUND + camera(grid, lens, d, pitch)
     opaque = head + "background { rgb <%r, %r, %r> }\n" % BACKGROUND + camera(grid, lens, d, pitch)
-    rgba = camlib.load(camlib.render(args.povray, args.work, name + "_alpha", transparent, W, H, extra=["+UA"]))
-    rgb = camlib.load(camlib.render(args.povray, args.work, name + "_opaque", opaque, W, H))
+    rgba = pt.load(pt.render(args.povray, args.work, name + "_alpha", transparent, W, H, extra=["+UA"]))
+    rgb = pt.load(pt.render(args.povray, args.work, name + "_opaque", opaque, W, H))
     dark, lit, disc, spread = classify(grid, lens, d, pitch)
-    checks.check(rgba.shape[2] == 4, name + ": +UA output has alpha", "channels: %d" % rgba.shape[2])
+    assert rgba.shape[2] == 4, name + ": +UA output has alpha" + ": " + ("channels: %d" % rgba.shape[2])
     if rgba.shape[2] != 4:
         return
     a = rgba[:, :, 3]
     dark_rgb = float(np.abs(rgba[dark][:, :3]).max())
     dark_alpha = float(a[dark].min())
-    checks.check(dark.sum() > 1000 and dark_rgb == 0 and dark_alpha == 1, name + ": blocked pixels are black, opaque",
-                 "%d pixels wholly outside every microimage (disc %.1f px + spread %.1f px): max RGB %.3g "
-                 "(expected 0), min alpha %.4f (expected 1)" % (dark.sum(), disc, spread, dark_rgb, dark_alpha))
+    assert (dark.sum() > 1000 and dark_rgb == 0 and dark_alpha == 1), (name + ": blocked pixels are black, opaque" + ": " + ("%d pixels wholly outside every microimage (disc %.1f px + spread %.1f px): max RGB %.3g "
+                 "(expected 0), min alpha %.4f (expected 1)" % (dark.sum(), disc, spread, dark_rgb, dark_alpha)))
     lit_alpha = float(a[lit].max())
-    checks.check(lit.sum() > 500 and lit_alpha == 0, name + ": lit pixels show the background (alpha 0)",
-                 "%d pixels wholly inside a microimage: max alpha %.4f (expected 0)" % (lit.sum(), lit_alpha))
+    assert (lit.sum() > 500 and lit_alpha == 0), name + ": lit pixels show the background (alpha 0)" + ": " + ("%d pixels wholly inside a microimage: max alpha %.4f (expected 0)" % (lit.sum(), lit_alpha))
     opaque_dark = float(np.abs(rgb[dark][:, :3]).max())
     lit_err = float(np.abs(rgb[lit][:, :3] - np.array(BACKGROUND)).max())
-    checks.check(opaque_dark == 0 and lit_err < 1e-3, name + ": without alpha: black where blocked, background where lit",
-                 "max RGB of blocked pixels %.3g (expected 0); max |lit - background| %.2g (expected 0 up "
-                 "to 16-bit rounding)" % (opaque_dark, lit_err))
+    assert (opaque_dark == 0 and lit_err < 1e-3), (name + ": without alpha: black where blocked, background where lit" + ": " + ("max RGB of blocked pixels %.3g (expected 0); max |lit - background| %.2g (expected 0 up "
+                 "to 16-bit rounding)" % (opaque_dark, lit_err)))
 
 
-def refused(args, checks):
+def test_pinhole_pinhole_refused(args):
     scene = ("#version 3.7;\n"            # line 1
              "global_settings { assumed_gamma 1.0 }\n"
              "camera {\n"                 # line 3
@@ -102,26 +103,11 @@ def refused(args, checks):
              "  microlens_array { hexagonal pitch 0.1 pinhole distance 0.4 }\n"
              "}\n"                        # line 7
              "sphere { <0, 0, 5>, 1 pigment { rgb 1 } }\n")
-    rc, text = camlib.render(args.povray, args.work, "pinhole_pinhole", scene, 32, 24, expect_failure=True)
+    rc, text = pt.render(args.povray, args.work, "pinhole_pinhole", scene, 32, 24, expect_failure=True)
     m = re.search(r"line:?\s*(\d+)", text, re.IGNORECASE)
     line = int(m.group(1)) if m else None
     named = "degenerate" in text and "pinhole" in text
-    checks.check(rc != 0 and named and line is not None and 3 <= line <= 7,
-                 "pinhole main lens + pinhole array is refused",
-                 "exit code %d (expected non-zero), message names the problem: %s, reported line %s "
+    assert (rc != 0 and named and line is not None and 3 <= line <= 7), ("pinhole main lens + pinhole array is refused" + ": " + ("exit code %d (expected non-zero), message names the problem: %s, reported line %s "
                  "(expected within the camera block, lines 3-7); console: %s"
-                 % (rc, named, line, " | ".join(l for l in text.splitlines() if "rror" in l or "degenerate" in l)[:400]))
+                 % (rc, named, line, " | ".join(l for l in text.splitlines() if "rror" in l or "degenerate" in l)[:400])))
 
-
-def main():
-    args = camlib.common_args(__doc__).parse_args()
-    checks = camlib.Checks("blocked pixels and the refused pinhole/pinhole pair")
-    blocked_case(args, checks, "plenoptic1_hex", "hexagonal", 0.5, 0.5, 0.12)
-    blocked_case(args, checks, "chief_ray_rect", "rectangular", "pinhole", 0.5, 0.12)
-    blocked_case(args, checks, "focused2_hex", "hexagonal", 0.42, 0.5, 0.12)
-    refused(args, checks)
-    return checks.finish()
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Bare pinhole array (no main lens): each microimage is a pinhole camera at its lens.
 
@@ -20,25 +19,25 @@ and its ray runs from the pixel through that lens's centre. So:
 import glob
 import math
 import os
-import sys
 
 import numpy as np
+import pytest
 
-import camlib
+import plenoptic_testing as pt
 
 LOC = np.array([0.1, 0.65, -3.0])   # scene units = mm here
 v3 = lambda a: "<%.17g, %.17g, %.17g>" % tuple(a)
 
 
-def block_test(args, checks):
+def test_rectangular_array_blocks(args):
     n, sx, d = 16, 0.01, 0.22
     p = n * sx
     W, H = 8 * n, 6 * n
-    scene = camlib.TEXTURED_SCENE
+    scene = pt.TEXTURED_SCENE
     plen = ("camera { plenoptic location %s mm_per_unit 1\n"
             "  microlens_array { rectangular pitch %r pinhole distance %r }\n"
             "  sensor { pixel_size %r } }\n" % (v3(LOC), p, d, sx))
-    img = camlib.load(camlib.render(args.povray, args.work, "rect_array", scene + plen, W, H))
+    img = pt.load(pt.render(args.povray, args.work, "rect_array", scene + plen, W, H))
     # Lenses whose n x n block lies wholly inside the image: block of lens (k, l) starts at
     # column W/2 - (k + 1/2) n (x grows to the left) and row H/2 + (l - 1/2) n (y grows down).
     lenses = []
@@ -56,13 +55,13 @@ def block_test(args, checks):
     stem = os.path.join(args.work, "rect_stock")
     for old in glob.glob(stem + "*.png"):
         os.remove(old)
-    camlib.render(args.povray, args.work, "rect_stock", scene + stock, n, n,
+    pt.render(args.povray, args.work, "rect_stock", scene + stock, n, n,
                   extra=["+KFI0", "+KFF%d" % (len(lenses) - 1)])
     digits = len(str(len(lenses) - 1))
     worst = (0, None)
     bad = 0
     for idx, (k, l, i0, j0) in enumerate(lenses):
-        ref = camlib.load("%s%0*d.png" % (stem, digits, idx))
+        ref = pt.load("%s%0*d.png" % (stem, digits, idx))
         block = img[j0:j0 + n, i0:i0 + n]
         diff = float(np.abs(block - ref).max())
         differing = int((np.abs(block - ref).max(axis=2) > 0).sum())
@@ -70,15 +69,13 @@ def block_test(args, checks):
             bad += 1
         if diff >= worst[0]:
             worst = (diff, (k, l, differing))
-    checks.check(bad == 0, "rectangular array: block under each lens == stock camera at the lens",
-                 "%d lenses compared (n=%d px, pitch %g mm, d %g mm, angle %.4f deg); %d differ; "
+    assert (bad == 0), ("rectangular array: block under each lens == stock camera at the lens" + ": " + ("%d lenses compared (n=%d px, pitch %g mm, d %g mm, angle %.4f deg); %d differ; "
                  "largest |diff| %.3g at lens %s (expected 0)" % (len(lenses), n, p, d, angle, bad,
-                                                               worst[0], worst[1]))
+                                                               worst[0], worst[1])))
     # The same blocks must differ between lenses (parallax), or the comparison proves nothing.
     a = img[lenses[0][3]:lenses[0][3] + n, lenses[0][2]:lenses[0][2] + n]
     b = img[lenses[-1][3]:lenses[-1][3] + n, lenses[-1][2]:lenses[-1][2] + n]
-    checks.check(float(np.abs(a - b).mean()) > 0.02, "rectangular array: lenses see different views",
-                 "mean |first block - last block| = %.3f (must be clearly non-zero)" % float(np.abs(a - b).mean()))
+    assert float(np.abs(a - b).mean()) > 0.02, "rectangular array: lenses see different views" + ": " + ("mean |first block - last block| = %.3f (must be clearly non-zero)" % float(np.abs(a - b).mean()))
 
 
 def point_scene(points, radius):
@@ -99,33 +96,37 @@ def nearest_lens_centre(grid, pitch, q):
         shift = (l % 2) / 2.0 if grid == "hexagonal" else 0.0
         k0 = int(round(q[0] / pitch - shift))
         for k in range(k0 - 2, k0 + 3):
-            c = camlib.lattice_point(grid, pitch, k, l)
+            c = pt.lattice_point(grid, pitch, k, l)
             d2 = (c[0] - q[0]) ** 2 + (c[1] - q[1]) ** 2
             if best is None or d2 < best[0]:
                 best = (d2, (k, l), c)
     return best[1], best[2], math.sqrt(best[0])
 
 
-def hex_points_test(args, checks, name, rotate, translate):
+@pytest.mark.parametrize("name, rotate, translate", [
+    ("hex_array", [0, 0, 0], [0, 0, 0]),
+    ("hex_array_posed", [0, 0, 17], [0.05, -0.08, 0.04]),
+])
+def test_hexagonal_array_points(args, name, rotate, translate):
     W, H = 192, 160
     sx = 0.01
     pitch, d = 0.36, 0.3
     radius = 0.12
-    R = camlib.rotation_xyz(rotate)
+    R = pt.rotation_xyz(rotate)
     t = np.array(translate, dtype=float)
     points = [np.array(p) for p in ([0.0, 0.0, 3.0], [0.55, -0.35, 2.4], [-0.6, 0.45, 4.0])]
     plen = ("camera { plenoptic location %s mm_per_unit 1\n"
             "  microlens_array { hexagonal pitch %r pinhole distance %r rotate %s translate %s }\n"
             "  sensor { pixel_size %r } samples 64 }\n"
             % (v3(LOC), pitch, d, v3(rotate), v3(translate), sx))
-    img = camlib.load(camlib.render(args.povray, args.work, name, point_scene(points, radius) + plen,
+    img = pt.load(pt.render(args.povray, args.work, name, point_scene(points, radius) + plen,
                                     W, H, ext="exr"))[:, :, 0]
     sensor_z = -d  # the sensor stays at -d; a z translation moves the array only
     expected = []  # every image that may show at least in part: (u, v, radius_px, clean, lens)
     for X in points:
         for l in range(-8, 9):
             for k in range(-8, 9):
-                own = camlib.lattice_point("hexagonal", pitch, k, l)
+                own = pt.lattice_point("hexagonal", pitch, k, l)
                 c = R @ own + t
                 # Pinhole projection through the lens centre onto the sensor plane.
                 s = (sensor_z - c[2]) / (c[2] - X[2])
@@ -137,7 +138,7 @@ def hex_points_test(args, checks, name, rotate, translate):
                 from_own = math.hypot(q[0] - own[0], q[1] - own[1])
                 if from_own / sx > pitch / math.sqrt(3) / sx + r_px + 1:
                     continue  # the disc's image cannot reach this lens's cell
-                u, v = camlib.sensor_to_pixel(hit[0], hit[1], W, H, sx, sx)
+                u, v = pt.sensor_to_pixel(hit[0], hit[1], W, H, sx, sx)
                 # Clean: wholly inside its own cell (inradius p/2) and inside the image.
                 clean = lens == (k, l) and (pitch / 2 - dist) / sx > r_px + 1.5 and \
                     r_px + 1.5 < u < W - 1 - r_px - 1.5 and r_px + 1.5 < v < H - 1 - r_px - 1.5
@@ -148,8 +149,8 @@ def hex_points_test(args, checks, name, rotate, translate):
         for b in expected:
             if a is not b and a[4] == b[4] and math.hypot(a[0] - b[0], a[1] - b[1]) < a[2] + b[2] + 3:
                 a[3] = False
-    labels, count = camlib.label_components(img > 0.01)
-    blobs = camlib.component_centroids(img, labels, count)
+    labels, count = pt.label_components(img > 0.01)
+    blobs = pt.component_centroids(img, labels, count)
     errors = []
     missing = []
     for (u, v, r_px, clean, _) in expected:
@@ -163,25 +164,10 @@ def hex_points_test(args, checks, name, rotate, translate):
     # Every blob must be one of the predicted images (clean or cut by a border).
     stray = [(round(b["u"], 1), round(b["v"], 1)) for b in blobs
              if not any(math.hypot(b["u"] - u, b["v"] - v) < r + 3 for u, v, r, _, _ in expected)]
-    checks.check(not missing and not stray and len(errors) >= 12,
-                 name + ": the predicted lenses show each disc",
-                 "%d clean predicted images found, %d missing %s, %d blobs in the render, "
-                 "%d unexpected %s" % (len(errors), len(missing), missing[:5], len(blobs), len(stray), stray[:5]))
+    assert (not missing and not stray and len(errors) >= 12), (name + ": the predicted lenses show each disc" + ": " + ("%d clean predicted images found, %d missing %s, %d blobs in the render, "
+                 "%d unexpected %s" % (len(errors), len(missing), missing[:5], len(blobs), len(stray), stray[:5])))
     if errors:
         e = np.array(errors)
-        checks.check(e.mean() <= 0.05 and e.max() <= 0.15, name + ": image positions",
-                     "|measured - pinhole projection| mean %.4f px, max %.4f px over %d images "
-                     "(tolerance: mean 0.05, max 0.15 px)" % (e.mean(), e.max(), len(e)))
+        assert (e.mean() <= 0.05 and e.max() <= 0.15), (name + ": image positions" + ": " + ("|measured - pinhole projection| mean %.4f px, max %.4f px over %d images "
+                     "(tolerance: mean 0.05, max 0.15 px)" % (e.mean(), e.max(), len(e))))
 
-
-def main():
-    args = camlib.common_args(__doc__).parse_args()
-    checks = camlib.Checks("bare pinhole array == one pinhole camera per lens")
-    block_test(args, checks)
-    hex_points_test(args, checks, "hex_array", [0, 0, 0], [0, 0, 0])
-    hex_points_test(args, checks, "hex_array_posed", [0, 0, 17], [0.05, -0.08, 0.04])
-    return checks.finish()
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Determinism: the same scene and options give the same image, whatever the threads.
 
@@ -9,11 +8,10 @@ threads, and with two threads and tiny render blocks (a different order of pixel
 across threads). The three images, depth maps and metadata files must be identical.
 """
 import os
-import sys
 
 import numpy as np
 
-import camlib
+import plenoptic_testing as pt
 
 W, H = 160, 120
 CAMERA = """
@@ -28,38 +26,29 @@ camera { plenoptic location <0.15, 0.7, -3> look_at <0, 0.45, 0>
 """
 
 
-def main():
-    args = camlib.common_args(__doc__).parse_args()
-    checks = camlib.Checks("determinism across thread counts")
+def test_determinism_across_thread_counts(args):
     runs = [("wt1", ["+WT1"]), ("wt2", ["+WT2"]), ("wt2_bs4", ["+WT2", "+BS4"])]
     images, depths, metas = {}, {}, {}
     for name, extra in runs:
-        path = camlib.render(args.povray, args.work, name, camlib.TEXTURED_SCENE + CAMERA, W, H, extra=extra)
-        images[name] = camlib.load(path)
-        meta = camlib.metadata(path)
+        path = pt.render(args.povray, args.work, name, pt.TEXTURED_SCENE + CAMERA, W, H, extra=extra)
+        images[name] = pt.load(path)
+        meta = pt.metadata_of(path)
         depth_file = meta.get("depth_map")
-        depths[name] = camlib.load(os.path.join(args.work, depth_file)) if depth_file else None
+        depths[name] = pt.load(os.path.join(args.work, depth_file)) if depth_file else None
         meta.pop("depth_map", None)
         metas[name] = meta
     ref = "wt1"
-    checks.check(depths[ref] is not None, "depth map written", "metadata depth_map: %r" % (depths[ref] is not None))
+    assert depths[ref] is not None, "depth map written" + ": " + ("metadata depth_map: %r" % (depths[ref] is not None))
     for name, _ in runs[1:]:
         diff = np.abs(images[name] - images[ref]).max(axis=2)
-        checks.check(int((diff > 0).sum()) == 0, "image %s == %s" % (name, ref),
-                     "%d of %d pixels differ, max |diff| %.3g (expected 0)"
-                     % (int((diff > 0).sum()), W * H, float(diff.max())))
+        assert (int((diff > 0).sum()) == 0), ("image %s == %s" % (name, ref) + ": " + ("%d of %d pixels differ, max |diff| %.3g (expected 0)"
+                     % (int((diff > 0).sum()), W * H, float(diff.max()))))
         if depths[ref] is not None and depths[name] is not None:
             a, b = depths[ref], depths[name]
             same = np.array_equal(a, b) or np.array_equal(np.nan_to_num(a, posinf=-9), np.nan_to_num(b, posinf=-9))
-            checks.check(same, "depth map %s == %s" % (name, ref),
-                         "%d values differ" % int((np.nan_to_num(a, posinf=-9) != np.nan_to_num(b, posinf=-9)).sum()))
-        checks.check(metas[name] == metas[ref], "metadata %s == %s" % (name, ref),
-                     "identical apart from the file name of the depth map: %s" % (metas[name] == metas[ref]))
+            assert same, "depth map %s == %s" % (name, ref) + ": " + ("%d values differ" % int((np.nan_to_num(a, posinf=-9) != np.nan_to_num(b, posinf=-9)).sum()))
+        assert metas[name] == metas[ref], "metadata %s == %s" % (name, ref) + ": " + ("identical apart from the file name of the depth map: %s" % (metas[name] == metas[ref]))
     # The image must hold a real picture, or identity would prove little.
     spread = float(images[ref][:, :, :3].std())
-    checks.check(spread > 0.05, "the render is not trivial", "standard deviation of the pixels %.3f" % spread)
-    return checks.finish()
+    assert spread > 0.05, "the render is not trivial" + ": " + ("standard deviation of the pixels %.3f" % spread)
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Microimage centres of plenoptic cameras in a uniformly white scene.
 
@@ -22,11 +21,11 @@ one microimage for each lens whose microimage lies inside the picture. The metad
 microimage lattice must give the same centres to 0.01 px.
 """
 import math
-import sys
 
 import numpy as np
+import pytest
 
-import camlib
+import plenoptic_testing as pt
 
 W, H = 176, 132
 SX = 0.006            # mm
@@ -48,7 +47,8 @@ CASES = [
 ]
 
 
-def run_case(args, checks, name, grid, lens, d, pitch, rotate, translate):
+@pytest.mark.parametrize("name, grid, lens, d, pitch, rotate, translate", CASES, ids=[c[0] for c in CASES])
+def test_microimage_centres(args, name, grid, lens, d, pitch, rotate, translate):
     lens_kw = "pinhole" if lens == "pinhole" else "focal_length %r" % lens
     scene = ("#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\nbackground { rgb 1 }\n"
              "camera { plenoptic location <0, 0, 0>\n"
@@ -57,20 +57,20 @@ def run_case(args, checks, name, grid, lens, d, pitch, rotate, translate):
              "  sensor { pixel_size %r } samples %d }\n"
              % ((F_MAIN, F_NUMBER, FOCUS_M, grid, pitch, lens_kw, d) + tuple(rotate) + tuple(translate)
                 + (SX, SAMPLES)))
-    path = camlib.render(args.povray, args.work, name, scene, W, H)
-    img = camlib.load(path)[:, :, 0]
-    lattice = camlib.metadata(path).get("microimage_lattice") or {}
+    path = pt.render(args.povray, args.work, name, scene, W, H)
+    img = pt.load(path)[:, :, 0]
+    lattice = pt.metadata_of(path).get("microimage_lattice") or {}
 
     # Expected centres, from the specification (docs/specification.md) only.
-    D = camlib.thin_lens_D(F_MAIN, FOCUS_M * 1000.0)
+    D = pt.thin_lens_D(F_MAIN, FOCUS_M * 1000.0)
     sensor_z = -(D + d)
     A = F_MAIN / F_NUMBER
     expected = []
     for l in range(-30, 31):
         for k in range(-30, 31):
-            c = camlib.posed_lens_centre(grid, pitch, k, l, rotate, translate, D)
+            c = pt.posed_lens_centre(grid, pitch, k, l, rotate, translate, D)
             s = sensor_z / c[2]
-            u, v = camlib.sensor_to_pixel(c[0] * s, c[1] * s, W, H, SX, SX)
+            u, v = pt.sensor_to_pixel(c[0] * s, c[1] * s, W, H, SX, SX)
             if -20 < u < W + 20 and -20 < v < H + 20:
                 expected.append((k, l, u, v))
     # Reach of a microimage around its centre (for the border test): the aperture's image
@@ -84,8 +84,8 @@ def run_case(args, checks, name, grid, lens, d, pitch, rotate, translate):
     spacing_px = pitch * (1 + 1 / kk) / SX
 
     # Dilate by one pixel so that lit pixels at a microimage's sampled edge join its body.
-    labels, count = camlib.label_components(camlib.dilate(img > 0.002, 1))
-    blobs = camlib.component_centroids(img, labels, count)
+    labels, count = pt.label_components(pt.dilate(img > 0.002, 1))
+    blobs = pt.component_centroids(img, labels, count)
     inner = [b for b in blobs if b["umin"] > 0 and b["vmin"] > 0 and b["umax"] < W - 1 and b["vmax"] < H - 1]
     # A pixel that overlaps the microimage's rim at all is lit (its centre up to half a diagonal,
     # 0.71 px, beyond the reach), and the dilation adds one more pixel: 2 px of margin.
@@ -100,13 +100,11 @@ def run_case(args, checks, name, grid, lens, d, pitch, rotate, translate):
         errors.append((math.hypot(near[0]["u"] - u, near[0]["v"] - v), near[0]["u"] - u, near[0]["v"] - v))
     stray = [(round(b["u"], 1), round(b["v"], 1)) for b in inner
              if not any(math.hypot(b["u"] - u, b["v"] - v) < spacing_px / 2 for _, _, u, v in expected)]
-    checks.check(not unmatched and not stray and len(inside) >= 20,
-                 name + ": one microimage per lens",
-                 "%d lenses with a microimage wholly inside the picture, %d bright regions clear of "
+    assert (not unmatched and not stray and len(inside) >= 20), (name + ": one microimage per lens" + ": " + ("%d lenses with a microimage wholly inside the picture, %d bright regions clear of "
                  "the border, %d lenses without exactly one region %s, %d regions at no lens %s "
                  "(microimage radius %.1f px, spacing %.1f px)"
                  % (len(inside), len(inner), len(unmatched), unmatched[:4], len(stray), stray[:4],
-                    reach_px, spacing_px))
+                    reach_px, spacing_px)))
     # The metadata's lattice must give the same centres (it is the ground truth users read).
     if lattice.get("origin_px") and lattice.get("basis_px"):
         o = np.array(lattice["origin_px"])
@@ -115,26 +113,13 @@ def run_case(args, checks, name, grid, lens, d, pitch, rotate, translate):
         for k, l, u, v in inside:
             ks = k - (l // 2) if grid == "hexagonal" else k
             worst = max(worst, float(np.hypot(*(o + ks * a + l * b - (u, v)))))
-        checks.check(worst < 0.01, name + ": metadata lattice",
-                     "largest distance between the metadata's centre and the specification's projection "
-                     "%.2g px over %d lenses (tolerance 0.01 px)" % (worst, len(inside)))
+        assert (worst < 0.01), (name + ": metadata lattice" + ": " + ("largest distance between the metadata's centre and the specification's projection "
+                     "%.2g px over %d lenses (tolerance 0.01 px)" % (worst, len(inside))))
     else:
-        checks.check(False, name + ": metadata lattice", "no microimage_lattice in the metadata")
+        assert False, name + ": metadata lattice" + ": " + ("no microimage_lattice in the metadata")
     if errors:
         e = np.array(errors)
-        checks.check(e[:, 0].mean() <= 0.1 and e[:, 0].max() <= 0.25, name + ": centroids",
-                     "|centroid - projection| mean %.4f px, max %.4f px, mean offset (%+.4f, %+.4f) px "
+        assert (e[:, 0].mean() <= 0.1 and e[:, 0].max() <= 0.25), (name + ": centroids" + ": " + ("|centroid - projection| mean %.4f px, max %.4f px, mean offset (%+.4f, %+.4f) px "
                      "over %d microimages (tolerance: mean 0.1, max 0.25 px)"
-                     % (e[:, 0].mean(), e[:, 0].max(), e[:, 1].mean(), e[:, 2].mean(), len(e)))
+                     % (e[:, 0].mean(), e[:, 0].max(), e[:, 1].mean(), e[:, 2].mean(), len(e))))
 
-
-def main():
-    args = camlib.common_args(__doc__).parse_args()
-    checks = camlib.Checks("microimage centres = central projection of the lens centres")
-    for case in CASES:
-        run_case(args, checks, *case)
-    return checks.finish()
-
-
-if __name__ == "__main__":
-    sys.exit(main())

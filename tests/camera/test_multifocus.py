@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Multi-focus arrays (focal_lengths <f0, f1, f2>): every lens type has its own blur.
 
@@ -24,11 +23,10 @@ microimage) and checks that
 """
 import math
 import os
-import sys
 
 import numpy as np
 
-import camlib
+import plenoptic_testing as pt
 
 W, H = 256, 192
 SX = 0.004
@@ -63,9 +61,9 @@ def render(args, name, focal_lengths):
              "  sensor { pixel_size %r } samples %d }\n"
              % ((Z_TARGET / 1000.0, F_MAIN, F_NUMBER, D, PITCH) + tuple(focal_lengths)
                 + (D_ARRAY, SX, SAMPLES)))
-    path = camlib.render(args.povray, args.work, name, scene, W, H)
-    img = camlib.load(path)[:, :, 0]
-    return img, camlib.metadata(path), D
+    path = pt.render(args.povray, args.work, name, scene, W, H)
+    img = pt.load(path)[:, :, 0]
+    return img, pt.metadata_of(path), D
 
 
 def sharpness(img, D):
@@ -82,9 +80,9 @@ def sharpness(img, D):
     out = {}
     for l in range(-12, 13):
         for k in range(-12, 13):
-            c = camlib.posed_lens_centre("hexagonal", PITCH, k, l, (0, 0, 0), (0, 0, 0), D)
+            c = pt.posed_lens_centre("hexagonal", PITCH, k, l, (0, 0, 0), (0, 0, 0), D)
             s = sensor_z / c[2]
-            u, v = camlib.sensor_to_pixel(c[0] * s, c[1] * s, W, H, SX, SX)
+            u, v = pt.sensor_to_pixel(c[0] * s, c[1] * s, W, H, SX, SX)
             if not (disc_px + 1 < u < W - 2 - disc_px and disc_px + 1 < v < H - 2 - disc_px):
                 continue
             sel = (uu - u) ** 2 + (vv - v) ** 2 <= r * r
@@ -99,52 +97,40 @@ def neighbours(k, l):
     return [(k - 1, l), (k + 1, l), (k, l - 1), (k + 1, l - 1), (k, l + 1), (k + 1, l + 1)]
 
 
-def analyse(checks, name, sharp, focal_lengths):
+def analyse(name, sharp, focal_lengths):
     blur = [predicted_blur_px(f) for f in focal_lengths]
     med = [float(np.median([s for (k, l), s in sharp.items() if lens_type(k, l) == t])) for t in range(3)]
     by_blur = sorted(range(3), key=lambda t: blur[t])
     by_sharp = sorted(range(3), key=lambda t: -med[t])
-    checks.check(by_blur == by_sharp and med[by_sharp[0]] > 1.5 * med[by_sharp[1]] and
-                 med[by_sharp[1]] > 1.5 * med[by_sharp[2]],
-                 name + ": sharpness per type follows the predicted blur",
-                 "focal lengths %s mm -> predicted blur %s px; median gradient energy per type %s "
+    assert (by_blur == by_sharp and med[by_sharp[0]] > 1.5 * med[by_sharp[1]] and
+                 med[by_sharp[1]] > 1.5 * med[by_sharp[2]]), (name + ": sharpness per type follows the predicted blur" + ": " + ("focal lengths %s mm -> predicted blur %s px; median gradient energy per type %s "
                  "(ordered as the blurs, each at least 1.5 times the next)"
-                 % (list(focal_lengths), [round(b, 2) for b in blur], [round(m, 5) for m in med]))
+                 % (list(focal_lengths), [round(b, 2) for b in blur], [round(m, 5) for m in med])))
     # Classify each microimage by its sharpness alone (nearest type median, in log scale).
     logm = np.log(med)
     cls = {key: int(np.argmin(np.abs(logm - math.log(max(s, 1e-12))))) for key, s in sharp.items()}
     wrong = [(key, lens_type(*key), cls[key]) for key in sharp if cls[key] != lens_type(*key)]
-    checks.check(not wrong and len(sharp) >= 30, name + ": each microimage's blur is its type's",
-                 "%d microimages measured, %d classified as another type %s"
-                 % (len(sharp), len(wrong), wrong[:5]))
+    assert (not wrong and len(sharp) >= 30), (name + ": each microimage's blur is its type's" + ": " + ("%d microimages measured, %d classified as another type %s"
+                 % (len(sharp), len(wrong), wrong[:5])))
     pairs = same = 0
     for key in sharp:
         for nb in neighbours(*key):
             if nb in sharp:
                 pairs += 1
                 same += cls[key] == cls[nb]
-    checks.check(pairs > 50 and same == 0, name + ": no two neighbours look alike",
-                 "%d neighbouring pairs measured, %d share a sharpness class (expected 0)" % (pairs // 2, same // 2))
+    assert (pairs > 50 and same == 0), name + ": no two neighbours look alike" + ": " + ("%d neighbouring pairs measured, %d share a sharpness class (expected 0)" % (pairs // 2, same // 2))
 
 
-def main():
-    args = camlib.common_args(__doc__).parse_args()
-    checks = camlib.Checks("multi-focus array: three lens types, neighbour rule")
+def test_multifocus(args):
     focal = (0.40, 0.42, 0.55)
     img, meta, D = render(args, "multifocus", focal)
     lattice = meta.get("microimage_lattice") or {}
-    checks.check(lattice.get("lens_types") == 3 and
-                 lattice.get("lens_type_rule", "").startswith("type(k, l) = (k - l) mod 3"),
-                 "metadata states the rule",
-                 "lens_types %r, lens_type_rule %r (expected 3 and the skew-index rule of docs/metadata.md)"
-                 % (lattice.get("lens_types"), lattice.get("lens_type_rule")))
-    analyse(checks, "focal_lengths <0.40, 0.42, 0.55>", sharpness(img, D), focal)
+    assert (lattice.get("lens_types") == 3 and
+                 lattice.get("lens_type_rule", "").startswith("type(k, l) = (k - l) mod 3")), ("metadata states the rule" + ": " + ("lens_types %r, lens_type_rule %r (expected 3 and the skew-index rule of docs/metadata.md)"
+                 % (lattice.get("lens_types"), lattice.get("lens_type_rule"))))
+    analyse("focal_lengths <0.40, 0.42, 0.55>", sharpness(img, D), focal)
     permuted = (0.55, 0.40, 0.42)
     img2, _, _ = render(args, "multifocus_permuted", permuted)
-    analyse(checks, "focal_lengths <0.55, 0.40, 0.42>", sharpness(img2, D), permuted)
-    camlib.save_png(os.path.join(args.work, "multifocus_view.png"), np.concatenate([img, img2], axis=1))
-    return checks.finish()
+    analyse("focal_lengths <0.55, 0.40, 0.42>", sharpness(img2, D), permuted)
+    pt.save_png(os.path.join(args.work, "multifocus_view.png"), np.concatenate([img, img2], axis=1))
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Rules of the camera block that a hostile new user found broken (issue 12, items 5 and 6).
 
@@ -9,8 +8,9 @@
    (checked on the render), and a normal camera prints no such warning.
 """
 import numpy as np
+import pytest
 
-import camlib
+import plenoptic_testing as pt
 
 WORLD = """#version 3.7;
 global_settings { assumed_gamma 1.0 }
@@ -27,49 +27,44 @@ def camera(*parts):
     return WORLD + "camera {\n  " + "\n  ".join((PLACE,) + parts) + "\n}\n"
 
 
-def main():
-    args = camlib.common_args(__doc__).parse_args()
-    checks = camlib.Checks("camera block rules: repeated blocks, silent black images")
+# 1. Repeated sensor blocks.
+SENSOR_CASES = [
+    ("sensor-repeated-empty", ["sensor { pixel_size 0.02 }", "sensor { }"], [0.01, 0.01], [0, 0]),
+    ("sensor-repeated-partial", ["sensor { pixel_size 0.02 offset <0.1, 0> }", "sensor { pixel_size 0.03 }"],
+     [0.03, 0.03], [0, 0]),
+    ("sensor-once", ["sensor { pixel_size 0.02 offset <0.1, 0> }"], [0.02, 0.02], [0.1, 0]),
+]
 
-    # 1. Repeated sensor blocks.
-    cases = [
-        ("sensor-repeated-empty", ["sensor { pixel_size 0.02 }", "sensor { }"], [0.01, 0.01], [0, 0]),
-        ("sensor-repeated-partial", ["sensor { pixel_size 0.02 offset <0.1, 0> }", "sensor { pixel_size 0.03 }"],
-         [0.03, 0.03], [0, 0]),
-        ("sensor-once", ["sensor { pixel_size 0.02 offset <0.1, 0> }"], [0.02, 0.02], [0.1, 0]),
-    ]
-    for name, blocks, pixel, offset in cases:
-        scene = camera("main_lens { thin_lens focal_length 16 f_number 4 focus_distance 2 }", ARRAY,
-                       *blocks, "samples 1")
-        image = camlib.render(args.povray, args.work, name, scene, 40, 30)
-        sensor = camlib.metadata(image)["sensor"]
-        checks.check(np.allclose(sensor["pixel_size_mm"], pixel) and np.allclose(sensor["offset_mm"], offset),
-                     name, "metadata pixel_size %s offset %s, expected %s %s"
-                     % (sensor["pixel_size_mm"], sensor["offset_mm"], pixel, offset))
-
-    # 2. Black images warn; normal ones do not.
-    lenses = [
-        ("dark-f-number", "main_lens { thin_lens focal_length 16 f_number 1e6 focus_distance 2 }", True),
-        ("dark-focus-at-focal-length",
-         "main_lens { thin_lens focal_length 16 f_number 4 focus_distance 0.016 + 1e-9 }", True),
-        ("normal", "main_lens { thin_lens focal_length 16 f_number 4 focus_distance 2 }", False),
-    ]
-    for name, lens, dark in lenses:
-        scene = camera(lens, ARRAY, "sensor { pixel_size 0.01 }", "samples 4")
-        rc, text = camlib.render(args.povray, args.work, name, scene, 60, 45, expect_failure=True)
-        if not checks.check(rc == 0, name + " renders", "exit %d" % rc):
-            print(text[-2000:])
-            continue
-        warned = " ".join(text.split()).count(DARK_WARNING)  # POV-Ray wraps its messages
-        mean = float(camlib.load(camlib.render(args.povray, args.work, name, scene, 60, 45))[:, :, :3].mean())
-        if dark:
-            checks.check(warned == 1, name + " warns", "warning printed %d time(s)" % warned)
-            checks.check(mean < 1e-3, name + " is indeed dark", "mean pixel value %.3g" % mean)
-        else:
-            checks.check(warned == 0 and mean > 0.05, name + " is quiet and lit",
-                         "warning printed %d time(s), mean %.3g" % (warned, mean))
-    return checks.finish()
+# 2. Black images warn; normal ones do not.
+LENSES = [
+    ("dark-f-number", "main_lens { thin_lens focal_length 16 f_number 1e6 focus_distance 2 }", True),
+    ("dark-focus-at-focal-length",
+     "main_lens { thin_lens focal_length 16 f_number 4 focus_distance 0.016 + 1e-9 }", True),
+    ("normal", "main_lens { thin_lens focal_length 16 f_number 4 focus_distance 2 }", False),
+]
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
+@pytest.mark.parametrize("name, blocks, pixel, offset", SENSOR_CASES, ids=[c[0] for c in SENSOR_CASES])
+def test_repeated_sensor_block_replaces(args, name, blocks, pixel, offset):
+    scene = camera("main_lens { thin_lens focal_length 16 f_number 4 focus_distance 2 }", ARRAY,
+                   *blocks, "samples 1")
+    image = pt.render(args.povray, args.work, name, scene, 40, 30)
+    sensor = pt.metadata_of(image)["sensor"]
+    assert np.allclose(sensor["pixel_size_mm"], pixel) and np.allclose(sensor["offset_mm"], offset), (
+        name + ": metadata pixel_size %s offset %s, expected %s %s"
+        % (sensor["pixel_size_mm"], sensor["offset_mm"], pixel, offset))
+
+
+@pytest.mark.parametrize("name, lens, dark", LENSES, ids=[c[0] for c in LENSES])
+def test_black_image_warns(args, name, lens, dark):
+    scene = camera(lens, ARRAY, "sensor { pixel_size 0.01 }", "samples 4")
+    rc, text = pt.render(args.povray, args.work, name, scene, 60, 45, expect_failure=True)
+    assert rc == 0, name + " renders: exit %d\n%s" % (rc, text[-2000:])
+    warned = " ".join(text.split()).count(DARK_WARNING)  # POV-Ray wraps its messages
+    mean = float(pt.load(pt.render(args.povray, args.work, name, scene, 60, 45))[:, :, :3].mean())
+    if dark:
+        assert warned == 1, name + " warns: warning printed %d time(s)" % warned
+        assert mean < 1e-3, name + " is indeed dark: mean pixel value %.3g" % mean
+    else:
+        assert warned == 0 and mean > 0.05, (name + " is quiet and lit: warning printed %d time(s), mean %.3g"
+                                             % (warned, mean))

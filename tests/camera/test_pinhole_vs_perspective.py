@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Pinhole main lens, no array == POV-Ray's stock perspective camera.
 
@@ -19,12 +18,11 @@ offset, a direction vector tilted by (-ox, -oy) / (H sy) in right/up units.
 import math
 import shutil
 import os
-import subprocess
-import sys
 
 import numpy as np
+import pytest
 
-import camlib
+import plenoptic_testing as pt
 
 LOCATION = (0.15, 0.7, -3.0)
 LOOK_AT = (0.0, 0.45, 0.0)
@@ -72,39 +70,28 @@ def stock_camera(W, H, sx, sy, D, ox, oy):
             % (vec(loc), vec(x * (W * sx / unit)), vec(y), vec(z * (D / unit) - x * (ox / unit) - y * (oy / unit))))
 
 
-def main():
-    args = camlib.common_args(__doc__).parse_args()
-    checks = camlib.Checks("pinhole main lens == stock perspective camera")
+@pytest.mark.parametrize("name, W, H, sx, sy, D, ox, oy", CASES, ids=[c[0] for c in CASES])
+def test_pinhole_vs_perspective(args, name, W, H, sx, sy, D, ox, oy):
     idiff = shutil.which("idiff")
-    for name, W, H, sx, sy, D, ox, oy in CASES:
-        stock = stock_camera(W, H, sx, sy, D, ox, oy)
-        plen = ("camera { plenoptic location %s look_at %s\n"
-                "  main_lens { pinhole distance %r }\n"
-                "  sensor { pixel_size <%r, %r> offset <%r, %r> } }" % (vec(LOCATION), vec(LOOK_AT), D, sx, sy, ox, oy))
-        a = camlib.render(args.povray, args.work, name + "_stock", camlib.TEXTURED_SCENE + stock, W, H)
-        b = camlib.render(args.povray, args.work, name + "_plenoptic", camlib.TEXTURED_SCENE + plen, W, H)
-        ia, ib = camlib.load(a), camlib.load(b)
-        diff = np.abs(ia - ib).max(axis=2)
-        n_diff = int((diff > 0).sum())
-        where = ""
-        if n_diff:
-            j, i = np.unravel_index(np.argmax(diff), diff.shape)
-            where = "; largest at pixel (%d, %d): stock %s plenoptic %s" % (
-                i, j, np.round(ia[j, i], 4).tolist(), np.round(ib[j, i], 4).tolist())
-            camlib.save_png(os.path.join(args.work, name + "_diff.png"), np.minimum(1, 16 * diff))
-        checks.check(n_diff == 0, name,
-                     "%dx%d sx=%g sy=%g D=%g offset=(%g, %g): %d of %d pixels differ, max |diff| %.3g (expected 0)%s"
-                     % (W, H, sx, sy, D, ox, oy, n_diff, W * H, float(diff.max()), where))
-        if idiff:
-            res = subprocess.run([idiff, "-fail", "0", "-failpercent", "0", "-hardfail", "0", a, b],
-                                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-            out = res.stdout.decode(errors="replace").strip().splitlines()
-            checks.check(res.returncode == 0, name + " (idiff)",
-                         "idiff exit %d (0 = identical): %s" % (res.returncode, out[-1] if out else ""))
-        else:
-            checks.check(False, name + " (idiff)", "OpenImageIO's idiff is not installed")
-    return checks.finish()
+    stock = stock_camera(W, H, sx, sy, D, ox, oy)
+    plen = ("camera { plenoptic location %s look_at %s\n"
+            "  main_lens { pinhole distance %r }\n"
+            "  sensor { pixel_size <%r, %r> offset <%r, %r> } }" % (vec(LOCATION), vec(LOOK_AT), D, sx, sy, ox, oy))
+    a = pt.render(args.povray, args.work, name + "_stock", pt.TEXTURED_SCENE + stock, W, H)
+    b = pt.render(args.povray, args.work, name + "_plenoptic", pt.TEXTURED_SCENE + plen, W, H)
+    ia, ib = pt.load(a), pt.load(b)
+    diff = np.abs(ia - ib).max(axis=2)
+    n_diff = int((diff > 0).sum())
+    where = ""
+    if n_diff:
+        j, i = np.unravel_index(np.argmax(diff), diff.shape)
+        where = "; largest at pixel (%d, %d): stock %s plenoptic %s" % (
+            i, j, np.round(ia[j, i], 4).tolist(), np.round(ib[j, i], 4).tolist())
+        pt.save_png(os.path.join(args.work, name + "_diff.png"), np.minimum(1, 16 * diff))
+    assert (n_diff == 0), (name + ": " + ("%dx%d sx=%g sy=%g D=%g offset=(%g, %g): %d of %d pixels differ, max |diff| %.3g (expected 0)%s"
+                 % (W, H, sx, sy, D, ox, oy, n_diff, W * H, float(diff.max()), where)))
+    assert idiff, name + " (idiff): OpenImageIO's idiff is not installed"
+    code, report = pt.idiff(a, b, ["-fail", "0", "-failpercent", "0", "-hardfail", "0"])
+    out = report.splitlines()
+    assert code == 0, name + " (idiff): " + ("idiff exit %d (0 = identical): %s" % (code, out[-1] if out else ""))
 
-
-if __name__ == "__main__":
-    sys.exit(main())

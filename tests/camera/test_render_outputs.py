@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """What a plenoptic render prints and writes beside its image (issue 12, item 7):
 
@@ -12,9 +11,8 @@
 """
 import os
 import re
-import subprocess
 
-import camlib
+import plenoptic_testing as pt
 
 SCENE = """#version %s;
 global_settings { assumed_gamma 1.0 }
@@ -32,57 +30,43 @@ camera {
 
 
 def povray(args, work, scene_name, scene, extra):
-    path = os.path.join(work, scene_name)
-    with open(path, "w") as f:
-        f.write(scene)
-    return subprocess.run([args.povray, "+I" + path, "+W40", "+H30", "-D", "-P", "-GR", "+FN8"] + extra,
-                          cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=120)
+    path = pt.write_text(os.path.join(work, scene_name), scene)
+    return pt.run_process([args.povray, "+I" + path, "+W40", "+H30", "-D", "-P", "-GR", "+FN8"] + extra,
+                          cwd=work, timeout=120, separate=True, binary=True)
 
 
-def main():
-    args = camlib.common_args(__doc__).parse_args()
+def test_render_outputs(args):
     os.makedirs(args.work, exist_ok=True)
-    checks = camlib.Checks("what a render writes and prints")
 
     # 1. +O-
     for stale in os.listdir(args.work):
         os.remove(os.path.join(args.work, stale))
     res = povray(args, args.work, "piped.pov", SCENE % "3.7", ["+O-"])
     err = " ".join(res.stderr.decode(errors="replace").split())
-    checks.check(res.returncode == 0 and res.stdout[:8] == b"\x89PNG\r\n\x1a\n", "+O- writes a PNG to stdout",
-                 "exit %d, stdout starts %r" % (res.returncode, res.stdout[:8]))
+    assert (res.returncode == 0 and res.stdout[:8] == b"\x89PNG\r\n\x1a\n"), "+O- writes a PNG to stdout" + ": " + ("exit %d, stdout starts %r" % (res.returncode, res.stdout[:8]))
     strays = [n for n in os.listdir(args.work) if n.startswith("stdout")]
-    checks.check(not strays, "+O- leaves no stdout.* file", "files: %s" % strays)
-    checks.check("standard output (+O-)" in err, "+O- says why there is no metadata",
-                 err[max(0, err.find("standard output") - 60):][:180])
+    assert not strays, "+O- leaves no stdout.* file" + ": " + ("files: %s" % strays)
+    assert "standard output (+O-)" in err, "+O- says why there is no metadata" + ": " + (err[max(0, err.find("standard output") - 60):][:180])
 
     # 2. A long output name.
     stem = "n" * 240
     res = povray(args, args.work, "long.pov", SCENE % "3.7", ["+O" + stem + ".png"])
     names = set(os.listdir(args.work))
-    checks.check(res.returncode == 0 and stem + ".plenoptic.json" in names and stem + ".depth.exr" in names,
-                 "a 244-character output name gets its metadata and depth map",
-                 "exit %d, metadata %s, depth %s" % (res.returncode, stem + ".plenoptic.json" in names,
-                                                     stem + ".depth.exr" in names))
+    assert (res.returncode == 0 and stem + ".plenoptic.json" in names and stem + ".depth.exr" in names), ("a 244-character output name gets its metadata and depth map" + ": " + ("exit %d, metadata %s, depth %s" % (res.returncode, stem + ".plenoptic.json" in names,
+                                                     stem + ".depth.exr" in names)))
     leftovers = [n for n in names if n.startswith(".plenoptic-")]
-    checks.check(not leftovers, "no temporary file is left", "%s" % leftovers)
+    assert not leftovers, "no temporary file is left" + ": " + ("%s" % leftovers)
 
     # 3. Samples in the statistics.
     res = povray(args, args.work, "stats.pov", SCENE % "3.7", ["+Ostats.png"])
     out = res.stdout.decode(errors="replace") + res.stderr.decode(errors="replace")
     m = re.search(r"Pixels:\s+(\d+)\s+Samples:\s+(\d+)", out)
     expected = 40 * 30 * 4
-    checks.check(m is not None and int(m.group(1)) == 1200 and int(m.group(2)) == expected,
-                 "statistics count the rays traced", "%s (expected Pixels 1200, Samples %d)"
-                 % (m.group(0) if m else "no statistics line", expected))
+    assert (m is not None and int(m.group(1)) == 1200 and int(m.group(2)) == expected), ("statistics count the rays traced" + ": " + ("%s (expected Pixels 1200, Samples %d)"
+                 % (m.group(0) if m else "no statistics line", expected)))
 
     # 4. #version 3.1
     res = povray(args, args.work, "old.pov", SCENE % "3.1", ["+Oold.png"])
     err = " ".join((res.stdout + res.stderr).decode(errors="replace").split())
-    checks.check(res.returncode != 0 and "needs #version 3.5 or later" in err and "3.1" in err,
-                 "#version 3.1 names the version the camera needs", err[err.find("Parse Error"):][:160])
-    return checks.finish()
+    assert (res.returncode != 0 and "needs #version 3.5 or later" in err and "3.1" in err), "#version 3.1 names the version the camera needs" + ": " + (err[err.find("Parse Error"):][:160])
 
-
-if __name__ == "__main__":
-    raise SystemExit(main())

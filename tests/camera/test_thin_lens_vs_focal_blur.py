@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Thin main lens, no array == stock perspective camera with focal_blur.
 
@@ -28,11 +27,10 @@ pixels' noise is not independent), and no blurred pixel may differ by more than 
 that tolerance.
 """
 import math
-import sys
 
 import numpy as np
 
-import camlib
+import plenoptic_testing as pt
 
 MM_PER_UNIT = 250.0   # a quarter-scale scene: large blur for a modest lens
 LOCATION = np.array([0.15, 0.7, -3.0])
@@ -49,7 +47,7 @@ BLUR_K = 6            # box blur for the low-noise comparison
 def stock_camera(aperture_units, samples):
     direction = (LOOK_AT - LOCATION) / np.linalg.norm(LOOK_AT - LOCATION)
     focal_point = LOCATION + FOCUS * direction
-    D = camlib.thin_lens_D(F, FOCUS * MM_PER_UNIT)
+    D = pt.thin_lens_D(F, FOCUS * MM_PER_UNIT)
     angle = 2 * math.degrees(math.atan(W * PIXEL / (2 * D)))
     v = lambda a: "<%.17g, %.17g, %.17g>" % tuple(a)
     return ("camera { perspective location %s look_at %s right x*%r/%r up y angle %.17g\n"
@@ -70,14 +68,12 @@ def mad(a, b):
     return float(np.abs(a - b).mean())
 
 
-def main():
-    args = camlib.common_args(__doc__).parse_args()
-    checks = camlib.Checks("thin main lens == stock perspective + focal_blur")
+def test_thin_lens_vs_focal_blur(args):
     A = F / F_NUMBER
-    scene = camlib.TEXTURED_SCENE
+    scene = pt.TEXTURED_SCENE
 
     def go(name, cam):
-        return camlib.load(camlib.render(args.povray, args.work, name, scene + cam, W, H))[:, :, :3]
+        return pt.load(pt.render(args.povray, args.work, name, scene + cam, W, H))[:, :, :3]
 
     plen = go("plenoptic_n%d" % N, plenoptic_camera(N))
     stock = go("stock_n%d" % N, stock_camera(2 * A / MM_PER_UNIT, N))
@@ -89,36 +85,32 @@ def main():
     expected = scale * noise
     tol = 1.5 * expected
     measured = mad(plen, stock)
-    checks.check(measured <= tol, "mean |plenoptic - stock|",
-                 "%.5f; stock noise scale (N vs 4N) %.5f -> expected %.5f from noise, tolerance %.5f"
-                 % (measured, noise, expected, tol))
+    assert (measured <= tol), ("mean |plenoptic - stock|" + ": " + ("%.5f; stock noise scale (N vs 4N) %.5f -> expected %.5f from noise, tolerance %.5f"
+                 % (measured, noise, expected, tol)))
 
-    bp, bs, bs4, bn = [camlib.box_blur(x, BLUR_K) for x in (plen, stock, stock4, naive)]
+    bp, bs, bs4, bn = [pt.box_blur(x, BLUR_K) for x in (plen, stock, stock4, naive)]
     bnoise = mad(bs, bs4)
     btol = 1.5 * scale * bnoise
     # A blurred image still holds pixels whose noise is not independent (neighbouring
     # pixels share texture), so the blurred noise is measured, not divided by k.
     bmeasured = mad(bp, bs)
-    checks.check(bmeasured <= btol, "mean |blur(plenoptic) - blur(stock)|",
-                 "%.5f; blurred stock noise (N vs 4N) %.5f -> tolerance %.5f (independent noise "
-                 "would give %.5f)" % (bmeasured, bnoise, btol, 1.5 * scale * noise / BLUR_K))
+    assert (bmeasured <= btol), ("mean |blur(plenoptic) - blur(stock)|" + ": " + ("%.5f; blurred stock noise (N vs 4N) %.5f -> tolerance %.5f (independent noise "
+                 "would give %.5f)" % (bmeasured, bnoise, btol, 1.5 * scale * noise / BLUR_K)))
     worst = float(np.abs(bp - bs).max())
     wtol = 8 * btol
-    checks.check(worst <= wtol, "max |blur(plenoptic) - blur(stock)|",
-                 "%.4f, tolerance %.4f (8 x the mean tolerance: the tail of the noise)" % (worst, wtol))
+    assert worst <= wtol, "max |blur(plenoptic) - blur(stock)|" + ": " + ("%.4f, tolerance %.4f (8 x the mean tolerance: the tail of the noise)" % (worst, wtol))
 
     # The same metrics must reject the stock camera with the naive aperture (half the
     # blur): otherwise the tolerance could not tell a wrong lens from noise.
     naive_mad = mad(plen, naive)
     naive_bmad = mad(bp, bn)
-    checks.check(naive_mad > tol and naive_bmad > btol, "half-aperture stock camera is rejected",
-                 "mean |diff| %.5f (tolerance %.5f), blurred %.5f (tolerance %.5f)"
-                 % (naive_mad, tol, naive_bmad, btol))
+    assert (naive_mad > tol and naive_bmad > btol), ("half-aperture stock camera is rejected" + ": " + ("mean |diff| %.5f (tolerance %.5f), blurred %.5f (tolerance %.5f)"
+                 % (naive_mad, tol, naive_bmad, btol)))
 
     # Out-of-focus parts must actually be blurred: the far wall's blur disc is
     # A D |1/z - 1/z'| wide; the in-focus sphere is sharp. Compare gradient energy with
     # the same scene through a pinhole (one sample, no blur).
-    D = camlib.thin_lens_D(F, FOCUS * MM_PER_UNIT)
+    D = pt.thin_lens_D(F, FOCUS * MM_PER_UNIT)
     wall_z = (3.0 - LOCATION[2]) * MM_PER_UNIT
     blur_px = A * D * abs(1 / (FOCUS * MM_PER_UNIT) - 1 / wall_z) / PIXEL
     v = lambda a: "<%.17g, %.17g, %.17g>" % tuple(a)
@@ -128,11 +120,6 @@ def main():
     grad = lambda x: float((np.diff(x.mean(axis=2), axis=1) ** 2).mean())
     top = slice(0, H // 4)  # the wall fills the top quarter
     ratio = grad(plen[top]) / grad(sharp[top])
-    checks.check(ratio < 0.5, "far wall is blurred",
-                 "gradient energy of the top quarter is %.3f of the pinhole image's "
-                 "(expected well below 0.5: blur disc %.1f px across)" % (ratio, blur_px))
-    return checks.finish()
+    assert (ratio < 0.5), ("far wall is blurred" + ": " + ("gradient energy of the top quarter is %.3f of the pinhole image's "
+                 "(expected well below 0.5: blur disc %.1f px across)" % (ratio, blur_px)))
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Determinism: one scene of tests/golden/scenes.json, rendered with one render thread, with
 two, and with two threads and small render blocks (another split of the work), must give
@@ -8,14 +7,16 @@ render), the metadata JSON and the depth EXR when there is one.
 The specification (docs/specification.md, section 3) asks for the same image whatever the
 thread count; POV-Ray's own focal blur has the same property.
 """
-import argparse
 import hashlib
 import os
 import struct
-import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import golden  # noqa: E402  (render() and the scene table)
+import pytest
+
+import plenoptic_testing as pt
+
+# The scenes ctest runs as determinism_<scene> (tests/golden/CMakeLists.txt).
+SCENES = ["plenoptic1_hex", "adaptive", "overlap_hex", "thin_none", "tilted_array", "depth_outputs"]
 
 VARIANTS = [
     ("wt1", ["+WT1"]),
@@ -69,38 +70,28 @@ def pixel_report(a, b):
         return "(cannot compare pixels: %s)" % e
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--povray", required=True)
-    ap.add_argument("--scene", required=True)
-    ap.add_argument("--work", required=True)
-    args = ap.parse_args()
-
-    s = golden.settings(golden.load_table(), args.scene)
+@pytest.mark.parametrize("scene", SCENES)
+def test_determinism(args, scene):
+    s = pt.golden_settings(pt.golden_table(), scene)
     # Thread options of the golden row are replaced by each variant's.
     s["options"] = [o for o in s.get("options", []) if not o.upper().startswith(("+WT", "+BS"))]
     files = {}
     for label, extra in VARIANTS:
-        out = os.path.join(os.path.abspath(args.work), args.scene, label)
-        try:
-            golden.render(args.povray, args.scene, s, out, extra=["+FN16"] + extra)
-        except RuntimeError as e:
-            print("FAIL %s: %s" % (args.scene, e))
-            return 1
+        out = os.path.join(args.work, scene, label)
+        pt.render_golden(args.povray, scene, s, out, extra=["+FN16"] + extra)
         files[label] = {}
         for suffix in (".png", ".plenoptic.json", ".depth.exr"):
-            p = os.path.join(out, args.scene + suffix)
+            p = os.path.join(out, scene + suffix)
             if os.path.exists(p):
                 files[label][suffix] = p
 
-    failed = False
+    failures = []
     base_label = VARIANTS[0][0]
     base = files[base_label]
     for label, _ in VARIANTS[1:]:
         other = files[label]
         if sorted(base) != sorted(other):
-            print("FAIL %s: %s wrote %s, %s wrote %s" % (args.scene, base_label, sorted(base), label, sorted(other)))
-            failed = True
+            failures.append("%s wrote %s, %s wrote %s" % (base_label, sorted(base), label, sorted(other)))
             continue
         for suffix in sorted(base):
             a, b = base[suffix], other[suffix]
@@ -108,14 +99,5 @@ def main():
                 print("same bytes: %s %s vs %s (%d bytes)" % (suffix, base_label, label, os.path.getsize(a)))
             else:
                 extra = pixel_report(a, b) if suffix == ".png" else ""
-                print("FAIL %s: %s differs between %s and %s: %s vs %s %s"
-                      % (args.scene, suffix, base_label, label, a, b, extra))
-                failed = True
-    if failed:
-        return 1
-    print("ok   %s: byte-identical with %s" % (args.scene, ", ".join(l for l, _ in VARIANTS)))
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+                failures.append("%s differs between %s and %s: %s vs %s %s" % (suffix, base_label, label, a, b, extra))
+    assert not failures, "%s: %s" % (scene, "\n".join(failures))

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Golden-image regression test of one scene of tests/golden/scenes.json.
 
@@ -17,76 +16,25 @@ Regenerating the references (only after a change that is meant to change images,
 docs/testing.md): set PLENOPTIC_UPDATE_GOLDEN=1 in the environment of ctest
 (`PLENOPTIC_UPDATE_GOLDEN=1 ctest -R '^golden_'`); it is the only switch.
 """
-import argparse
-import json
 import os
 import shutil
-import subprocess
-import sys
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-SCENES_DIR = os.path.join(HERE, "scenes")
-REF_DIR = os.path.join(HERE, "references")
-TABLE = os.path.join(HERE, "scenes.json")
+import numpy as np
+import pytest
+
+import plenoptic_testing as pt
+
+REF_DIR = os.path.join(pt.GOLDEN_DIR, "references")
 UPDATE_VARIABLE = "PLENOPTIC_UPDATE_GOLDEN"
-
-sys.path.insert(0, os.path.join(HERE, "..", "metadata"))
-import metadata_schema  # noqa: E402  (tests/metadata: the strict reader and the schema check)
-
-
-def load_table(path=TABLE):
-    with open(path) as f:
-        table = json.load(f)
-    return table
-
-
-def settings(table, name):
-    """The scene's row merged over the defaults (one level deep for the threshold blocks)."""
-    if name not in table["scenes"]:
-        raise KeyError("scene '%s' is not in %s" % (name, TABLE))
-    row = table["scenes"][name]
-    out = {}
-    for k, v in table["defaults"].items():
-        out[k] = dict(v) if isinstance(v, dict) else v
-    for k, v in row.items():
-        if isinstance(v, dict) and isinstance(out.get(k), dict):
-            out[k].update(v)
-        else:
-            out[k] = v
-    return out
-
-
-def render(povray, name, s, out_dir, extra=()):
-    """Renders scenes/<name>.pov into out_dir/<name>.png; returns the povray output text."""
-    os.makedirs(out_dir, exist_ok=True)
-    png = os.path.join(out_dir, name + ".png")
-    for suffix in (".png", ".plenoptic.json", ".depth.exr"):
-        p = os.path.join(out_dir, name + suffix)
-        if os.path.exists(p):
-            os.remove(p)
-    cmd = [povray, "+I" + os.path.join(SCENES_DIR, name + ".pov"), "+O" + png,
-           "+W%d" % s["width"], "+H%d" % s["height"], "-D", "-P", "+FN8", "-GS", "-GR",
-           "+L" + SCENES_DIR] + list(s.get("options", [])) + list(extra)
-    res = subprocess.run(cmd, cwd=out_dir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                         timeout=600)
-    text = res.stdout.decode(errors="replace")
-    if res.returncode != 0 or not os.path.exists(png):
-        raise RuntimeError("render of %s failed (exit %d):\n  %s\n%s"
-                           % (name, res.returncode, " ".join(cmd), text[-3000:]))
-    return text
+SCENES = sorted(pt.golden_table()["scenes"])
 
 
 def idiff(ref, new, t, diff_out):
     """Runs idiff with the thresholds t; returns (passed, exit code, idiff's report)."""
-    exe = shutil.which("idiff")
-    if not exe:
-        raise RuntimeError("OpenImageIO's idiff is not installed (Debian: openimageio-tools)")
-    cmd = [exe, "-fail", str(t["fail"]), "-failpercent", str(t["failpercent"]),
-           "-hardfail", str(t["hardfail"]), "-abs", "-scale", "16", "-o", diff_out, ref, new]
-    res = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-    text = res.stdout.decode(errors="replace").strip()
+    code, text = pt.idiff(ref, new, ["-fail", str(t["fail"]), "-failpercent", str(t["failpercent"]),
+                                     "-hardfail", str(t["hardfail"])], diff_out=diff_out)
     # 0: identical within -fail; 1: warning only; 2: failure; 3: size mismatch; 4: file error.
-    return res.returncode in (0, 1), res.returncode, text
+    return code in (0, 1), code, text
 
 
 def compare_json(ref, new, rel, absolute, path="", out=None):
@@ -124,16 +72,7 @@ def compare_json(ref, new, rel, absolute, path="", out=None):
 
 def compare_depth(ref, new, t, diff_out):
     """Depth maps: special values must match exactly, finite depths within t (idiff)."""
-    import numpy as np
-    import OpenImageIO as oiio
-
-    def read(p):
-        buf = oiio.ImageBuf(p)
-        if buf.has_error:
-            raise RuntimeError("cannot read %s: %s" % (p, buf.geterror()))
-        return buf.get_pixels(oiio.FLOAT)
-
-    a, b = read(ref), read(new)
+    a, b = pt.read_pixels(ref), pt.read_pixels(new)
     problems = []
     if a.shape != b.shape:
         return ["depth map size %s, reference %s" % (b.shape, a.shape)]
@@ -153,13 +92,16 @@ def compare_depth(ref, new, t, diff_out):
     return problems
 
 
-def run(povray, name, work, update):
-    table = load_table()
-    s = settings(table, name)
+@pytest.mark.parametrize("name", SCENES)
+def test_golden(args, name):
+    # The one switch that regenerates references (docs/testing.md).
+    update = os.environ.get(UPDATE_VARIABLE, "") not in ("", "0")
+    povray, work = args.povray, args.work
+    s = pt.golden_settings(pt.golden_table(), name)
     out_dir = os.path.join(work, name)
     if os.path.exists(out_dir):
         shutil.rmtree(out_dir)
-    render(povray, name, s, out_dir)
+    pt.render_golden(povray, name, s, out_dir)
     png = os.path.join(out_dir, name + ".png")
     meta = os.path.join(out_dir, name + ".plenoptic.json")
     depth = os.path.join(out_dir, name + ".depth.exr")
@@ -175,10 +117,7 @@ def run(povray, name, work, update):
         failures.append("metadata %s: expected %s" % (meta, "to exist" if expect_meta else "none"))
     if expect_depth != os.path.exists(depth):
         failures.append("depth map %s: expected %s" % (depth, "to exist" if expect_depth else "none"))
-    if failures:
-        for f in failures:
-            print("FAIL %s: %s" % (name, f))
-        return 1
+    assert not failures, "%s: %s" % (name, "; ".join(failures))
 
     if update:
         os.makedirs(REF_DIR, exist_ok=True)
@@ -190,13 +129,11 @@ def run(povray, name, work, update):
                 os.remove(ref)
         print("UPDATED references of %s in %s (%s=1): look at %s before committing it"
               % (name, REF_DIR, UPDATE_VARIABLE, ref_png))
-        return 0
+        return
 
     for ref, wanted in ((ref_png, True), (ref_meta, expect_meta), (ref_depth, expect_depth)):
-        if wanted and not os.path.exists(ref):
-            print("FAIL %s: no reference %s; create it with %s=1 (see docs/testing.md)"
-                  % (name, ref, UPDATE_VARIABLE))
-            return 1
+        assert not wanted or os.path.exists(ref), ("%s: no reference %s; create it with %s=1 (see docs/testing.md)"
+                                                   % (name, ref, UPDATE_VARIABLE))
 
     img_t = s["image"]
     diff_png = os.path.join(out_dir, name + ".diff.png")
@@ -211,12 +148,8 @@ def run(povray, name, work, update):
 
     if expect_meta:
         # Both read strictly and checked against docs/metadata.schema.json.
-        try:
-            r = metadata_schema.load(ref_meta)
-            m = metadata_schema.load(meta)
-        except metadata_schema.MetadataError as e:
-            print("FAIL %s: %s" % (name, e))
-            return 1
+        r = pt.load_metadata(ref_meta)
+        m = pt.load_metadata(meta)
         mt = s["metadata"]
         diffs = compare_json(r, m, mt["rel"], mt["abs"])
         print("metadata: %d field difference(s) beyond abs %g + rel %g" % (len(diffs), mt["abs"], mt["rel"]))
@@ -233,30 +166,6 @@ def run(povray, name, work, update):
         elif os.path.exists(depth_diff):
             os.remove(depth_diff)
 
-    if failures:
-        for f in failures:
-            print("FAIL %s: %s" % (name, f))
-        print("If this change is intended, regenerate with %s=1 (docs/testing.md) and look at the new images."
-              % UPDATE_VARIABLE)
-        return 1
-    print("ok   %s" % name)
-    return 0
+    assert not failures, ("%s:\n%s\nIf this change is intended, regenerate with %s=1 (docs/testing.md) and look at "
+                          "the new images." % (name, "\n".join(failures), UPDATE_VARIABLE))
 
-
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--povray", required=True)
-    ap.add_argument("--scene", required=True, help="name of a row of scenes.json")
-    ap.add_argument("--work", required=True, help="scratch directory")
-    args = ap.parse_args()
-    # The one switch that regenerates references (docs/testing.md).
-    update = os.environ.get(UPDATE_VARIABLE, "") not in ("", "0")
-    try:
-        return run(args.povray, args.scene, os.path.abspath(args.work), update)
-    except (RuntimeError, KeyError, subprocess.TimeoutExpired) as e:
-        print("FAIL %s: %s" % (args.scene, e))
-        return 1
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -27,11 +27,10 @@ import os
 import shutil
 import struct
 import subprocess
-import sys
 
 import numpy as np
 
-import gt_common as gt
+import plenoptic_testing as pt
 
 W, H = 96, 72
 C = (0.8, 0.35, 0.05)  # linear radiance of the plane; 0.05 is on the steep part of the sRGB curve
@@ -94,7 +93,7 @@ def png_chunks(path):
     """{chunk type: [payloads]} of a PNG file, read byte by byte."""
     data = open(path, "rb").read()
     if data[:8] != b"\x89PNG\r\n\x1a\n":
-        raise SystemExit("FAIL: %s is not a PNG file" % path)
+        raise AssertionError("%s is not a PNG file" % path)
     chunks, i = {}, 8
     while i + 8 <= len(data):
         length, kind = struct.unpack(">I4s", data[i:i + 8])
@@ -113,20 +112,17 @@ def render(args, name, ext, options):
     for stale in (name + "." + ext, name + ".plenoptic.json"):
         if os.path.exists(os.path.join(args.work, stale)):
             os.remove(os.path.join(args.work, stale))
-    with open(os.path.join(args.work, "encoding.pov"), "w") as f:
-        f.write(gt.SCENE_HEADER + SCENE)
+    pt.write_text(os.path.join(args.work, "encoding.pov"), pt.SCENE_HEADER + SCENE)
     cmd = [args.povray, "+Iencoding.pov", "+O%s.%s" % (name, ext), "+W%d" % W, "+H%d" % H, "-D", "-P"] + options
-    run = subprocess.run(cmd, cwd=args.work, capture_output=True, text=True)
-    if run.returncode != 0:
-        sys.stderr.write(run.stderr[-3000:])
-        raise SystemExit("FAIL: rendering %s exited with status %d" % (name, run.returncode))
+    run = pt.run_process(cmd, cwd=args.work, timeout=300)
+    assert run.returncode == 0, "rendering %s exited with status %d\n%s" % (name, run.returncode, run.output[-3000:])
     return os.path.join(args.work, name + "." + ext)
 
 
 def decode(args, image, out, extra=()):
     """Runs plenoptic-decode; (exit status, stderr, centre view (T, S, 3) or None)."""
     shutil.rmtree(out, ignore_errors=True)
-    run = subprocess.run([sys.executable, os.path.join(args.tools, "plenoptic-decode"), image, "-o", out,
+    run = subprocess.run(pt.decoder(args.tools) + [image, "-o", out,
                           "--no-gif"] + list(extra), capture_output=True, text=True)
     npy = os.path.join(out, "lightfield.npy")
     if run.returncode != 0 or not os.path.exists(npy):
@@ -135,13 +131,11 @@ def decode(args, image, out, extra=()):
     description = json.load(open(os.path.join(out, "lightfield.json")))
     n_v, n_u = data.shape[2:4]
     if not description["usable_mask"][n_v // 2][n_u // 2]:
-        raise SystemExit("FAIL: the centre angular sample of %s is not usable" % image)
+        raise AssertionError("the centre angular sample of %s is not usable" % image)
     return run.returncode, run.stderr, data[:, :, n_v // 2, n_u // 2, :].astype(np.float64)
 
 
-def main():
-    args = gt.parse_args(__doc__)
-    checks = gt.Checks("ground_truth_decode_encoding")
+def test_decode_encoding(args):
     expected = np.array(C)
 
     # What povray writes and OpenImageIO reports.
@@ -154,15 +148,12 @@ def main():
         return [struct.unpack(">I", c)[0] for c in chunks[name].get("gAMA", [])]
 
     for name in ("linear16", "linear8"):
-        checks.check(gama(name) == [100000] and "sRGB" not in chunks[name] and "iCCP" not in chunks[name],
-                     "%s (File_Gamma=1.0): gAMA %s, sRGB chunk %s, iCCP %s (want gAMA 100000 alone)"
+        assert (gama(name) == [100000] and "sRGB" not in chunks[name] and "iCCP" not in chunks[name]), ("%s (File_Gamma=1.0): gAMA %s, sRGB chunk %s, iCCP %s (want gAMA 100000 alone)"
                      % (name, gama(name), "sRGB" in chunks[name], "iCCP" in chunks[name]))
     for name in ("srgb16", "srgb8"):
-        checks.check("sRGB" in chunks[name] and gama(name) == [45455],
-                     "%s (default File_Gamma, sRGB): sRGB chunk %s, gAMA %s (want an sRGB chunk and gAMA 45455)"
+        assert ("sRGB" in chunks[name] and gama(name) == [45455]), ("%s (default File_Gamma, sRGB): sRGB chunk %s, gAMA %s (want an sRGB chunk and gAMA 45455)"
                      % (name, "sRGB" in chunks[name], gama(name)))
-    checks.check(gama("gamma22_16") == [45455] and "sRGB" not in chunks["gamma22_16"],
-                 "gamma22_16 (File_Gamma=2.2): gAMA %s, sRGB chunk %s (want gAMA 45455 alone)"
+    assert (gama("gamma22_16") == [45455] and "sRGB" not in chunks["gamma22_16"]), ("gamma22_16 (File_Gamma=2.2): gAMA %s, sRGB chunk %s (want gAMA 45455 alone)"
                  % (gama("gamma22_16"), "sRGB" in chunks["gamma22_16"]))
     for name, ext, options, bits, curve in CASES:
         print("      %-11s %s %-28s OpenImageIO: oiio:ColorSpace %r, oiio:Gamma %g"
@@ -172,16 +163,14 @@ def main():
     centres = {}
     for name, ext, options, bits, curve in CASES:
         status, stderr, centre = decode(args, files[name], os.path.join(args.work, "encoding_%s.lightfield" % name))
-        if not checks.check(status == 0 and centre is not None, "%s: plenoptic-decode exits 0 (got %d%s)"
-                            % (name, status, "; stderr %r" % stderr[-400:] if status else "")):
-            continue
+        assert status == 0 and centre is not None, ("%s: plenoptic-decode exits 0 (got %d%s)"
+                                                    % (name, status, "; stderr %r" % stderr[-400:] if status else ""))
         want_word = "encoding %s" % (curve if isinstance(curve, str) else "gamma %g" % curve)
-        checks.check(want_word in stderr, "%s: the decoder says which encoding it applied: %r in %r"
+        assert (want_word in stderr), ("%s: the decoder says which encoding it applied: %r in %r"
                      % (name, want_word, [l for l in stderr.splitlines() if "encoding" in l]))
         bound = quantisation_bound(expected, bits, curve)
         error = np.abs(centre - expected).reshape(-1, 3).max(axis=0)
-        checks.check(np.all(error <= bound),
-                     "%s (%s, %s %s): centre view of %d lenses = C within the quantisation bound: mean %s, "
+        assert (np.all(error <= bound)), ("%s (%s, %s %s): centre view of %d lenses = C within the quantisation bound: mean %s, "
                      "worst error %s <= %s" % (name, ext, "%d-bit" % bits if bits else "half float", curve,
                                               centre.shape[0] * centre.shape[1],
                                               np.round(centre.reshape(-1, 3).mean(axis=0), 6), error, bound))
@@ -196,8 +185,7 @@ def main():
             difference = np.abs(centres[a][0] - centres[b][0]).reshape(-1, 3).max(axis=0)
             if np.any(difference > centres[a][1] + centres[b][1]):
                 worst.append((a, b, difference))
-    checks.check(len(names) == len(CASES) and not worst,
-                 "the %d central views agree pairwise within the sum of their quantisation bounds%s"
+    assert (len(names) == len(CASES) and not worst), ("the %d central views agree pairwise within the sum of their quantisation bounds%s"
                  % (len(names), "; not: %s" % worst if worst else ""))
 
     # --encoding overrides the file.
@@ -206,20 +194,14 @@ def main():
             ("srgb16", "linear", encode(expected, "srgb"), 16, "srgb")):
         status, stderr, centre = decode(args, files[name], os.path.join(args.work, "encoding_%s_as_%s.lightfield"
                                                                         % (name, option)), ["--encoding", option])
-        if not checks.check(status == 0 and centre is not None, "%s --encoding %s: exit 0 (got %d%s)"
-                            % (name, option, status, "; stderr %r" % stderr[-400:] if status else "")):
-            continue
+        assert status == 0 and centre is not None, ("%s --encoding %s: exit 0 (got %d%s)"
+                                                    % (name, option, status, "; stderr %r" % stderr[-400:] if status else ""))
         # The stored value's error, carried through the override's curve instead of the file's.
         bound = np.abs(decode_curve(encode(expected, curve) + 0.5 / 65535, option) - want) * 1.05 + 1e-6
         error = np.abs(centre - want).reshape(-1, 3).max(axis=0)
-        checks.check(np.all(error <= bound),
-                     "%s --encoding %s overrides the file: centre %s, want %s (worst error %s <= %s)"
+        assert (np.all(error <= bound)), ("%s --encoding %s overrides the file: centre %s, want %s (worst error %s <= %s)"
                      % (name, option, np.round(centre.reshape(-1, 3).mean(axis=0), 6), np.round(want, 6), error,
                         bound))
-        checks.check("encoding %s (--encoding)" % option in stderr, "%s --encoding %s: the decoder says so: %r"
+        assert ("encoding %s (--encoding)" % option in stderr), ("%s --encoding %s: the decoder says so: %r"
                      % (name, option, [l for l in stderr.splitlines() if "encoding" in l]))
-    checks.finish()
 
-
-if __name__ == "__main__":
-    main()

@@ -15,7 +15,7 @@ import shutil
 import subprocess
 import sys
 
-import gt_common as gt
+import plenoptic_testing as pt
 
 SCENE_ARRAY = """camera {
   plenoptic
@@ -44,13 +44,11 @@ def run(cmd):
     return subprocess.run(cmd, capture_output=True, text=True, errors="replace")
 
 
-def main():
-    args = gt.parse_args(__doc__)
-    checks = gt.Checks("ground_truth_decode_errors")
-    png, meta_path, _ = gt.render(args, "decode_ok", SCENE_ARRAY, 96, 72)
-    png_plain, meta_plain, _ = gt.render(args, "decode_no_array", SCENE_NO_ARRAY, 64, 48)
-    good = gt.read_json(meta_path)
-    decode = [sys.executable, os.path.join(args.tools, "plenoptic-decode"), "-q"]
+def test_decode_errors(args):
+    png, meta_path, _ = pt.render_ground_truth(args.povray, args.work, "decode_ok", SCENE_ARRAY, 96, 72)
+    png_plain, meta_plain, _ = pt.render_ground_truth(args.povray, args.work, "decode_no_array", SCENE_NO_ARRAY, 64, 48)
+    good = pt.read_json(meta_path)
+    decode = pt.decoder(args.tools) + ["-q"]
     bad_dir = os.path.join(args.work, "decode_bad")
     shutil.rmtree(bad_dir, ignore_errors=True)
     os.makedirs(bad_dir)
@@ -58,11 +56,9 @@ def main():
     # Positive controls.
     out = os.path.join(args.work, "decode_ok.lightfield")
     result = run(decode + [png, "-o", out])
-    checks.check(result.returncode == 0 and os.path.exists(os.path.join(out, "contact_sheet.png")),
-                 "the unbroken render decodes (exit %d, stderr %r)" % (result.returncode, result.stderr.strip()[-300:]))
+    assert (result.returncode == 0 and os.path.exists(os.path.join(out, "contact_sheet.png"))), "the unbroken render decodes (exit %d, stderr %r)" % (result.returncode, result.stderr.strip()[-300:])
     result = run([args.project, meta_path, "0", "0", "0"])
-    checks.check(result.returncode == 0 and len(result.stdout.split()) >= 5,
-                 "plenoptic-project projects the sphere's centre with the unbroken metadata (exit %d, output %r)"
+    assert (result.returncode == 0 and len(result.stdout.split()) >= 5), ("plenoptic-project projects the sphere's centre with the unbroken metadata (exit %d, output %r)"
                  % (result.returncode, result.stdout.strip()))
 
     def broken(name, edit=None, text=None):
@@ -131,7 +127,7 @@ def main():
         ok = (result.returncode == 2 and len(lines) == 1 and lines[0].startswith("plenoptic-decode: error:")
               and all(w in lines[0] for w in words) and "Traceback" not in result.stderr
               and not os.path.exists(os.path.join(target, "contact_sheet.png")))
-        checks.check(ok, "decode, %s: exit %d (want 2), stderr %r (want one line mentioning %s)"
+        assert (ok), ("decode, %s: exit %d (want 2), stderr %r (want one line mentioning %s)"
                      % (label, result.returncode, result.stderr.strip()[-400:], words))
         # plenoptic-project reads the same file. True: it must refuse it too, naming the same
         # field; False: a field it does not need; "projects": a file it must accept.
@@ -140,12 +136,12 @@ def main():
         result = run([args.project, path, "0", "0", "0"])
         lines = [l for l in result.stderr.splitlines() if l.strip()]
         if project_too == "projects":
-            checks.check(result.returncode == 0, "project, %s: a camera without an array still projects (exit %d, %r)"
+            assert (result.returncode == 0), ("project, %s: a camera without an array still projects (exit %d, %r)"
                          % (label, result.returncode, result.stderr.strip()))
             continue
         ok = (result.returncode == 2 and len(lines) == 1 and lines[0].startswith("plenoptic-project: " + path)
               and all(w in lines[0] for w in words if w not in ("cannot read", "object")))
-        checks.check(ok, "project, %s: exit %d (want 2), stderr %r" % (label, result.returncode, result.stderr.strip()))
+        assert ok, "project, %s: exit %d (want 2), stderr %r" % (label, result.returncode, result.stderr.strip())
 
     # plenoptic-project: the field it names when a camera value is wrong, and bad coordinates.
     for label, edit, word in (
@@ -155,16 +151,10 @@ def main():
              "sensor.plane_z_mm")):
         path = broken("project_" + label.replace(" ", "_"), edit)
         result = run([args.project, path, "0", "0", "0"])
-        checks.check(result.returncode == 2 and word in result.stderr and len(result.stderr.strip().splitlines()) == 1,
-                     "project, %s: exit %d, stderr %r (want 2, one line naming %s)"
+        assert (result.returncode == 2 and word in result.stderr and len(result.stderr.strip().splitlines()) == 1), ("project, %s: exit %d, stderr %r (want 2, one line naming %s)"
                      % (label, result.returncode, result.stderr.strip(), word))
     for label, coords in (("two coordinates", ["0", "0"]), ("not a number", ["0", "zero", "1"]),
                           ("infinite", ["0", "inf", "1"])):
         result = run([args.project, meta_path] + coords)
-        checks.check(result.returncode == 2 and result.stdout == "" and result.stderr.strip(),
-                     "project, %s: exit %d (want 2), stderr %r" % (label, result.returncode, result.stderr.strip()))
-    checks.finish()
+        assert (result.returncode == 2 and result.stdout == "" and result.stderr.strip()), "project, %s: exit %d (want 2), stderr %r" % (label, result.returncode, result.stderr.strip())
 
-
-if __name__ == "__main__":
-    main()

@@ -26,7 +26,7 @@ import shutil
 import subprocess
 import sys
 
-import gt_common as gt
+import plenoptic_testing as pt
 
 PEAK_LIMIT_MIB = 300
 ADDRESS_SPACE_CAP = 2 * 1024 ** 3
@@ -63,13 +63,11 @@ def run_measured(command, cwd):
     return child.returncode, text, usage.ru_maxrss / 1024.0  # Linux: kilobytes
 
 
-def main():
-    args = gt.parse_args(__doc__)
-    checks = gt.Checks("ground_truth_decode_limits")
-    decode = [sys.executable, os.path.join(args.tools, "plenoptic-decode")]
-    wide_png, _, _ = gt.render(args, "limits_wide", SCENE_WIDE, 64, 48)
-    png, meta_path, _ = gt.render(args, "limits_normal", SCENE_NORMAL, 96, 72)
-    good = gt.read_json(meta_path)
+def test_decode_limits(args):
+    decode = pt.decoder(args.tools)
+    wide_png, _, _ = pt.render_ground_truth(args.povray, args.work, "limits_wide", SCENE_WIDE, 64, 48)
+    png, meta_path, _ = pt.render_ground_truth(args.povray, args.work, "limits_normal", SCENE_NORMAL, 96, 72)
+    good = pt.read_json(meta_path)
 
     # The spacing the render's lattice must have, from the optics: the array at the main lens's
     # image distance D, each lens's centre projected from the main-lens centre onto the sensor.
@@ -100,29 +98,23 @@ def main():
         shutil.rmtree(out, ignore_errors=True)
         status, stderr, peak = run_measured(decode + arguments + ["-o", out, "-q"], args.work)
         lines = [l for l in stderr.splitlines() if l.strip()]
-        checks.check(status == 2 and len(lines) == 1 and lines[0].startswith("plenoptic-decode: error:")
+        assert (status == 2 and len(lines) == 1 and lines[0].startswith("plenoptic-decode: error:")
                      and all(w in lines[0] for w in words) and "Traceback" not in stderr
-                     and not os.path.exists(os.path.join(out, "contact_sheet.png")),
-                     "%s: exit %d (want 2), stderr %r (want one line with %s)"
+                     and not os.path.exists(os.path.join(out, "contact_sheet.png"))), ("%s: exit %d (want 2), stderr %r (want one line with %s)"
                      % (label, status, stderr.strip()[-600:], words))
-        checks.check(peak < PEAK_LIMIT_MIB, "%s: peak memory %.0f MiB (want < %d)" % (label, peak, PEAK_LIMIT_MIB))
+        assert peak < PEAK_LIMIT_MIB, "%s: peak memory %.0f MiB (want < %d)" % (label, peak, PEAK_LIMIT_MIB)
 
     # Positive control, and the up-front size is the size of what gets built.
     out = os.path.join(args.work, "limits_normal.lightfield")
     shutil.rmtree(out, ignore_errors=True)
     status, stderr, peak = run_measured(decode + [png, "-o", out, "-q", "--no-gif"], args.work)
-    checks.check(status == 0 and peak < PEAK_LIMIT_MIB,
-                 "the normal render decodes: exit %d, peak memory %.0f MiB (want 0, < %d)%s"
+    assert (status == 0 and peak < PEAK_LIMIT_MIB), ("the normal render decodes: exit %d, peak memory %.0f MiB (want 0, < %d)%s"
                  % (status, peak, PEAK_LIMIT_MIB, "; stderr %r" % stderr[-400:] if status else ""))
     if status == 0:
         import plenoptic_lf
         plan = getattr(plenoptic_lf, "plan_decode", None)
         written = json.load(open(os.path.join(out, "lightfield.json")))["shape"]
         predicted = list(plan(plenoptic_lf.load_metadata(meta_path)).shape) if plan else None
-        checks.check(predicted == written, "plan_decode predicts the light field's shape %s = written %s"
+        assert (predicted == written), ("plan_decode predicts the light field's shape %s = written %s"
                      % (predicted, written))
-    checks.finish()
 
-
-if __name__ == "__main__":
-    main()

@@ -20,7 +20,7 @@ import shutil
 import subprocess
 import sys
 
-import gt_common as gt
+import plenoptic_testing as pt
 
 SCENE = """camera {
   plenoptic
@@ -38,10 +38,8 @@ raise ImportError("No module named 'OpenImageIO' (hidden by the test)", name="Op
 '''
 
 
-def main():
-    args = gt.parse_args(__doc__)
-    checks = gt.Checks("ground_truth_decode_requires_oiio")
-    png, _, _ = gt.render(args, "no_oiio", SCENE, 96, 72)
+def test_decode_requires_oiio(args):
+    png, _, _ = pt.render_ground_truth(args.povray, args.work, "no_oiio", SCENE, 96, 72)
     blocker = os.path.join(args.work, "no_oiio_path")
     shutil.rmtree(blocker, ignore_errors=True)
     os.makedirs(blocker)
@@ -54,11 +52,10 @@ def main():
     # The blocker works, and a fallback would have what it needs.
     probe = subprocess.run([sys.executable, "-c", "import numpy, PIL\ntry:\n import OpenImageIO\n"
                             "except ImportError as e:\n print('blocked', e)"], env=env, capture_output=True, text=True)
-    checks.check(probe.returncode == 0 and probe.stdout.startswith("blocked"),
-                 "with the blocker on PYTHONPATH, numpy and Pillow import and OpenImageIO does not: %r %r"
+    assert (probe.returncode == 0 and probe.stdout.startswith("blocked")), ("with the blocker on PYTHONPATH, numpy and Pillow import and OpenImageIO does not: %r %r"
                  % (probe.stdout.strip(), probe.stderr.strip()[-300:]))
 
-    launcher = [sys.executable, os.path.join(args.tools, "plenoptic-decode")]
+    launcher = pt.decoder(args.tools)
     as_module = [sys.executable, "-m", "plenoptic_lf"]
     for label, command, environment in (("tools/plenoptic-decode", launcher, env),
                                         ("python3 -m plenoptic_lf", as_module, env_module)):
@@ -67,18 +64,16 @@ def main():
         run = subprocess.run(command + [png, "-o", out], env=environment, capture_output=True, text=True,
                              cwd=args.work)
         lines = [l for l in run.stderr.splitlines() if l.strip()]
-        checks.check(run.returncode != 0 and len(lines) == 1 and lines[0].startswith("plenoptic-decode: error:")
+        assert (run.returncode != 0 and len(lines) == 1 and lines[0].startswith("plenoptic-decode: error:")
                      and "python3-openimageio" in lines[0] and "pip install OpenImageIO" in lines[0]
-                     and "Traceback" not in run.stderr and not os.path.exists(os.path.join(out, "contact_sheet.png")),
-                     "%s without OpenImageIO: exit %d (want non-zero), stderr %r (want one line naming "
+                     and "Traceback" not in run.stderr and not os.path.exists(os.path.join(out, "contact_sheet.png"))), ("%s without OpenImageIO: exit %d (want non-zero), stderr %r (want one line naming "
                      "python3-openimageio and 'pip install OpenImageIO'), outputs written: %s"
                      % (label, run.returncode, run.stderr.strip()[-500:], os.path.exists(out)))
-        checks.check(run.returncode == 1, "%s without OpenImageIO: exit status %d (want 1, as for a missing numpy)"
+        assert (run.returncode == 1), ("%s without OpenImageIO: exit status %d (want 1, as for a missing numpy)"
                      % (label, run.returncode))
         help_run = subprocess.run(command + ["--help"], env=environment, capture_output=True, text=True,
                                   cwd=args.work)
-        checks.check(help_run.returncode == 0 and help_run.stdout.startswith("usage: plenoptic-decode"),
-                     "%s --help without OpenImageIO: exit %d, %r" % (label, help_run.returncode,
+        assert (help_run.returncode == 0 and help_run.stdout.startswith("usage: plenoptic-decode")), ("%s --help without OpenImageIO: exit %d, %r" % (label, help_run.returncode,
                                                                      help_run.stdout[:60] + help_run.stderr[-200:]))
 
     # The library: importable without OpenImageIO, read_raw refuses with the same message.
@@ -89,19 +84,13 @@ def main():
                "except ImportError as e:\n"
                "    print('ImportError', type(e).__name__, e)\n" % png)
     run = subprocess.run([sys.executable, "-c", snippet], env=env_module, capture_output=True, text=True)
-    checks.check(run.returncode == 0 and run.stdout.startswith("ImportError") and "python3-openimageio" in run.stdout
-                 and "pip install OpenImageIO" in run.stdout,
-                 "library without OpenImageIO: import plenoptic_lf works and read_raw raises an ImportError "
+    assert (run.returncode == 0 and run.stdout.startswith("ImportError") and "python3-openimageio" in run.stdout
+                 and "pip install OpenImageIO" in run.stdout), ("library without OpenImageIO: import plenoptic_lf works and read_raw raises an ImportError "
                  "naming both packages: %r %r" % (run.stdout.strip(), run.stderr.strip()[-300:]))
 
     # Positive control.
     out = os.path.join(args.work, "no_oiio_control.lightfield")
     shutil.rmtree(out, ignore_errors=True)
     run = subprocess.run(launcher + [png, "-o", out, "-q", "--no-gif"], capture_output=True, text=True)
-    checks.check(run.returncode == 0 and os.path.exists(os.path.join(out, "contact_sheet.png")),
-                 "with OpenImageIO the same render decodes (exit %d, %r)" % (run.returncode, run.stderr.strip()[-300:]))
-    checks.finish()
+    assert (run.returncode == 0 and os.path.exists(os.path.join(out, "contact_sheet.png"))), "with OpenImageIO the same render decodes (exit %d, %r)" % (run.returncode, run.stderr.strip()[-300:])
 
-
-if __name__ == "__main__":
-    main()

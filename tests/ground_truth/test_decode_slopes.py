@@ -20,7 +20,7 @@ import sys
 
 import numpy as np
 
-import gt_common as gt
+import plenoptic_testing as pt
 
 SCENE = """camera {
   plenoptic
@@ -34,11 +34,9 @@ sphere { 0, 0.3 pigment { checker rgb 1 rgb <1, 0.2, 0.1> scale 0.1 } finish { e
 """
 
 
-def main():
-    args = gt.parse_args(__doc__)
-    checks = gt.Checks("ground_truth_decode_slopes")
-    png, _, _ = gt.render(args, "slopes", SCENE, 96, 72)
-    decode = [sys.executable, os.path.join(args.tools, "plenoptic-decode"), png, "--no-gif", "--no-npy", "-q"]
+def test_decode_slopes(args):
+    png, _, _ = pt.render_ground_truth(args.povray, args.work, "slopes", SCENE, 96, 72)
+    decode = pt.decoder(args.tools) + [png, "--no-gif", "--no-npy", "-q"]
 
     def run(options, name):
         out = os.path.join(args.work, "slopes_" + name + ".lightfield")
@@ -53,28 +51,21 @@ def main():
         description = os.path.join(out, "lightfield.json")
         slopes = json.load(open(description))["slopes"] if os.path.exists(description) else None
         want = np.linspace(start, stop, count)
-        checks.check(result.returncode == 0 and slopes is not None and len(slopes) == count
-                     and np.allclose(slopes, want, rtol=0, atol=1e-12),
-                     "%s: exit %d (want 0), sweep %s (want linspace(%g, %g, %d))%s"
+        assert (result.returncode == 0 and slopes is not None and len(slopes) == count
+                     and np.allclose(slopes, want, rtol=0, atol=1e-12)), ("%s: exit %d (want 0), sweep %s (want linspace(%g, %g, %d))%s"
                      % (" ".join(options), result.returncode, slopes, start, stop, count,
                         "; stderr %r" % result.stderr.strip()[-300:] if result.returncode else ""))
 
     for value in ("a:1:5", "1:2", "0:1:x", "0:1:2.5", "1:0:5", "0:1:1", "nan:1:3"):
         result, out = run(["--slopes", value], "bad")
         lines = [l for l in result.stderr.splitlines() if l.strip()]
-        checks.check(result.returncode == 2 and len(lines) == 1 and lines[0].startswith("plenoptic-decode: error:")
+        assert (result.returncode == 2 and len(lines) == 1 and lines[0].startswith("plenoptic-decode: error:")
                      and "--slopes" in lines[0] and "START:STOP:COUNT" in lines[0] and value in lines[0]
                      and "could not convert" not in lines[0] and "invalid literal" not in lines[0]
                      and "Traceback" not in result.stderr
-                     and not os.path.exists(os.path.join(out, "contact_sheet.png")),
-                     "--slopes %s: exit %d (want 2), stderr %r (want one line naming --slopes, START:STOP:COUNT "
+                     and not os.path.exists(os.path.join(out, "contact_sheet.png"))), ("--slopes %s: exit %d (want 2), stderr %r (want one line naming --slopes, START:STOP:COUNT "
                      "and the value)" % (value, result.returncode, result.stderr.strip()[-400:]))
     result, _ = run(["--slopes", "-q"], "missing")
-    checks.check(result.returncode == 2 and "--slopes" in result.stderr and "expected one argument" in result.stderr,
-                 "--slopes -q (no value): exit %d, stderr %r (want argparse's 'expected one argument')"
+    assert (result.returncode == 2 and "--slopes" in result.stderr and "expected one argument" in result.stderr), ("--slopes -q (no value): exit %d, stderr %r (want argparse's 'expected one argument')"
                  % (result.returncode, result.stderr.strip()[-300:]))
-    checks.finish()
 
-
-if __name__ == "__main__":
-    main()

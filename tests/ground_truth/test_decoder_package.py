@@ -14,14 +14,15 @@ Checks, without rendering anything:
     without it).
 """
 
-import argparse
 import ast
 import os
 import shutil
 import subprocess
 import sys
 
-import gt_common as gt
+import pytest
+
+import plenoptic_testing as pt
 
 # Import name -> distribution name on PyPI, for every third-party module the package may import.
 DISTRIBUTIONS = {"numpy": "numpy", "PIL": "Pillow", "OpenImageIO": "OpenImageIO"}
@@ -56,14 +57,9 @@ def third_party_imports(package_dir):
     return found
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--python", required=True, help="the python/ folder (pyproject.toml, plenoptic_lf/)")
-    parser.add_argument("--tools", required=True, help="the tools/ folder (the plenoptic-decode launcher)")
-    parser.add_argument("--version", required=True, help="the project's version (CMake's PROJECT_VERSION)")
-    parser.add_argument("--work", required=True, help="scratch folder")
-    args = parser.parse_args()
-    checks = gt.Checks("ground_truth_decoder_package")
+def test_decoder_package(args):
+    assert args.project_version, "--project-version (CMake's PROJECT_VERSION) is needed"
+    args.version = args.project_version
     python_dir = os.path.abspath(args.python)
     package_dir = os.path.join(python_dir, "plenoptic_lf")
     os.makedirs(args.work, exist_ok=True)
@@ -72,24 +68,19 @@ def main():
     with open(os.path.join(python_dir, "pyproject.toml"), "rb") as f:
         pyproject = tomllib.load(f)
     project = pyproject.get("project", {})
-    checks.check(project.get("name") == "plenoptic-lf" and project.get("version") == args.version,
-                 "pyproject.toml: name %r, version %r (want 'plenoptic-lf', the project's %r)"
+    assert (project.get("name") == "plenoptic-lf" and project.get("version") == args.version), ("pyproject.toml: name %r, version %r (want 'plenoptic-lf', the project's %r)"
                  % (project.get("name"), project.get("version"), args.version))
     licence = project.get("license")
     licence = licence.get("text") if isinstance(licence, dict) else licence
-    checks.check(licence == "AGPL-3.0-or-later" and project.get("requires-python") == ">=3.9",
-                 "pyproject.toml: license %r, requires-python %r" % (licence, project.get("requires-python")))
-    checks.check(project.get("scripts") == {"plenoptic-decode": "plenoptic_lf.cli:main"},
-                 "pyproject.toml: scripts %r (want plenoptic-decode = plenoptic_lf.cli:main)" % project.get("scripts"))
-    checks.check(pyproject.get("build-system", {}).get("build-backend") == "setuptools.build_meta",
-                 "pyproject.toml: build backend %r" % pyproject.get("build-system", {}).get("build-backend"))
+    assert (licence == "AGPL-3.0-or-later" and project.get("requires-python") == ">=3.9"), "pyproject.toml: license %r, requires-python %r" % (licence, project.get("requires-python"))
+    assert project.get("scripts") == {"plenoptic-decode": "plenoptic_lf.cli:main"}, "pyproject.toml: scripts %r (want plenoptic-decode = plenoptic_lf.cli:main)" % project.get("scripts")
+    assert pyproject.get("build-system", {}).get("build-backend") == "setuptools.build_meta", "pyproject.toml: build backend %r" % pyproject.get("build-system", {}).get("build-backend")
 
     imports = third_party_imports(package_dir)
     unknown = sorted(set(imports) - set(DISTRIBUTIONS))
     declared = sorted(requirement_name(r).lower() for r in project.get("dependencies", []))
     imported = sorted(DISTRIBUTIONS[m].lower() for m in imports if m in DISTRIBUTIONS)
-    checks.check(not unknown and declared == imported,
-                 "dependencies declared %s = distributions of the third-party imports %s%s"
+    assert (not unknown and declared == imported), ("dependencies declared %s = distributions of the third-party imports %s%s"
                  % (declared, imported, "; imports without a known distribution: %s (in %s)"
                     % (unknown, {m: sorted(imports[m]) for m in unknown}) if unknown else ""))
 
@@ -97,7 +88,7 @@ def main():
     files += [os.path.join(python_dir, "pyproject.toml"), os.path.join(args.tools, "plenoptic-decode")]
     missing_header = [os.path.relpath(p, os.path.dirname(python_dir)) for p in files
                       if "SPDX-License-Identifier: AGPL-3.0-or-later" not in "".join(open(p).readlines()[:2])]
-    checks.check(not missing_header, "%d files start with the SPDX header; without it: %s"
+    assert (not missing_header), ("%d files start with the SPDX header; without it: %s"
                  % (len(files), missing_header))
 
     # A fresh interpreter with only python/ added: every module, the API, the version.
@@ -109,21 +100,24 @@ def main():
              "print(p.__version__, p.__file__, missing, callable(p.main))" % (python_dir, modules))
     run = subprocess.run([sys.executable, "-I", "-c", probe], capture_output=True, text=True)
     expected = "%s %s [] True" % (args.version, os.path.join(package_dir, "__init__.py"))
-    checks.check(run.returncode == 0 and run.stdout.strip() == expected,
-                 "with only python/ on sys.path, %d modules import and the API is complete: %r (want %r)%s"
+    assert (run.returncode == 0 and run.stdout.strip() == expected), ("with only python/ on sys.path, %d modules import and the API is complete: %r (want %r)%s"
                  % (len(modules), run.stdout.strip(), expected, " stderr: " + run.stderr[-500:] if run.stderr else ""))
 
     env = dict(os.environ, PYTHONPATH=python_dir)
     as_module = subprocess.run([sys.executable, "-m", "plenoptic_lf", "--help"], capture_output=True, text=True,
                                env=env, cwd=args.work)
-    launcher = subprocess.run([sys.executable, os.path.join(args.tools, "plenoptic-decode"), "--help"],
+    launcher = subprocess.run(pt.decoder(args.tools) + ["--help"],
                               capture_output=True, text=True, cwd=args.work)
-    checks.check(as_module.returncode == 0 and launcher.returncode == 0
-                 and as_module.stdout.startswith("usage: plenoptic-decode") and as_module.stdout == launcher.stdout,
-                 "python3 -m plenoptic_lf --help (exit %d) and tools/plenoptic-decode --help (exit %d) print the "
+    assert (as_module.returncode == 0 and launcher.returncode == 0
+                 and as_module.stdout.startswith("usage: plenoptic-decode") and as_module.stdout == launcher.stdout), ("python3 -m plenoptic_lf --help (exit %d) and tools/plenoptic-decode --help (exit %d) print the "
                  "same usage" % (as_module.returncode, launcher.returncode))
 
-    # pip, offline, into a throwaway venv that sees Debian's numpy, Pillow and OpenImageIO.
+
+def test_pip_install_into_a_venv(args):
+    """pip, offline, into a throwaway venv that sees Debian's numpy, Pillow and OpenImageIO
+    (skipped when python3 -m venv does not work: Debian's python3-venv is missing)."""
+    python_dir = os.path.abspath(args.python)
+    launcher = subprocess.run(pt.decoder(args.tools) + ["--help"], capture_output=True, text=True, cwd=args.work)
     venv = os.path.join(args.work, "venv")
     source = os.path.join(args.work, "source")
     for path in (venv, source):
@@ -131,27 +125,20 @@ def main():
     made = subprocess.run([sys.executable, "-m", "venv", "--system-site-packages", venv],
                           capture_output=True, text=True)
     if made.returncode != 0:
-        print("SKIP  pip install check: %s -m venv failed (Debian: apt install python3-venv): %s"
-              % (sys.executable, made.stderr.strip()[-300:]))
-    else:
-        shutil.copytree(python_dir, source, ignore=shutil.ignore_patterns("build", "*.egg-info", "__pycache__"))
-        pip = subprocess.run([os.path.join(venv, "bin", "python"), "-m", "pip", "install", "--no-deps",
-                              "--no-build-isolation", "--no-index", "--quiet", source],
-                             capture_output=True, text=True)
-        checks.check(pip.returncode == 0, "pip install --no-deps --no-build-isolation into a venv (exit %d) %s"
-                     % (pip.returncode, pip.stderr.strip()[-500:]))
-        command = os.path.join(venv, "bin", "plenoptic-decode")
-        if pip.returncode == 0:
-            run = subprocess.run([command, "--help"], capture_output=True, text=True, cwd=args.work)
-            where = subprocess.run([os.path.join(venv, "bin", "python"), "-c",
-                                    "import plenoptic_lf; print(plenoptic_lf.__file__)"],
-                                   capture_output=True, text=True, cwd=args.work)
-            checks.check(run.returncode == 0 and run.stdout == launcher.stdout
-                         and where.stdout.strip().startswith(venv + os.sep),
-                         "the venv's plenoptic-decode --help (exit %d) prints the usage; the package loads from %s"
-                         % (run.returncode, where.stdout.strip() or where.stderr.strip()[-300:]))
-    checks.finish()
+        pytest.skip("pip install check: %s -m venv failed (Debian: apt install python3-venv): %s"
+                    % (sys.executable, made.stderr.strip()[-300:]))
+    shutil.copytree(python_dir, source, ignore=shutil.ignore_patterns("build", "*.egg-info", "__pycache__"))
+    pip = subprocess.run([os.path.join(venv, "bin", "python"), "-m", "pip", "install", "--no-deps",
+                          "--no-build-isolation", "--no-index", "--quiet", source],
+                         capture_output=True, text=True)
+    assert (pip.returncode == 0), ("pip install --no-deps --no-build-isolation into a venv (exit %d) %s"
+                 % (pip.returncode, pip.stderr.strip()[-500:]))
+    command = os.path.join(venv, "bin", "plenoptic-decode")
+    run = subprocess.run([command, "--help"], capture_output=True, text=True, cwd=args.work)
+    where = subprocess.run([os.path.join(venv, "bin", "python"), "-c",
+                            "import plenoptic_lf; print(plenoptic_lf.__file__)"],
+                           capture_output=True, text=True, cwd=args.work)
+    assert (run.returncode == 0 and run.stdout == launcher.stdout
+                 and where.stdout.strip().startswith(venv + os.sep)), ("the venv's plenoptic-decode --help (exit %d) prints the usage; the package loads from %s"
+                 % (run.returncode, where.stdout.strip() or where.stderr.strip()[-300:]))
 
-
-if __name__ == "__main__":
-    main()

@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-import gt_common as gt
+import plenoptic_testing as pt
 
 W, H = 320, 240
 PIXEL = 0.01
@@ -57,17 +57,17 @@ box { <-5, -5, %r>, <%r, 5, %r>
 def expected_depth():
     """Distance (scene units) per pixel, +inf where nothing is hit, and a mask of pixels too close
     to an edge (a plane's, or a lens cell's) to compare; also |m| per pixel."""
-    D = gt.image_distance(F, FOCUS * MM)
+    D = pt.image_distance(F, FOCUS * MM)
     d = MICRO_F
     A = F / N
     jj, ii = np.mgrid[0:H, 0:W]
-    px, py = gt.sensor_point(ii, jj, W, H, PIXEL, PIXEL, *OFFSET)
+    px, py = pt.sensor_point(ii, jj, W, H, PIXEL, PIXEL, *OFFSET)
     # Own lens: the line main-lens centre -> pixel meets the array plane z = -D at p D / (D + d).
     q = np.stack([px, py], axis=-1) * (D / (D + d))
-    R = gt.rot_z(ROTATE_DEG)
+    R = pt.rot_z(ROTATE_DEG)
     local = (q - TRANSLATE) @ R  # R^T (q - t), row vectors
-    k, l, gap = gt.nearest_lens_local("hexagonal", PITCH, local)
-    c = gt.lens_centre_local("hexagonal", PITCH, k, l) @ R.T + TRANSLATE
+    k, l, gap = pt.nearest_lens_local("hexagonal", PITCH, local)
+    c = pt.lens_centre_local("hexagonal", PITCH, k, l) @ R.T + TRANSLATE
     # Chief ray: pixel -> lens centre (undeviated), on to the main lens, refracted there.
     w = (c - np.stack([px, py], axis=-1)) / d  # per unit z
     m = c + w * D
@@ -92,23 +92,19 @@ def expected_depth():
     return depth, unsure, np.hypot(m[..., 0], m[..., 1]), A, D, d
 
 
-def main():
-    args = gt.parse_args(__doc__)
-    checks = gt.Checks("ground_truth_depth_map")
-    png, meta_path, depth_path = gt.render(args, "depth_planes", SCENE, W, H)
-    meta = gt.read_json(meta_path)
-    checks.check(meta["depth_map"] == "depth_planes.depth.exr",
-                 "metadata depth_map names the EXR beside the image: %r" % meta["depth_map"])
+def test_depth_map(args):
+    png, meta_path, depth_path = pt.render_ground_truth(args.povray, args.work, "depth_planes", SCENE, W, H)
+    meta = pt.read_json(meta_path)
+    assert meta["depth_map"] == "depth_planes.depth.exr", "metadata depth_map names the EXR beside the image: %r" % meta["depth_map"]
 
     import OpenImageIO as oiio
     buf = oiio.ImageBuf(depth_path)
     spec = buf.spec()
-    checks.check(not buf.has_error and spec.width == W and spec.height == H and tuple(spec.channelnames) == ("Z",)
-                 and spec.format == oiio.TypeDesc("float"),
-                 "depth EXR: %d x %d, channels %s, %s (want %d x %d, ('Z',), float)"
+    assert (not buf.has_error and spec.width == W and spec.height == H and tuple(spec.channelnames) == ("Z",)
+                 and spec.format == oiio.TypeDesc("float")), ("depth EXR: %d x %d, channels %s, %s (want %d x %d, ('Z',), float)"
                  % (spec.width, spec.height, tuple(spec.channelnames), spec.format, W, H))
     measured = np.asarray(buf.get_pixels(oiio.FLOAT))[:, :, 0].astype(np.float64)
-    image = gt.read_linear(png)
+    image = pt.read_linear(png)
 
     expected, unsure, m_radius, A, D, d = expected_depth()
     blocked = measured == -1
@@ -118,40 +114,33 @@ def main():
     spread = 0.5 * math.hypot(PIXEL, PIXEL) * D / d + PITCH / math.sqrt(3)
     surely_lit = m_radius < A / 2 - spread
     surely_blocked = m_radius > A / 2 + spread
-    checks.check(surely_lit.sum() > 0.2 * W * H and surely_blocked.sum() > 100,
-                 "geometry gives %d pixels that must receive light and %d that cannot"
+    assert (surely_lit.sum() > 0.2 * W * H and surely_blocked.sum() > 100), ("geometry gives %d pixels that must receive light and %d that cannot"
                  % (surely_lit.sum(), surely_blocked.sum()))
-    checks.check(not (blocked & surely_lit).any(), "no pixel whose chief ray crosses the main lens %.2f mm inside "
+    assert (not (blocked & surely_lit).any()), ("no pixel whose chief ray crosses the main lens %.2f mm inside "
                  "the aperture is -1 (found %d)" % (spread, (blocked & surely_lit).sum()))
-    checks.check(not (lit & surely_blocked).any(), "every pixel whose chief ray crosses the main lens %.2f mm "
+    assert (not (lit & surely_blocked).any()), ("every pixel whose chief ray crosses the main lens %.2f mm "
                  "outside the aperture is -1 (%d are not)" % (spread, (lit & surely_blocked).sum()))
     black = (image == 0).all(axis=2)
-    checks.check(np.array_equal(blocked, black), "-1 exactly where the pixel is black (%d pixels -1, %d black, "
+    assert (np.array_equal(blocked, black)), ("-1 exactly where the pixel is black (%d pixels -1, %d black, "
                  "%d disagree)" % (blocked.sum(), black.sum(), (blocked != black).sum()))
     others = np.isfinite(measured) & ~blocked
-    checks.check(not (measured[others] < 0).any(), "no other negative depths (%d)" % (measured[others] < 0).sum())
+    assert not (measured[others] < 0).any(), "no other negative depths (%d)" % (measured[others] < 0).sum()
 
     compare = lit & ~unsure
     finite = compare & np.isfinite(expected)
     infinite = compare & ~np.isfinite(expected)
-    checks.check(finite.sum() > 0.3 * W * H and infinite.sum() > 0.05 * W * H,
-                 "%d pixels compared with a plane distance, %d that see nothing" % (finite.sum(), infinite.sum()))
+    assert (finite.sum() > 0.3 * W * H and infinite.sum() > 0.05 * W * H), "%d pixels compared with a plane distance, %d that see nothing" % (finite.sum(), infinite.sum())
     relative = np.abs(measured[finite] - expected[finite]) / expected[finite]
     worst = int(np.argmax(relative))
     where = np.argwhere(finite)[worst]
-    checks.check(relative.max() <= 2e-6, "depth = (z - m_z) / w_z along the chief ray: worst relative error %.2g "
+    assert (relative.max() <= 2e-6), ("depth = (z - m_z) / w_z along the chief ray: worst relative error %.2g "
                  "at pixel (%d, %d): %.9g vs %.9g (float32 storage: <= 2e-6)"
                  % (relative.max(), where[1], where[0], measured[tuple(where)], expected[tuple(where)]))
     near = finite & (expected < 0.6 * (Z_FAR - LOCATION[2]))
-    checks.check(near.sum() > 0.1 * W * H and (finite & ~near).sum() > 0.1 * W * H,
-                 "both planes are compared (%d near, %d far pixels)" % (near.sum(), (finite & ~near).sum()))
+    assert (near.sum() > 0.1 * W * H and (finite & ~near).sum() > 0.1 * W * H), "both planes are compared (%d near, %d far pixels)" % (near.sum(), (finite & ~near).sum())
     wrong_inf = infinite & ~np.isposinf(measured)
-    checks.check(not wrong_inf.any(), "+inf where the chief ray meets no surface (%d of %d pixels are not)"
+    assert (not wrong_inf.any()), ("+inf where the chief ray meets no surface (%d of %d pixels are not)"
                  % (wrong_inf.sum(), infinite.sum()))
     stray_inf = finite & np.isinf(measured)
-    checks.check(not stray_inf.any(), "no +inf where a plane is hit (%d)" % stray_inf.sum())
-    checks.finish()
+    assert not stray_inf.any(), "no +inf where a plane is hit (%d)" % stray_inf.sum()
 
-
-if __name__ == "__main__":
-    main()

@@ -18,7 +18,9 @@ import math
 
 import numpy as np
 
-import gt_common as gt
+import pytest
+
+import plenoptic_testing as pt
 
 W, H = 320, 240
 PIXEL = 0.01
@@ -82,17 +84,17 @@ def lftoolbox_grid(model):
 
 def expected_metadata(case):
     """Principal point, lattice origin and basis, disc diameter from docs/specification.md (sections 2, 3)."""
-    D = gt.image_distance(F, FOCUS * 1000.0)
+    D = pt.image_distance(F, FOCUS * 1000.0)
     d, p = case["d"], case["pitch"]
     ox, oy = case["offset"]
-    principal = gt.sensor_to_pixel(0.0, 0.0, W, H, PIXEL, PIXEL, ox, oy)
+    principal = pt.sensor_to_pixel(0.0, 0.0, W, H, PIXEL, PIXEL, ox, oy)
     scale = (D + d) / D  # central projection from the main-lens centre, array -> sensor
-    R = gt.rot_z(case["rotate"])
+    R = pt.rot_z(case["rotate"])
     t = np.array(case["translate"])
 
     def px(local):
         x, y = (t + R @ np.asarray(local)) * scale
-        return np.array(gt.sensor_to_pixel(x, y, W, H, PIXEL, PIXEL, ox, oy))
+        return np.array(pt.sensor_to_pixel(x, y, W, H, PIXEL, PIXEL, ox, oy))
 
     origin = px([0.0, 0.0])
     b_local = [p / 2, p * math.sqrt(3) / 2] if case["grid"] == "hexagonal" else [0.0, p]
@@ -102,27 +104,25 @@ def expected_metadata(case):
     return np.array(principal), origin, a, b, aperture * d / D / PIXEL
 
 
-def run_case(args, checks, case):
+@pytest.mark.parametrize("case", CASES, ids=[c["name"] for c in CASES])
+def test_lattice(args, case):
     name = case["name"]
-    png, meta_path, _ = gt.render(args, "lattice_" + name, scene(case), W, H)
-    meta = gt.read_json(meta_path)
+    png, meta_path, _ = pt.render_ground_truth(args.povray, args.work, "lattice_" + name, scene(case), W, H)
+    meta = pt.read_json(meta_path)
     lattice = meta["microimage_lattice"]
-    image = gt.read_linear(png).mean(axis=2)
+    image = pt.read_linear(png).mean(axis=2)
 
     principal, origin, a, b, diameter = expected_metadata(case)
     m_origin = np.array(lattice["origin_px"])
     m_a, m_b = np.array(lattice["basis_px"][0]), np.array(lattice["basis_px"][1])
-    checks.check(np.abs(np.array(meta["principal_point_px"]) - principal).max() < 1e-6,
-                 "%s: principal_point_px %s = specification %s" % (name, meta["principal_point_px"], principal.tolist()))
+    assert np.abs(np.array(meta["principal_point_px"]) - principal).max() < 1e-6, "%s: principal_point_px %s = specification %s" % (name, meta["principal_point_px"], principal.tolist())
     largest = max(np.abs(m_origin - origin).max(), np.abs(m_a - a).max(), np.abs(m_b - b).max())
-    checks.check(largest < 1e-6,
-                 "%s: lattice origin %s a %s b %s = specification origin %s a %s b %s"
+    assert (largest < 1e-6), ("%s: lattice origin %s a %s b %s = specification origin %s a %s b %s"
                  % (name, m_origin.round(6).tolist(), m_a.round(6).tolist(), m_b.round(6).tolist(),
                     origin.round(6).tolist(), a.round(6).tolist(), b.round(6).tolist()))
-    checks.check(abs(lattice["microimage_diameter_px"] - diameter) < 1e-6,
-                 "%s: microimage_diameter_px %.6f = A d / D / pixel %.6f"
+    assert (abs(lattice["microimage_diameter_px"] - diameter) < 1e-6), ("%s: microimage_diameter_px %.6f = A d / D / pixel %.6f"
                  % (name, lattice["microimage_diameter_px"], diameter))
-    checks.check(lattice["exact"] is True, "%s: lattice marked exact (the array is not tilted)" % name)
+    assert lattice["exact"] is True, "%s: lattice marked exact (the array is not tilted)" % name
 
     # Measure every microimage whose window lies inside the picture.
     spacing = min(np.hypot(*m_a), np.hypot(*m_b))
@@ -143,16 +143,14 @@ def run_case(args, checks, case):
             measured.append(centre)
             areas.append(total)
     predicted, measured = np.array(predicted), np.array(measured)
-    checks.check(len(measured) >= 100, "%s: %d microimages measured (need >= 100)" % (name, len(measured)))
+    assert len(measured) >= 100, "%s: %d microimages measured (need >= 100)" % (name, len(measured))
     error = np.hypot(*(measured - predicted).T)
-    checks.check(error.mean() <= 0.1 and error.max() <= 0.3,
-                 "%s: metadata lattice - measured centres: mean %.4f px (<= 0.1), worst %.4f px (<= 0.3)"
+    assert (error.mean() <= 0.1 and error.max() <= 0.3), ("%s: metadata lattice - measured centres: mean %.4f px (<= 0.1), worst %.4f px (<= 0.3)"
                  % (name, error.mean(), error.max()))
 
     # The disc's area (white = 1) gives its diameter.
     measured_diameter = 2 * math.sqrt(np.median(areas) / math.pi)
-    checks.check(abs(measured_diameter - diameter) <= 0.02 * diameter,
-                 "%s: disc diameter from its area %.3f px = A d / D / pixel %.3f px (2%%)"
+    assert (abs(measured_diameter - diameter) <= 0.02 * diameter), ("%s: disc diameter from its area %.3f px = A d / D / pixel %.3f px (2%%)"
                  % (name, measured_diameter, diameter))
 
     # LFToolbox's grid, 1-based, against the measured centres. As in LFToolbox, the grid is a
@@ -163,23 +161,11 @@ def run_case(args, checks, case):
     grid = np.column_stack([gu.ravel() - 1, gv.ravel() - 1])
     distance = np.array([np.hypot(*(grid - m).T).min() for m in measured])
     covered = distance <= 0.3
-    checks.check(covered.mean() >= 0.9, "%s: LFToolbox's %d x %d grid covers %.1f%% of the measured microimages"
+    assert (covered.mean() >= 0.9), ("%s: LFToolbox's %d x %d grid covers %.1f%% of the measured microimages"
                  % (name, model["UMax"], model["VMax"], 100 * covered.mean()))
     interior = ((grid[:, 0] >= window + 1) & (grid[:, 0] <= W - 2 - window)
                 & (grid[:, 1] >= window + 1) & (grid[:, 1] <= H - 2 - window))
     error = np.array([np.hypot(*(measured - g).T).min() for g in grid[interior]])
-    checks.check(len(error) > 0 and error.mean() <= 0.1 and error.max() <= 0.3,
-                 "%s: LFToolbox grid points inside the image - measured centres: mean %.4f px, worst %.4f px "
+    assert (len(error) > 0 and error.mean() <= 0.1 and error.max() <= 0.3), ("%s: LFToolbox grid points inside the image - measured centres: mean %.4f px, worst %.4f px "
                  "(%d points)" % (name, error.mean(), error.max(), len(error)))
 
-
-def main():
-    args = gt.parse_args(__doc__)
-    checks = gt.Checks("ground_truth_lattice")
-    for case in CASES:
-        run_case(args, checks, case)
-    checks.finish()
-
-
-if __name__ == "__main__":
-    main()

@@ -24,7 +24,9 @@ import math
 
 import numpy as np
 
-import gt_common as gt
+import pytest
+
+import plenoptic_testing as pt
 
 TOLERANCE_PX = 0.25
 W, H = 320, 240
@@ -85,7 +87,7 @@ CONFIGS = [
 def main_distance(cfg):
     if cfg["D"] is not None:
         return cfg["D"]
-    return gt.image_distance(cfg["F"], cfg["focus_mm"])  # 1/F = 1/z + 1/D
+    return pt.image_distance(cfg["F"], cfg["focus_mm"])  # 1/F = 1/z + 1/D
 
 
 def depths(cfg):
@@ -134,7 +136,7 @@ def sphere_points(cfg):
         # Chief line through the main-lens centre: the sensor point (xs, ys, -(D + d)) and the
         # object (-xs, -ys) z / (D + d) lie on one line through the origin.
         x, y = -xs * z / (D + d), -ys * z / (D + d)
-        b = gt.image_distance(F, z)
+        b = pt.image_distance(F, z)
         delta = abs(D - b)
         # The sphere's image (radius rho b / z, at delta from the array) reaches the sensor scaled
         # by d / delta: through a pinhole, along the chief lines of a d = f lens, or as the image
@@ -170,14 +172,14 @@ def is_clean(cfg, point, rho, k, l, u, v):
     if cfg["F"] is None:
         # Camera array: a pixel belongs to the lens straight above it, and the cells tile the
         # sensor, so keep the blob off the cell border.
-        kk, ll, gap = gt.nearest_lens_local(cfg["grid"], p, np.array([xs, ys]))
+        kk, ll, gap = pt.nearest_lens_local(cfg["grid"], p, np.array([xs, ys]))
         border = gap / (2 * p * (math.sqrt(2) if cfg["grid"] == "rectangular" else 1.0))
         return border > (reach + 1.5) * PIXEL, (int(kk), int(ll))
     D, F, A = main_distance(cfg), cfg["F"], cfg["A"]
-    b = gt.image_distance(F, point[2])
+    b = pt.image_distance(F, point[2])
     image = np.array([-point[0] * b / point[2], -point[1] * b / point[2], -b])
     spread = rho * b / point[2]  # radius of the sphere's image
-    centre = gt.lens_centre_local(cfg["grid"], p, k, l)
+    centre = pt.lens_centre_local(cfg["grid"], p, k, l)
     if cfg["micro_f"] is None:
         corners = [centre]
         # Blob pixels' rays cross the main lens up to reach * pixel * D / d from the chief line.
@@ -199,7 +201,7 @@ def is_clean(cfg, point, rho, k, l, u, v):
                 return False, None
     # The lens whose cell holds the predicted position, seen from the main-lens centre on the
     # array plane (None within 0.5 px of a cell border, where either is right).
-    kk, ll, gap = gt.nearest_lens_local(cfg["grid"], p, np.array([xs, ys]) * D / (D + d))
+    kk, ll, gap = pt.nearest_lens_local(cfg["grid"], p, np.array([xs, ys]) * D / (D + d))
     # Distance to the cell border: (|q - c1|^2 - |q - c0|^2) / (2 |c1 - c0|), neighbours at most
     # p (hexagonal) or p sqrt(2) (rectangular, diagonal) apart.
     border = gap / (2 * p * (math.sqrt(2) if cfg["grid"] == "rectangular" else 1.0))
@@ -226,19 +228,20 @@ def write_overlay(path, image, predicted, found, scale=3):
     im.save(path)
 
 
-def run_config(args, checks, cfg):
+@pytest.mark.parametrize("cfg", CONFIGS, ids=[c["name"] for c in CONFIGS])
+def test_projection(args, cfg):
     name = cfg["name"]
     points, radii = sphere_points(cfg)
     spheres = "\n".join("sphere { <%r, %r, %r>, %r pigment { rgb 1 } finish { emission 1 diffuse 0 ambient 0 } }"
                         % (tuple(to_world(p)) + (r / MM_PER_UNIT,)) for p, r in zip(points, radii))
-    png, meta_path, _ = gt.render(args, "projection_" + name, camera_block(cfg) + spheres + "\n", W, H)
-    meta = gt.read_json(meta_path)
+    png, meta_path, _ = pt.render_ground_truth(args.povray, args.work, "projection_" + name, camera_block(cfg) + spheres + "\n", W, H)
+    meta = pt.read_json(meta_path)
     frame = meta["camera_frame"]
     frame_error = max(np.abs(np.array(frame["location"]) - LOCATION).max(),
                       np.abs(np.array(frame["right"]) - RIGHT).max(),
                       np.abs(np.array(frame["up"]) - UP).max(),
                       np.abs(np.array(frame["direction"]) - DIRECTION).max())
-    checks.check(frame_error < 1e-9, "%s: metadata camera_frame equals the scene's camera (largest difference %.2g)"
+    assert (frame_error < 1e-9), ("%s: metadata camera_frame equals the scene's camera (largest difference %.2g)"
                  % (name, frame_error))
 
     # The light of each lens stays inside its own cell (so a blob is never cut by a cell border).
@@ -246,12 +249,12 @@ def run_config(args, checks, cfg):
     if cfg["F"] is not None:
         spacing = min(math.hypot(*lattice["basis_px"][0]), math.hypot(*lattice["basis_px"][1]))
         disc = cfg["A"] * cfg["d"] / main_distance(cfg) / PIXEL
-        checks.check(disc < spacing - 0.5, "%s: the main aperture's disc behind each lens (%.2f px) fits its "
+        assert (disc < spacing - 0.5), ("%s: the main aperture's disc behind each lens (%.2f px) fits its "
                      "cell (%.2f px)" % (name, disc, spacing))
-    image = gt.read_linear(png).mean(axis=2)
-    found = gt.blobs(image, 0.004)
-    hits = gt.run_project(args, meta_path, [to_world(p) for p in points])
-    checks.check(len(found) > 0 and len(hits) > 0, "%s: %d blobs in the render, %d predicted images"
+    image = pt.read_linear(png).mean(axis=2)
+    found = pt.blobs(image, 0.004)
+    hits = pt.run_project(args.project, meta_path, [to_world(p) for p in points])
+    assert (len(found) > 0 and len(hits) > 0), ("%s: %d blobs in the render, %d predicted images"
                  % (name, len(found), len(hits)))
 
     # plenoptic-project names lenses in row form; the metadata lattice counts skew indices:
@@ -267,7 +270,7 @@ def run_config(args, checks, cfg):
         centre = origin + k_skew * basis_a + l * basis_b
         if math.hypot(u - centre[0], v - centre[1]) > cell_px + 1e-6:
             far_from_lens.append((index, k, l, round(u, 2), round(v, 2), tuple(centre.round(2))))
-    checks.check(not far_from_lens, "%s: each image lies in the cell of its lens's lattice centre (row-form k -> "
+    assert (not far_from_lens), ("%s: each image lies in the cell of its lens's lattice centre (row-form k -> "
                  "skew k - floor(l/2)); outside: %s" % (name, far_from_lens[:4]))
 
     overlay = []  # (u, v, clean) for the picture written beside the render
@@ -288,17 +291,16 @@ def run_config(args, checks, cfg):
         best = min(near, key=lambda i: math.hypot(found[i]["u"] - u, found[i]["v"] - v))
         errors.append((math.hypot(found[best]["u"] - u, found[best]["v"] - v), index, k, l, u, v,
                        found[best]["u"], found[best]["v"]))
-    checks.check(len(errors) >= 10, "%s: %d predicted images are wholly seen and compared (need >= 10)"
+    assert (len(errors) >= 10), ("%s: %d predicted images are wholly seen and compared (need >= 10)"
                  % (name, len(errors)))
-    checks.check(not missing, "%s: every wholly seen predicted image shows a blob; missing: %s"
+    assert (not missing), ("%s: every wholly seen predicted image shows a blob; missing: %s"
                  % (name, missing[:5]))
-    checks.check(not wrong_lens, "%s: each image's lens (k, l) is the lens whose cell holds it; "
+    assert (not wrong_lens), ("%s: each image's lens (k, l) is the lens whose cell holds it; "
                  "disagreements (point, k, l, expected): %s" % (name, wrong_lens[:5]))
     if errors:
         worst = max(errors)
         mean = sum(e[0] for e in errors) / len(errors)
-        checks.check(worst[0] <= TOLERANCE_PX,
-                     "%s: blob centroid - plenoptic-project <= %.2f px: mean %.3f px, worst %.3f px "
+        assert (worst[0] <= TOLERANCE_PX), ("%s: blob centroid - plenoptic-project <= %.2f px: mean %.3f px, worst %.3f px "
                      "(point %d lens (%d, %d): predicted (%.3f, %.3f), measured (%.3f, %.3f))"
                      % ((name, TOLERANCE_PX, mean) + worst))
     write_overlay(png[:-4] + "_check.png", image, overlay, found)
@@ -307,17 +309,6 @@ def run_config(args, checks, cfg):
     fluxes = sorted(found[i]["flux"] for i in explained) or [0.0]
     median = fluxes[len(fluxes) // 2]
     unexplained = [bl for i, bl in enumerate(found) if i not in explained and bl["flux"] > 0.75 * median]
-    checks.check(not unexplained, "%s: every blob is an image plenoptic-project predicts; unexplained: %s"
+    assert (not unexplained), ("%s: every blob is an image plenoptic-project predicts; unexplained: %s"
                  % (name, [(round(b["u"], 2), round(b["v"], 2), round(b["flux"], 2)) for b in unexplained[:5]]))
 
-
-def main():
-    args = gt.parse_args(__doc__)
-    checks = gt.Checks("ground_truth_projection")
-    for cfg in CONFIGS:
-        run_config(args, checks, cfg)
-    checks.finish()
-
-
-if __name__ == "__main__":
-    main()

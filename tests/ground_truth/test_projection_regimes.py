@@ -39,11 +39,12 @@ of those points' images through it weighted by the part of each point's light th
 """
 
 import math
-import subprocess
 
 import numpy as np
 
-import gt_common as gt
+import pytest
+
+import plenoptic_testing as pt
 
 TOLERANCE_PX = 0.3
 OVERLAP_TOLERANCE_PX = 0.4
@@ -151,25 +152,6 @@ def disc_points(centre, radius):
     return points
 
 
-def run_project(args, meta_path, world_points):
-    """(point, k, l, u, v, fraction) per image; fractions of 1 from a tool without --fraction."""
-    coords = ["%.17g" % c for p in world_points for c in p]
-    run = subprocess.run([args.project, "--fraction", meta_path] + coords, capture_output=True, text=True)
-    with_fraction = run.returncode == 0
-    if not with_fraction:
-        run = subprocess.run([args.project, meta_path] + coords, capture_output=True, text=True)
-    if run.returncode != 0:
-        raise SystemExit("FAIL: plenoptic-project exited %d: %s" % (run.returncode, run.stderr.strip()))
-    hits = []
-    for line in run.stdout.split("\n"):
-        if not line.strip():
-            continue
-        f = line.split()
-        hits.append((int(f[0]), int(f[1]), int(f[2]), float(f[3]), float(f[4]),
-                     float(f[5]) if with_fraction else 1.0))
-    return hits
-
-
 def found_labels(image):
     """The label image of find_blobs (0 background, blob i + 1)."""
     return _blobs(image)[1]
@@ -199,14 +181,16 @@ def _blobs(image):
     return found, grown
 
 
-def run_config(args, checks, cfg, report):
+@pytest.mark.parametrize("cfg", CONFIGS, ids=[c["name"] for c in CONFIGS])
+def test_projection_regimes(args, cfg):
+    report = []
     name = cfg["name"]
     spheres = [sphere_centre(cfg, k, l, ox, oy, z) + (r, 1.0) for (k, l, ox, oy, z, r) in cfg["spheres"]]
     scene = camera_block(cfg) + "".join(
         "sphere { <%r, %r, %r>, %r pigment { rgb 1 } finish { emission %r diffuse 0 ambient 0 } }\n"
         % (x / 1000.0, y / 1000.0, z / 1000.0, r / 1000.0, e) for (x, y, z, r, e) in spheres)
-    png, meta_path, _ = gt.render(args, "regimes_" + name, scene, W, H)
-    image = gt.read_linear(png).mean(axis=2)
+    png, meta_path, _ = pt.render_ground_truth(args.povray, args.work, "regimes_" + name, scene, W, H)
+    image = pt.read_linear(png).mean(axis=2)
     found = find_blobs(image)
 
     # Predicted images per (sphere, lens): fraction-weighted mean of its disc points' images.
@@ -219,7 +203,7 @@ def run_config(args, checks, cfg, report):
     first_point = [owner.index(s) for s in range(len(spheres))]  # each sphere's centre
     centre_images = [[] for _ in spheres]
     sums = {}
-    for (index, k, l, u, v, fraction) in run_project(args, meta_path, points):
+    for (index, k, l, u, v, fraction) in pt.run_project(args.project, meta_path, points, fraction=True):
         if index == first_point[owner[index]]:
             centre_images[owner[index]].append((u, v, fraction))
         key = (owner[index], k, l)
@@ -287,24 +271,25 @@ def run_config(args, checks, cfg, report):
                      sum(e[0] for e in full) / len(full) if full else math.nan, worst[0])
                   + "; light images: %d, worst %.3f px" % (len(errors) - len(full),
                                                            max([e[0] for e in errors if e[2]] or [math.nan])))
+    print(report[-1])
     for p in predicted:
         print("  %s sphere %d lens %s: (%.3f, %.3f) energy %.3f" % (name, p["sphere"], p["lens"], p["u"], p["v"],
                                                                     p["energy"]))
     for b in found:
         print("  %s blob (%.3f, %.3f) flux %.3f pixels %d" % (name, b["u"], b["v"], b["flux"], b["count"]))
-    checks.check(len(found) > 0 and len(predicted) > 0, "%s: %d blobs, %d predicted images"
+    assert (len(found) > 0 and len(predicted) > 0), ("%s: %d blobs, %d predicted images"
                  % (name, len(found), len(predicted)))
-    checks.check(not missing, "%s: every predicted image with at least %.2f of its sphere's strongest image's "
+    assert (not missing), ("%s: every predicted image with at least %.2f of its sphere's strongest image's "
                  "energy lies in a blob; missing (sphere, lens, u, v, energy): %s"
                  % (name, REQUIRED_ENERGY, missing[:5]))
-    checks.check(not centre_missing, "%s: every sphere's centre images somewhere; none for spheres %s"
+    assert (not centre_missing), ("%s: every sphere's centre images somewhere; none for spheres %s"
                  % (name, centre_missing))
-    checks.check(not centre_stray, "%s: every image of a sphere's centre (with at least %.2f of the energy of "
+    assert (not centre_stray), ("%s: every image of a sphere's centre (with at least %.2f of the energy of "
                  "its strongest) lies in a blob; outside: %s"
                  % (name, REQUIRED_ENERGY, centre_stray[:5]))
-    checks.check(not unexplained, "%s: every blob holds a predicted image; unexplained (u, v, flux): %s"
+    assert (not unexplained), ("%s: every blob holds a predicted image; unexplained (u, v, flux): %s"
                  % (name, unexplained[:5]))
-    checks.check(not mixed, "%s: no blob holds images of two spheres (the scene keeps them apart): %s"
+    assert (not mixed), ("%s: no blob holds images of two spheres (the scene keeps them apart): %s"
                  % (name, mixed[:5]))
     single = OVERLAP_TOLERANCE_PX if cfg.get("overlap") else TOLERANCE_PX
     merged = MERGED_TOLERANCE_PX if cfg.get("overlap") else TOLERANCE_PX
@@ -312,21 +297,7 @@ def run_config(args, checks, cfg, report):
     def allowed(e):
         return LIGHT_TOLERANCE_PX if e[2] else (merged if e[1] > 1 else single)
     bad = [e for e in errors if e[0] > allowed(e)]
-    checks.check(not bad, "%s: blob centroid - energy-weighted predicted images <= %.2f px (%.2f px for blobs "
+    assert (not bad), ("%s: blob centroid - energy-weighted predicted images <= %.2f px (%.2f px for blobs "
                  "holding several images, %.2f px for light images; worst %.3f px); beyond (px, images, light, "
                  "blob u, v, predicted u, v): %s" % (name, single, merged, LIGHT_TOLERANCE_PX, worst[0], bad[:5]))
 
-
-def main():
-    args = gt.parse_args(__doc__)
-    checks = gt.Checks("ground_truth_projection_regimes")
-    report = []
-    for cfg in CONFIGS:
-        run_config(args, checks, cfg, report)
-    for line in report:
-        print(line)
-    checks.finish()
-
-
-if __name__ == "__main__":
-    main()

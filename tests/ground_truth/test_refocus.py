@@ -24,7 +24,7 @@ import sys
 
 import numpy as np
 
-import gt_common as gt
+import plenoptic_testing as pt
 
 W, H = 480, 360
 PIXEL = 0.01
@@ -51,8 +51,8 @@ plane { z, %r texture { Tex scale 0.02 } }
 
 def predicted_slope(z_mm):
     """Lenses per pixel of angular offset for a plane at z (see the module docstring)."""
-    D = gt.image_distance(F, FOCUS_MM)
-    b = gt.image_distance(F, z_mm)
+    D = pt.image_distance(F, FOCUS_MM)
+    b = pt.image_distance(F, z_mm)
     return (D / b - 1) * D * PIXEL / (MICRO_F * PITCH)
 
 
@@ -96,18 +96,16 @@ def peak(values, xs):
     return xs[i]
 
 
-def main():
-    args = gt.parse_args(__doc__)
+def test_refocus(args):
     import plenoptic_lf as lf_module
-    checks = gt.Checks("ground_truth_refocus")
-    png, meta_path, _ = gt.render(args, "refocus_planes", SCENE, W, H)
+    png, meta_path, _ = pt.render_ground_truth(args.povray, args.work, "refocus_planes", SCENE, W, H)
     raw = lf_module.read_raw(png, "linear")
     meta = lf_module.load_metadata(meta_path, (raw.shape[1], raw.shape[0]))
     lf = lf_module.decode(raw, meta)
     T, S, n_v, n_u, _ = lf.shape
     cv, cu = lf.centre_index()
     print("light field %s, angular offsets %s px" % (lf.shape, lf.du.tolist()))
-    checks.check(S >= 30 and T >= 25 and n_u >= 7, "decoded %d x %d lenses with %d x %d angular samples "
+    assert (S >= 30 and T >= 25 and n_u >= 7), ("decoded %d x %d lenses with %d x %d angular samples "
                  "(need >= 30 x 25 and >= 7)" % (S, T, n_u, n_v))
 
     # Lens rows of each plane: the near plane's edge (y = 0) runs through the picture's middle.
@@ -128,8 +126,7 @@ def main():
         measured = ds / baseline
         # Tolerance: 3% of the slope plus a tenth of a lens over the baseline (view matching).
         tolerance = 0.03 * abs(expected) + 0.1 / baseline
-        checks.check(ds is not None and abs(measured - expected) <= tolerance,
-                     "%s (z = %g mm): disparity between views u = %+g and %+g px: %.3f lenses = slope %.4f; "
+        assert (ds is not None and abs(measured - expected) <= tolerance), ("%s (z = %g mm): disparity between views u = %+g and %+g px: %.3f lenses = slope %.4f; "
                      "thin-lens prediction %.4f (tolerance %.4f)"
                      % (name, z, lf.du[left], lf.du[right], ds, measured, expected, tolerance))
         sharpness = np.array([lf_module.laplacian_energy(im)[rows][:, margin:-margin].mean() for im in refocused])
@@ -137,19 +134,18 @@ def main():
         # A sharpness peak cannot tell slopes apart that misalign the outermost views by less than
         # about a quarter of a lens (the images hardly differ): tolerance 0.25 lens / max |du|.
         tolerance = 0.25 / (np.abs(lf.du[usable]).max() / lf.step)
-        checks.check(abs(best - expected) <= tolerance,
-                     "%s: refocus sweep sharpest at slope %.4f; prediction %.4f (tolerance %.4f)"
+        assert (abs(best - expected) <= tolerance), ("%s: refocus sweep sharpest at slope %.4f; prediction %.4f (tolerance %.4f)"
                      % (name, best, expected, tolerance))
         in_focus = lf_module.laplacian_energy(lf.refocus(expected))[rows].mean()
         at_zero = lf_module.laplacian_energy(lf.refocus(0.0))[rows].mean()
-        checks.check(in_focus > 1.5 * at_zero, "%s: refocused at the predicted slope it is %.2f times as sharp "
+        assert (in_focus > 1.5 * at_zero), ("%s: refocused at the predicted slope it is %.2f times as sharp "
                      "as at slope 0 (need > 1.5)" % (name, in_focus / max(at_zero, 1e-12)))
 
     # The command-line decoder on the same render: every output it promises.
     out = os.path.join(args.work, "refocus_planes.lightfield")
-    run = subprocess.run([sys.executable, os.path.join(args.tools, "plenoptic-decode"), png, "-o", out,
+    run = subprocess.run(pt.decoder(args.tools) + [png, "-o", out,
                           "--encoding", "linear"], capture_output=True, text=True)
-    checks.check(run.returncode == 0, "plenoptic-decode exits 0 (got %d; stderr: %s)"
+    assert (run.returncode == 0), ("plenoptic-decode exits 0 (got %d; stderr: %s)"
                  % (run.returncode, run.stderr.strip()[-500:]))
     if run.returncode == 0:
         description = json.load(open(os.path.join(out, "lightfield.json")))
@@ -157,31 +153,23 @@ def main():
         refocus = glob.glob(os.path.join(out, "refocus", "*.png"))
         expected_files = ["contact_sheet.png", "views_mosaic.png", "epi.png", "refocus.gif", "lightfield.npy"]
         missing = [f for f in expected_files if not os.path.exists(os.path.join(out, f))]
-        checks.check(not missing and len(views) == int(lf.mask.sum()) and len(refocus) == len(description["slopes"]),
-                     "decoder wrote %s, %d views (usable angular samples: %d), %d refocus PNGs (%d slopes); missing: %s"
+        assert (not missing and len(views) == int(lf.mask.sum()) and len(refocus) == len(description["slopes"])), ("decoder wrote %s, %d views (usable angular samples: %d), %d refocus PNGs (%d slopes); missing: %s"
                      % (expected_files, len(views), int(lf.mask.sum()), len(refocus), len(description["slopes"]),
                         missing))
         stored = np.load(os.path.join(out, "lightfield.npy"))
-        checks.check(stored.shape == lf.shape and np.abs(stored - lf.data).max() < 1e-5,
-                     "lightfield.npy %s equals the module's decode %s" % (stored.shape, lf.shape))
+        assert (stored.shape == lf.shape and np.abs(stored - lf.data).max() < 1e-5), "lightfield.npy %s equals the module's decode %s" % (stored.shape, lf.shape)
         from PIL import Image
         sheet = Image.open(os.path.join(out, "contact_sheet.png"))
-        checks.check(sheet.size[0] >= 1000 and sheet.size[1] >= 400, "contact sheet is %d x %d px" % sheet.size)
+        assert (sheet.size[0] >= 1000 and sheet.size[1] >= 400), "contact sheet is %d x %d px" % sheet.size
         near_i, far_i = description["near_far_slope_index"]
         sweep = description["slopes"]
         step = sweep[1] - sweep[0]
-        checks.check(abs(sweep[near_i] - predicted_slope(Z_NEAR)) <= step
-                     and abs(sweep[far_i] - predicted_slope(Z_FAR)) <= step,
-                     "contact sheet's near/far panels use slopes %.3f / %.3f; the planes' slopes are %.3f / %.3f "
+        assert (abs(sweep[near_i] - predicted_slope(Z_NEAR)) <= step
+                     and abs(sweep[far_i] - predicted_slope(Z_FAR)) <= step), ("contact sheet's near/far panels use slopes %.3f / %.3f; the planes' slopes are %.3f / %.3f "
                      "(within one sweep step %.3f)" % (sweep[near_i], sweep[far_i], predicted_slope(Z_NEAR),
                                                        predicted_slope(Z_FAR), step))
         distances = description["slope_distances"]
-        checks.check(distances[near_i] is not None and distances[far_i] is not None
-                     and distances[near_i] < 1.0 < distances[far_i],
-                     "the near panel is labelled nearer than the focus distance 1 and the far one farther: %s / %s"
+        assert (distances[near_i] is not None and distances[far_i] is not None
+                     and distances[near_i] < 1.0 < distances[far_i]), ("the near panel is labelled nearer than the focus distance 1 and the far one farther: %s / %s"
                      % (distances[near_i], distances[far_i]))
-    checks.finish()
 
-
-if __name__ == "__main__":
-    main()

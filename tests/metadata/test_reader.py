@@ -12,10 +12,12 @@ A surrogate pair and raw UTF-8 in a string must still be accepted. Finally the r
 numbers are in their shortest round-trip form (a pitch of 0.15 is written 0.15).
 """
 
-import argparse
 import os
 import subprocess
-import sys
+
+import pytest
+
+import plenoptic_testing as pt
 
 SCENE = """#version 3.7;
 global_settings { assumed_gamma 1.0 }
@@ -32,98 +34,86 @@ sphere { 0, 0.3 pigment { rgb 1 } finish { emission 1 diffuse 0 } }
 """
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--povray", required=True)
-    ap.add_argument("--project", required=True, help="the plenoptic-project binary")
-    ap.add_argument("--work", required=True)
-    args = ap.parse_args()
-    os.makedirs(args.work, exist_ok=True)
-    failures = []
+NULL_DEPTH = b'"depth_map": null'
 
-    def check(ok, message):
-        print(("ok    " if ok else "FAIL  ") + message)
-        if not ok:
-            failures.append(message)
+# label -> (old, new) replaced once in the rendered file, or a function of it; words the one line
+# of stderr must hold.
+CASES = [
+    ("lone high surrogate", (NULL_DEPTH, b'"depth_map": "\\ud800.exr"'), ["surrogate"]),
+    ("lone low surrogate", (NULL_DEPTH, b'"depth_map": "\\udc00.exr"'), ["surrogate"]),
+    ("high surrogate then a letter", (NULL_DEPTH, b'"depth_map": "\\ud83d\\u0041.exr"'), ["surrogate"]),
+    ("Latin-1 byte", (NULL_DEPTH, b'"depth_map": "caf\xe9.exr"'), ["UTF-8"]),
+    ("overlong encoding", (NULL_DEPTH, b'"depth_map": "\xc0\xaf.exr"'), ["UTF-8"]),
+    ("encoded surrogate", (NULL_DEPTH, b'"depth_map": "\xed\xa0\x80.exr"'), ["UTF-8"]),
+    ("cut sequence", (NULL_DEPTH, b'"depth_map": "\xe2\x82"'), ["UTF-8"]),
+    ("duplicate top-level key", (b'"mm_per_unit": 1000,', b'"mm_per_unit": 1000,\n  "mm_per_unit": 500,'),
+     ["duplicate key 'mm_per_unit'"]),
+    ("duplicate key, same value", (b'"version": 1,', b'"version": 1,\n  "version": 1,'),
+     ["duplicate key 'version'"]),
+    ("duplicate nested key", (b'"pitch_mm":', b'"pitch_mm": 0.3,\n    "pitch_mm":'),
+     ["duplicate key 'pitch_mm'", "microlens_array"]),
+    ("truncated", lambda good: good[:len(good) // 2], ["not valid JSON", "line"]),
+    ("truncated inside a string", lambda good: good[:good.index(b'"hexagonal"') + 4], ["not valid JSON"]),
+    ("empty file", lambda good: b"", ["not valid JSON"]),
+]
 
-    with open(os.path.join(args.work, "reader.pov"), "w") as f:
-        f.write(SCENE)
+
+@pytest.fixture(scope="module")
+def good(args):
+    """The bytes of the rendered metadata."""
+    pt.render(args.povray, args.work, "reader", SCENE, 48, 36, options=("-D", "-P", "-V"), relative=True)
     meta = os.path.join(args.work, "reader.plenoptic.json")
-    if os.path.exists(meta):
-        os.remove(meta)
-    run = subprocess.run([args.povray, "+Ireader.pov", "+Oreader.png", "+W48", "+H36", "-D", "-P", "-V"],
-                         cwd=args.work, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-    if run.returncode != 0 or not os.path.exists(meta):
-        print(run.stdout.decode(errors="replace")[-2000:])
-        print("FAIL  render (exit %d)" % run.returncode)
-        return 1
+    assert os.path.exists(meta), "the render wrote no %s" % meta
     with open(meta, "rb") as f:
-        good = f.read()
-
-    def project(path):
-        r = subprocess.run([args.project, path, "0", "0", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-        return r.returncode, r.stdout.decode(errors="replace"), r.stderr.decode(errors="replace")
-
-    code, out, err = project(meta)
-    check(code == 0 and out.strip(), "the rendered metadata projects (exit %d, %r)" % (code, err.strip()))
-
-    def variant(name, data):
-        path = os.path.join(args.work, "reader_" + name + ".plenoptic.json")
-        with open(path, "wb") as f:
-            f.write(data)
-        return path
-
-    def replaced(old, new):
-        assert old in good, old
-        return good.replace(old, new, 1)
-
-    null_depth = b'"depth_map": null'
-    cases = [
-        ("lone high surrogate", replaced(null_depth, b'"depth_map": "\\ud800.exr"'), ["surrogate"]),
-        ("lone low surrogate", replaced(null_depth, b'"depth_map": "\\udc00.exr"'), ["surrogate"]),
-        ("high surrogate then a letter", replaced(null_depth, b'"depth_map": "\\ud83d\\u0041.exr"'), ["surrogate"]),
-        ("Latin-1 byte", replaced(null_depth, b'"depth_map": "caf\xe9.exr"'), ["UTF-8"]),
-        ("overlong encoding", replaced(null_depth, b'"depth_map": "\xc0\xaf.exr"'), ["UTF-8"]),
-        ("encoded surrogate", replaced(null_depth, b'"depth_map": "\xed\xa0\x80.exr"'), ["UTF-8"]),
-        ("cut sequence", replaced(null_depth, b'"depth_map": "\xe2\x82"'), ["UTF-8"]),
-        ("duplicate top-level key", replaced(b'"mm_per_unit": 1000,', b'"mm_per_unit": 1000,\n  "mm_per_unit": 500,'),
-         ["duplicate key 'mm_per_unit'"]),
-        ("duplicate key, same value", replaced(b'"version": 1,', b'"version": 1,\n  "version": 1,'),
-         ["duplicate key 'version'"]),
-        ("duplicate nested key", replaced(b'"pitch_mm":', b'"pitch_mm": 0.3,\n    "pitch_mm":'),
-         ["duplicate key 'pitch_mm'", "microlens_array"]),
-        ("truncated", good[:len(good) // 2], ["not valid JSON", "line"]),
-        ("truncated inside a string", good[:good.index(b'"hexagonal"') + 4], ["not valid JSON"]),
-        ("empty file", b"", ["not valid JSON"]),
-    ]
-    for label, data, words in cases:
-        path = variant(label.replace(" ", "_").replace(",", ""), data)
-        code, out, err = project(path)
-        lines = [l for l in err.splitlines() if l.strip()]
-        ok = (code == 2 and out == "" and len(lines) == 1 and lines[0].startswith("plenoptic-project: " + path + ": ")
-              and all(w in lines[0] for w in words) and lines[0].isprintable() and lines[0].isascii())
-        check(ok, "%s: refused, exit %d (want 2), stderr %r (want one line naming the file and %s)"
-              % (label, code, err.strip()[-300:], words))
-
-    # Accepted: a surrogate pair, raw UTF-8, and non-ASCII in a string.
-    path = variant("utf8", replaced(null_depth, '"depth_map": "sc\\u00e9ne \\ud83d\\ude00 é.exr"'.encode("utf-8")))
-    code, out, err = project(path)
-    check(code == 0 and out.strip(), "a surrogate pair and UTF-8 in a string are accepted (exit %d, %r)"
-          % (code, err.strip()))
-
-    # The writer: shortest round-trip numbers.
-    check(b'"pitch_mm": 0.15,' in good and b"0.14999999999999999" not in good,
-          "the rendered file writes the pitch 0.15 as 0.15 (%r)"
-          % [l.strip() for l in good.splitlines() if b"pitch_mm" in l])
-    check(b'"focal_lengths_mm": [0.6]' in good and b'"distance_mm": 0.6,' in good,
-          "and the microlens focal length and distance 0.6 as 0.6")
-
-    if failures:
-        print("metadata_reader: %d check(s) failed" % len(failures))
-        return 1
-    print("metadata_reader: all checks passed")
-    return 0
+        return f.read()
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+def project(args, path):
+    r = subprocess.run([args.project, path, "0", "0", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    return r.returncode, r.stdout.decode(errors="replace"), r.stderr.decode(errors="replace")
+
+
+def variant(args, name, data):
+    path = os.path.join(args.work, "reader_" + name + ".plenoptic.json")
+    with open(path, "wb") as f:
+        f.write(data)
+    return path
+
+
+def replaced(good, old, new):
+    assert old in good, old
+    return good.replace(old, new, 1)
+
+
+def test_rendered_metadata_projects(args, good):
+    code, out, err = project(args, os.path.join(args.work, "reader.plenoptic.json"))
+    assert code == 0 and out.strip(), "the rendered metadata projects (exit %d, %r)" % (code, err.strip())
+
+
+@pytest.mark.parametrize("label, change, words", CASES, ids=[c[0] for c in CASES])
+def test_broken_metadata_refused(args, good, label, change, words):
+    data = change(good) if callable(change) else replaced(good, *change)
+    path = variant(args, label.replace(" ", "_").replace(",", ""), data)
+    code, out, err = project(args, path)
+    lines = [l for l in err.splitlines() if l.strip()]
+    ok = (code == 2 and out == "" and len(lines) == 1 and lines[0].startswith("plenoptic-project: " + path + ": ")
+          and all(w in lines[0] for w in words) and lines[0].isprintable() and lines[0].isascii())
+    assert ok, ("%s: refused, exit %d (want 2), stderr %r (want one line naming the file and %s)"
+                % (label, code, err.strip()[-300:], words))
+
+
+def test_surrogate_pair_and_utf8_accepted(args, good):
+    """Accepted: a surrogate pair, raw UTF-8, and non-ASCII in a string."""
+    path = variant(args, "utf8", replaced(good, NULL_DEPTH,
+                                          '"depth_map": "sc\\u00e9ne \\ud83d\\ude00 é.exr"'.encode("utf-8")))
+    code, out, err = project(args, path)
+    assert code == 0 and out.strip(), ("a surrogate pair and UTF-8 in a string are accepted (exit %d, %r)"
+                                       % (code, err.strip()))
+
+
+def test_writer_shortest_numbers(good):
+    """The writer: shortest round-trip numbers."""
+    assert b'"pitch_mm": 0.15,' in good and b"0.14999999999999999" not in good, (
+        "the rendered file writes the pitch 0.15 as 0.15 (%r)" % [l.strip() for l in good.splitlines() if b"pitch_mm" in l])
+    assert b'"focal_lengths_mm": [0.6]' in good and b'"distance_mm": 0.6,' in good, (
+        "and the microlens focal length and distance 0.6 as 0.6")

@@ -15,20 +15,17 @@ lattice without an array, ...) must each be refused. The golden references
 (tests/golden/references) must match the schema too.
 """
 
-import argparse
 import copy
 import glob
 import json
 import os
 import re
-import subprocess
-import sys
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
-import metadata_schema  # noqa: E402
+import pytest
 
-REFERENCES = os.path.join(HERE, "..", "golden", "references")
+import plenoptic_testing as pt
+
+REFERENCES = os.path.join(pt.GOLDEN_DIR, "references")
 
 HEADER = """#version 3.7;
 global_settings { assumed_gamma 1.0 }
@@ -123,21 +120,10 @@ def get(doc, path):
 
 
 def render(args, name, body):
-    work = args.work
-    pov = os.path.join(work, name + ".pov")
-    out = os.path.join(work, name + ".png")
-    for stale in (out, os.path.join(work, name + ".plenoptic.json"), os.path.join(work, name + ".depth.exr")):
-        if os.path.exists(stale):
-            os.remove(stale)
-    with open(pov, "w") as f:
-        f.write(HEADER + "camera {\n  plenoptic\n  location <0, 0, -2>\n  look_at <0, 0, 0>\n  sensor { "
-                "pixel_size 0.02 }\n  %s\n}\n" % body)
-    cmd = [args.povray, "+I" + name + ".pov", "+O" + name + ".png", "+W48", "+H36", "-D", "-P", "-V", "+WT1"]
-    run = subprocess.run(cmd, cwd=work, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-    if run.returncode != 0:
-        raise RuntimeError("render of %s failed (exit %d):\n%s" % (name, run.returncode,
-                                                                   run.stdout.decode(errors="replace")[-2000:]))
-    return os.path.join(work, name + ".plenoptic.json")
+    text = (HEADER + "camera {\n  plenoptic\n  location <0, 0, -2>\n  look_at <0, 0, 0>\n  sensor { "
+            "pixel_size 0.02 }\n  %s\n}\n" % body)
+    pt.render(args.povray, args.work, name, text, 48, 36, options=("-D", "-P", "-V", "+WT1"), relative=True)
+    return os.path.join(args.work, name + ".plenoptic.json")
 
 
 def mutations(doc):
@@ -200,85 +186,86 @@ def mutations(doc):
     ]
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--povray", required=True)
-    ap.add_argument("--work", required=True)
-    args = ap.parse_args()
-    os.makedirs(args.work, exist_ok=True)
-    failures = []
-
-    def check(ok, message):
-        print(("ok    " if ok else "FAIL  ") + message)
-        if not ok:
-            failures.append(message)
-
-    docs = {}
-    for name, (body, expect) in SCENES.items():
+@pytest.fixture(scope="module")
+def docs(args):
+    """name -> the metadata of its render, or the MetadataError reading it raised."""
+    out = {}
+    for name, (body, _) in SCENES.items():
         path = render(args, name, body)
         try:
-            doc = metadata_schema.load(path)
-        except metadata_schema.MetadataError as e:
-            check(False, "%s: %s" % (name, e))
+            out[name] = pt.load_metadata(path)
+        except pt.MetadataError as e:
+            out[name] = e
+    return out
+
+
+def rendered(docs, name):
+    doc = docs[name]
+    assert not isinstance(doc, Exception), "%s: %s" % (name, doc)
+    return doc
+
+
+@pytest.mark.parametrize("name", list(SCENES))
+def test_submodel_metadata(args, docs, name):
+    doc = rendered(docs, name)  # strict JSON, matches the schema
+    expect = SCENES[name][1]
+    with open(os.path.join(args.work, name + ".plenoptic.json"), encoding="utf-8") as f:
+        text = f.read()
+    wrong_order = [p or "(top level)" for p, keys in ORDER.items()
+                   if isinstance(get(doc, p) if p else doc, dict) and list((get(doc, p) if p else doc)) != keys]
+    assert not wrong_order, "%s: members in the documented order (wrong in %s)" % (name, wrong_order)
+    bad = not_shortest(text)
+    assert not bad, "%s: every number in its shortest round-trip form (not: %s)" % (name, bad[:5])
+    wrong = {p: get(doc, p) for p, v in expect.items() if get(doc, p) != v}
+    assert not wrong, "%s: says what the scene asked for (wrong: %r)" % (name, wrong)
+
+
+@pytest.mark.parametrize("source", ["thin_thin_hexagonal", "multifocus", "none_pinhole_array"])
+def test_schema_refuses_mutations(docs, source):
+    """The schema can fail: mutated copies of real documents."""
+    accepted = []
+    for label, broken in mutations(rendered(docs, source)):
+        if source == "multifocus" and label in ("two focal lengths", "three lens types with one focal length"):
             continue
-        docs[name] = doc
-        check(True, "%s: strict JSON, matches the schema" % name)
-        with open(path, encoding="utf-8") as f:
-            text = f.read()
-        wrong_order = [p or "(top level)" for p, keys in ORDER.items()
-                       if isinstance(get(doc, p) if p else doc, dict) and list((get(doc, p) if p else doc)) != keys]
-        check(not wrong_order, "%s: members in the documented order (wrong in %s)" % (name, wrong_order))
-        bad = not_shortest(text)
-        check(not bad, "%s: every number in its shortest round-trip form (not: %s)" % (name, bad[:5]))
-        wrong = {p: get(doc, p) for p, v in expect.items() if get(doc, p) != v}
-        check(not wrong, "%s: says what the scene asked for (wrong: %r)" % (name, wrong))
-
-    # The schema can fail: mutated copies of real documents.
-    for source in ("thin_thin_hexagonal", "multifocus", "none_pinhole_array"):
-        if source not in docs:
+        if source == "none_pinhole_array" and label in ("thin lens without focal length",):
             continue
-        for label, broken in mutations(docs[source]):
-            if source == "multifocus" and label in ("two focal lengths", "three lens types with one focal length"):
-                continue
-            if source == "none_pinhole_array" and label in ("thin lens without focal length",):
-                continue
-            problems = metadata_schema.schema_errors(broken)
-            check(bool(problems), "%s, %s: refused by the schema (%s)" % (source, label, "; ".join(problems[:2])))
-    if "multifocus" in docs:
-        broken = copy.deepcopy(docs["multifocus"])
-        broken["microimage_lattice"]["lens_types"] = 1
-        broken["microimage_lattice"]["lens_type_rule"] = "type(k, l) = 0"
-        problems = metadata_schema.schema_errors(broken)
-        check(bool(problems), "multifocus, one lens type with three focal lengths: refused (%s)" % problems[:1])
+        if not pt.schema_errors(broken):
+            accepted.append(label)
+    assert not accepted, "%s: mutated copies the schema does not refuse: %s" % (source, accepted)
 
-    # The strict reading refuses what Python's json would let through.
-    good = json.dumps(docs.get("thin_thin_hexagonal", {}))
-    for label, data in (("duplicate key", good.replace('"version": 1,', '"version": 1, "version": 1,', 1)),
-                        ("lone surrogate", good.replace('"depth_map": null', '"depth_map": "\\ud800.exr"')),
-                        ("invalid UTF-8", good.replace('"depth_map": null', '"depth_map": "caf\xe9.exr"')
-                         .encode("latin-1")),
-                        ("NaN", good.replace('"mm_per_unit": 1000', '"mm_per_unit": NaN'))):
-        try:
-            metadata_schema.parse(data, "mutated")
-            check(False, "strict reading, %s: accepted" % label)
-        except metadata_schema.MetadataError as e:
-            check(True, "strict reading, %s: refused (%s)" % (label, e))
 
-    # The golden references (written by earlier builds) match the schema too.
+def test_one_lens_type_with_three_focal_lengths_refused(docs):
+    broken = copy.deepcopy(rendered(docs, "multifocus"))
+    broken["microimage_lattice"]["lens_types"] = 1
+    broken["microimage_lattice"]["lens_type_rule"] = "type(k, l) = 0"
+    problems = pt.schema_errors(broken)
+    assert problems, "multifocus, one lens type with three focal lengths: accepted by the schema"
+
+
+STRICT_CASES = ["duplicate key", "lone surrogate", "invalid UTF-8", "NaN"]
+
+
+@pytest.mark.parametrize("label", STRICT_CASES)
+def test_strict_reading_refuses(docs, label):
+    """The strict reading refuses what Python's json would let through."""
+    good = json.dumps(rendered(docs, "thin_thin_hexagonal"))
+    data = {"duplicate key": good.replace('"version": 1,', '"version": 1, "version": 1,', 1),
+            "lone surrogate": good.replace('"depth_map": null', '"depth_map": "\\ud800.exr"'),
+            "invalid UTF-8": good.replace('"depth_map": null', '"depth_map": "caf\xe9.exr"').encode("latin-1"),
+            "NaN": good.replace('"mm_per_unit": 1000', '"mm_per_unit": NaN')}[label]
+    assert data != good, "strict reading, %s: the mutation did not apply" % label
+    with pytest.raises(pt.MetadataError):
+        pt.parse_json_strict(data, "mutated")
+
+
+def test_golden_references_match_schema():
+    """The golden references (written by earlier builds) match the schema too."""
     references = sorted(glob.glob(os.path.join(REFERENCES, "*.plenoptic.json")))
+    problems = []
     for ref in references:
         try:
-            metadata_schema.load(ref)
-        except metadata_schema.MetadataError as e:
-            check(False, "golden reference %s: %s" % (os.path.basename(ref), e))
-    check(len(references) > 0, "%d golden references match the schema" % len(references))
-
-    if failures:
-        print("metadata_schema: %d check(s) failed" % len(failures))
-        return 1
-    print("metadata_schema: all checks passed")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+            pt.load_metadata(ref)
+        except pt.MetadataError as e:
+            problems.append("golden reference %s: %s" % (os.path.basename(ref), e))
+    assert not problems, "\n".join(problems)
+    assert len(references) > 0, "%d golden references match the schema" % len(references)

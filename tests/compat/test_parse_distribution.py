@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Every scene and include file of POV-Ray's own distribution that parses with Debian's
 packaged povray must parse with ours (docs/specification.md, section 6).
@@ -18,12 +17,14 @@ Items:
   menu      each [section] of the Windows "Insert Menu" Images.ini (Declare=Switch=N),
             which is how those .pov files and their .txt snippets are meant to be parsed
 
-Modes:
-  --mode full  every item, with both binaries; writes <work>/report.tsv, prints the time
-               each binary took and the list of items that fail with both.
-  --mode ci    the deterministic subset (every include item + every Nth other item of the
-               sorted list, N = --every); ours runs on each item and Debian's only on the
+Modes (pytest options, tests/conftest.py):
+  --compat-mode full  every item, with both binaries; writes <work>/report.tsv, prints the time
+               each binary took and the list of items that fail with both (tests/compat/full-sweep).
+  --compat-mode ci    the deterministic subset (every include item + every Nth other item of the
+               sorted list, N = --compat-every); ours runs on each item and Debian's only on the
                items where ours fails (the question is only ever "does Debian parse it?").
+  --compat-only REGEX: only items whose name matches; --compat-timeout: seconds per parse;
+  --compat-known: fails_with_both.txt to compare the full sweep with.
 
 Both programs run with the same user povray.conf (HOME points into the work directory) that
 lets them read the distribution, and find the distribution's timrom.ttf under the names of
@@ -32,14 +33,12 @@ the Windows fonts the Insert Menu snippets use.
 An item fails when Debian's povray reaches the marker and ours does not. Items that fail
 with both binaries are listed (tests/compat/fails_with_both.txt holds the full sweep's list).
 """
-import argparse
 import glob
 import os
 import re
 import shutil
-import subprocess
-import sys
-import time
+
+import plenoptic_testing as pt
 
 MARKER = "COMPAT-PARSE-REACHED-END"
 # Include files are parsed after the three that POV-Ray's documentation tells a scene to
@@ -190,15 +189,6 @@ def no_spaces(path, work):
     return link
 
 
-def first_error(text, code):
-    """The first error POV-Ray printed, on one line (the error line and the two after it)."""
-    lines = [l.strip() for l in text.splitlines() if l.strip()]
-    for i, l in enumerate(lines):
-        if "error" in l.lower():
-            return " | ".join(lines[i:i + 3])[:400]
-    return ("exit %d: %s" % (code, lines[-1] if lines else "no output"))[:400]
-
-
 def parse_once(povray, item, work, home, fonts, timeout):
     """-> (status, seconds, message); status is ok | error | timeout."""
     d = os.path.join(work, "items", safe_name(item.ident))
@@ -211,41 +201,26 @@ def parse_once(povray, item, work, home, fonts, timeout):
                                       "-GS", "-GR", "-GW"]
     cmd += ["+L" + no_spaces(p, work) for p in item.libdirs] + ["+L" + fonts] + item.post_args
     env = dict(os.environ, HOME=home)
-    t0 = time.monotonic()
     try:
-        res = subprocess.run(cmd, cwd=d, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                             timeout=timeout)
-    except subprocess.TimeoutExpired:
-        return "timeout", time.monotonic() - t0, "no end of parse within %d s" % timeout
+        res = pt.run_process(cmd, cwd=d, env=env, timeout=timeout)
     except OSError as e:  # the program itself cannot run: no verdict on the item
-        raise SystemExit("FAIL: cannot run %s: %s" % (povray, e))
-    dt = time.monotonic() - t0
-    text = res.stdout.decode(errors="replace")
-    if MARKER in text:
+        raise AssertionError("cannot run %s: %s" % (povray, e))
+    if res.timed_out:
+        return "timeout", res.seconds, "no end of parse within %d s" % timeout
+    if MARKER in res.output:
         shutil.rmtree(d, ignore_errors=True)
-        return "ok", dt, ""
-    return "error", dt, first_error(text, res.returncode)
+        return "ok", res.seconds, ""
+    return "error", res.seconds, pt.first_error(res.output, res.returncode)
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--povray", required=True, help="our povray")
-    ap.add_argument("--reference", default="/usr/bin/povray", help="Debian's packaged povray")
-    ap.add_argument("--distribution", required=True, help="UPSTREAM_DIR/distribution")
-    ap.add_argument("--work", required=True, help="scratch directory")
-    ap.add_argument("--mode", choices=["ci", "full"], default="ci")
-    ap.add_argument("--every", type=int, default=8, help="ci: keep every Nth non-include item")
-    ap.add_argument("--timeout", type=int, default=120, help="seconds per parse")
-    ap.add_argument("--known", help="fails_with_both.txt to compare the full sweep with")
-    ap.add_argument("--only", help="regular expression: only items whose name matches")
-    args = ap.parse_args()
-
-    if not os.path.exists(args.reference):
-        print("FAIL: Debian's povray (%s) is not installed: run tools/install-deps" % args.reference)
-        return 1
-    dist = os.path.abspath(args.distribution)
-    work = os.path.abspath(args.work)
-    os.makedirs(work, exist_ok=True)
+def test_parse_distribution(args):
+    reference = pt.require_debian_povray(args.reference_povray)
+    assert args.upstream, "no --upstream (the unpacked Debian POV-Ray source)"
+    mode, every, timeout = args.compat_mode, int(args.compat_every), int(args.compat_timeout)
+    known, only = args.compat_known, args.compat_only
+    assert mode in ("ci", "full"), "--compat-mode is ci or full, not %r" % mode
+    dist = os.path.abspath(os.path.join(args.upstream, "distribution"))
+    work = args.work
     home = prepare_home(work, dist)
     fonts = prepare_fonts(work, dist)
 
@@ -253,26 +228,24 @@ def main():
     counts = {}
     for it in items:
         counts[it.kind] = counts.get(it.kind, 0) + 1
-    chosen = items if args.mode == "full" else ci_subset(items, args.every)
-    if args.only:
-        chosen = [it for it in chosen if re.search(args.only, it.ident)]
+    chosen = items if mode == "full" else ci_subset(items, every)
+    if only:
+        chosen = [it for it in chosen if re.search(only, it.ident)]
     print("distribution: %s" % dist)
     print("items: %s; this run (%s): %d" % (", ".join("%d %s" % (counts[k], k) for k in sorted(counts)),
-                                           args.mode, len(chosen)))
-    if not chosen:
-        print("FAIL: no item to parse (is %s POV-Ray's distribution folder?)" % dist)
-        return 1
+                                           mode, len(chosen)))
+    assert chosen, "no item to parse (is %s POV-Ray's distribution folder?)" % dist
 
     regressions, both, only_ours, rows = [], [], [], []
     t_ours = t_ref = 0.0
     report = open(os.path.join(work, "report.tsv"), "w")
     report.write("kind\titem\tours\tdebian\tours_seconds\tdebian_seconds\tours_message\tdebian_message\n")
     for it in chosen:
-        s_ours, dt_ours, m_ours = parse_once(args.povray, it, work, home, fonts, args.timeout)
+        s_ours, dt_ours, m_ours = parse_once(args.povray, it, work, home, fonts, timeout)
         t_ours += dt_ours
         s_ref, dt_ref, m_ref = None, 0.0, ""
-        if args.mode == "full" or s_ours != "ok":
-            s_ref, dt_ref, m_ref = parse_once(args.reference, it, work, home, fonts, args.timeout)
+        if mode == "full" or s_ours != "ok":
+            s_ref, dt_ref, m_ref = parse_once(reference, it, work, home, fonts, timeout)
             t_ref += dt_ref
         row = (it.kind, it.ident, s_ours, s_ref or "-", "%.2f" % dt_ours, "%.2f" % dt_ref, m_ours, m_ref)
         rows.append(row)
@@ -298,23 +271,20 @@ def main():
         print("%d item(s) parse with ours only:" % len(only_ours))
         for ident, msg in only_ours:
             print("  ours-only  %s: Debian says %s" % (ident, msg))
-    if args.mode == "full":
+    if mode == "full":
         listing = os.path.join(work, "fails_with_both.txt")
         with open(listing, "w") as f:
             for ident, _ in both:
                 f.write(ident + "\n")
         print("list of items failing with both written to %s" % listing)
-        if args.known and os.path.exists(args.known) and not args.only:
-            with open(args.known) as f:
-                known = set(l.strip() for l in f if l.strip() and not l.startswith("#"))
+        if known and os.path.exists(known) and not only:
+            with open(known) as f:
+                listed = set(l.strip() for l in f if l.strip() and not l.startswith("#"))
             now = set(i for i, _ in both)
-            if known != now:
+            if listed != now:
                 print("note: %s differs from this sweep: new %s, gone %s"
-                      % (args.known, sorted(now - known), sorted(known - now)))
+                      % (known, sorted(now - listed), sorted(listed - now)))
     print("%d parsed, %d fail with both, %d regression(s)"
           % (len(chosen) - len(both) - len(regressions), len(both), len(regressions)))
-    return 1 if regressions else 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    assert not regressions, ("%d item(s) that Debian's povray parses and ours does not: %s"
+                             % (len(regressions), ", ".join(it.ident for it in regressions)))

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Malformed plenoptic camera blocks: every one must be refused at parse time.
 
@@ -21,13 +20,12 @@ has (location, look_at, transforms); the specification (docs/specification.md, s
 refuses "any NaN or infinite value", while stock POV-Ray accepts them for its own cameras, so
 they are a separate ctest.
 """
-import argparse
 import os
 import shutil
-import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import rtlib  # noqa: E402
+import pytest
+
+import plenoptic_testing as pt
 
 MAIN = """\
   main_lens {
@@ -284,11 +282,11 @@ def marked_lines(block):
     """Lines (1-based, in the whole scene) where the error may be reported: every line marked
     with MARK (a rule may be checked at the second keyword or at the closing brace); a block
     without a marker is unterminated, and the error belongs at the first line after it."""
-    text = rtlib.scene_text(block).splitlines()
+    text = pt.scene_text(block).splitlines()
     marked = [n for n, line in enumerate(text, 1) if MARK in line]
     if marked:
         return marked
-    return [len(rtlib.HEADER.splitlines()) + len(block.rstrip("\n").splitlines()) + 1]
+    return [len(pt.WORLD_HEADER.splitlines()) + len(block.rstrip("\n").splitlines()) + 1]
 
 
 def check_case(povray, work, index, name, block, fragments):
@@ -297,17 +295,17 @@ def check_case(povray, work, index, name, block, fragments):
     shutil.rmtree(case_dir, ignore_errors=True)
     os.makedirs(case_dir)
     scene = os.path.join(case_dir, "bad.pov")
-    rtlib.write_scene(scene, block)
+    pt.write_scene(scene, block)
     expected_lines = marked_lines(block)
-    run = rtlib.run_povray(povray, "bad.pov", os.path.join(case_dir, "bad.png"), 16, 12,
+    run = pt.run_povray(povray, "bad.pov", os.path.join(case_dir, "bad.png"), 16, 12,
                            ["+FN8", "+WT1"], timeout=30, cwd=case_dir)
-    problems, err = rtlib.refusal_problems(run)
+    problems, err = pt.refusal_problems(run)
     if err is not None:
         efile, eline, message = err
         if os.path.basename(efile) != "bad.pov":
             problems.append("error names file %r, expected bad.pov" % efile)
         if eline not in expected_lines:
-            text = rtlib.scene_text(block).splitlines()
+            text = pt.scene_text(block).splitlines()
             problems.append("LINE: error reported at line %d (%r), expected line %s (%s)" %
                             (eline, text[eline - 1].strip() if 0 < eline <= len(text) else "?",
                              " or ".join(str(n) for n in expected_lines),
@@ -321,51 +319,34 @@ def check_case(povray, work, index, name, block, fragments):
     if problems and all(p.startswith("LINE:") for p in problems):
         problems.append("message (right apart from the line): " + err[2])
     elif problems:
-        problems.append("povray output:\n" + rtlib.tail(run.output, 8))
+        problems.append("povray output:\n" + pt.tail(run.output, 8))
     return problems, run, err
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--povray", required=True)
-    ap.add_argument("--work", required=True, help="scratch directory")
-    ap.add_argument("--group", choices=sorted(GROUPS), default="camera")
-    ap.add_argument("--list", action="store_true", help="print the table and exit")
-    ap.add_argument("-k", help="only cases whose name contains this text")
-    args = ap.parse_args()
-
-    cases = GROUPS[args.group]
-    if args.list:
-        for name, block, fragments, why in cases:
-            print("%-55s %-60s %s" % (name, " + ".join(fragments), why))
-        return 0
-    work = os.path.join(args.work, args.group)
+def refused(args, group, index, name, block, fragments, why):
+    work = os.path.join(args.work, group)
     os.makedirs(work, exist_ok=True)
-    passed = failed = line_only = 0
-    for index, (name, block, fragments, why) in enumerate(cases):
-        if args.k and args.k not in name:
-            continue
-        problems, run, err = check_case(args.povray, work, index, name, block, fragments)
-        if problems:
-            failed += 1
-            if problems[0].startswith("LINE:"):
-                line_only += 1
-            print("FAIL %-50s (%s)" % (name, why))
-            for p in problems:
-                print("     " + p)
-        else:
-            passed += 1
-            print("ok   %-50s line %d: %s" % (name, err[1], err[2][:110]))
-    if line_only:
-        print("NOTE: %d of the failures are only the reported line: the value was refused with the right "
-              "message, but at the line of the token after it (the check runs once POV-Ray has read "
-              "ahead; known bug, see docs/robustness.md)" % line_only)
-    print("%d passed, %d failed" % (passed, failed))
-    if args.group == "camera" and not args.k and passed + failed < 40:
-        print("FAIL: the table must hold at least 40 cases, it has %d" % (passed + failed))
-        return 1
-    return 1 if failed else 0
+    problems, run, err = check_case(args.povray, work, index, name, block, fragments)
+    note = ""
+    if problems and problems[0].startswith("LINE:"):
+        note = ("\nNOTE: only the reported line is wrong: the value was refused with the right message, but at "
+                "the line of the token after it (the check runs once POV-Ray has read ahead; known bug, see "
+                "docs/robustness.md)")
+    assert not problems, "%s (%s)\n     %s%s" % (name, why, "\n     ".join(problems), note)
+    print("ok   %-50s line %d: %s" % (name, err[1], err[2][:110]))
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+@pytest.mark.parametrize("index", range(len(CASES)), ids=[c[0] for c in CASES])
+def test_camera_block(args, index):
+    """ctest robustness_malformed_cameras (with test_camera_table_size)."""
+    refused(args, "camera", index, *CASES[index])
+
+
+def test_camera_table_size():
+    assert len(CASES) >= 40, "the table must hold at least 40 cases, it has %d" % len(CASES)
+
+
+@pytest.mark.parametrize("index", range(len(PLACEMENT_CASES)), ids=[c[0] for c in PLACEMENT_CASES])
+def test_placement_keyword(args, index):
+    """ctest robustness_malformed_placement."""
+    refused(args, "placement", index, *PLACEMENT_CASES[index])

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """The extremes matrix: tiny renders at the edges of every parameter.
 
@@ -21,16 +20,13 @@ the pixels differ by more than 1e-3).
 A REFUSED case must exit non-zero by itself (no signal, no time-out) with POV-Ray's
 `File '...' line N` parse error and the expected words.
 """
-import argparse
 import os
 import shutil
-import sys
-import time
 
 import numpy as np
+import pytest
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import rtlib  # noqa: E402
+import plenoptic_testing as pt
 
 PLACE = "  location <0, 0.4, -2>\n  look_at <0, 0.3, 0>\n"
 
@@ -157,7 +153,7 @@ CASES = [
 
 
 def render(povray, case_dir, scene, out, w, h, extra, timeout):
-    return rtlib.run_povray(povray, scene, os.path.join(case_dir, out), w, h, extra, timeout=timeout, cwd=case_dir)
+    return pt.run_povray(povray, scene, os.path.join(case_dir, out), w, h, extra, timeout=timeout, cwd=case_dir)
 
 
 def check_rendered(povray, case_dir, w, h, opts, results, name):
@@ -167,12 +163,12 @@ def check_rendered(povray, case_dir, w, h, opts, results, name):
     for threads in (1, 2):
         out = "t%d.exr" % threads
         run = render(povray, case_dir, "case.pov", out, w, h, ["+FE", "+UA", "+WT%d" % threads], timeout)
-        crash = rtlib.crash_reason(run)
+        crash = pt.crash_reason(run)
         if crash or run.returncode != 0:
             problems.append("EXR render (%d thread%s): %s\n%s" % (threads, "s" if threads > 1 else "",
-                            crash or "exit %d" % run.returncode, rtlib.tail(run.output)))
+                            crash or "exit %d" % run.returncode, pt.tail(run.output)))
             return problems, None
-        images.append(rtlib.read_exr(os.path.join(case_dir, out)))
+        images.append(pt.read_pixels(os.path.join(case_dir, out)))
     a, b = images
     if a.shape != (h, w, a.shape[2]):
         problems.append("EXR is %s, expected %dx%d" % (a.shape, w, h))
@@ -191,9 +187,9 @@ def check_rendered(povray, case_dir, w, h, opts, results, name):
         problems.append("only %.1f%% of pixels receive light, expected at least %.0f%% (the sky is everywhere)" %
                         (100 * lit, 100 * need))
     run = render(povray, case_dir, "case.pov", "t.png", w, h, ["+FN8", "+WT2"], timeout)
-    crash = rtlib.crash_reason(run)
+    crash = pt.crash_reason(run)
     if crash or run.returncode != 0:
-        problems.append("PNG render: %s\n%s" % (crash or "exit %d" % run.returncode, rtlib.tail(run.output)))
+        problems.append("PNG render: %s\n%s" % (crash or "exit %d" % run.returncode, pt.tail(run.output)))
     else:
         png = os.path.join(case_dir, "t.png")
         meta = os.path.join(case_dir, "t.plenoptic.json")
@@ -203,7 +199,7 @@ def check_rendered(povray, case_dir, w, h, opts, results, name):
             problems.append("no metadata JSON beside the PNG")
         else:
             try:
-                data = rtlib.load_json_strict(meta)
+                data = pt.load_metadata(meta)
                 if data.get("image") != {"width": w, "height": h}:
                     problems.append("metadata image %r, expected %dx%d" % (data.get("image"), w, h))
             except ValueError as e:
@@ -214,7 +210,7 @@ def check_rendered(povray, case_dir, w, h, opts, results, name):
 
 def check_refused(povray, case_dir, w, h, opts):
     run = render(povray, case_dir, "case.pov", "t.png", w, h, ["+FN8", "+WT1"], opts.get("timeout", 60))
-    problems, err = rtlib.refusal_problems(run)
+    problems, err = pt.refusal_problems(run)
     if err is not None:
         missing = [w_ for w_ in opts["refuse"] if w_.lower() not in err[2].lower()]
         if missing:
@@ -222,65 +218,48 @@ def check_refused(povray, case_dir, w, h, opts):
     if any(os.path.exists(os.path.join(case_dir, f)) for f in ("t.png", "t.plenoptic.json")):
         problems.append("left an image or metadata behind")
     if problems:
-        problems.append(rtlib.tail(run.output, 8))
+        problems.append(pt.tail(run.output, 8))
     return problems, err
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--povray", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("-k", help="only cases whose name contains this text")
-    ap.add_argument("--list", action="store_true", help="print the table and exit")
-    args = ap.parse_args()
-    if args.list:
-        for name, block, expect, why, opts in CASES:
-            print("%-55s %-9s %s" % (name, expect, why))
-        return 0
-    os.makedirs(args.work, exist_ok=True)
-    results = {}
-    passed = failed = 0
-    selected = {name for name, _, _, _, _ in CASES if not args.k or args.k in name}
-    selected |= {opts["like"] for name, _, _, _, opts in CASES if name in selected and opts.get("like")}
-    for index, (name, block, expect, why, opts) in enumerate(CASES):
-        if name not in selected:
-            continue
-        case_dir = os.path.join(args.work, "case%02d" % index)
-        shutil.rmtree(case_dir, ignore_errors=True)
-        os.makedirs(case_dir)
-        rtlib.write_scene(os.path.join(case_dir, "case.pov"), block)
-        w, h = opts.get("w", W), opts.get("h", H)
-        start = time.monotonic()
-        if expect == "rendered":
-            problems, lit = check_rendered(args.povray, case_dir, w, h, opts, results, name)
-            like = opts.get("like")
-            if not problems and like:
-                if like not in results:
-                    problems.append("reference case %r did not render" % like)
-                else:
-                    ref = results[like]
-                    cur = results[name]
-                    differs = np.any(np.abs(cur - ref) > 1e-3, axis=2)
-                    frac = float(np.mean(differs))
-                    if frac > 0.02:
-                        problems.append("differs from %r in %.1f%% of pixels (> 2%%); max difference %.4g" %
-                                        (like, 100 * frac, float(np.max(np.abs(cur - ref)))))
-            detail = "lit %.0f%%" % (100 * lit) if lit is not None else ""
-        else:
-            problems, err = check_refused(args.povray, case_dir, w, h, opts)
-            detail = ("line %d: %s" % (err[1], err[2][:90])) if err else ""
-        seconds = time.monotonic() - start
-        if problems:
-            failed += 1
-            print("FAIL %-55s expected %s (%s)" % (name, expect, why))
-            for p in problems:
-                print("     " + p)
-        else:
-            passed += 1
-            print("ok   %-55s %-8s %5.1fs %s" % (name, expect, seconds, detail))
-    print("%d passed, %d failed" % (passed, failed))
-    return 1 if failed else 0
+# name -> the EXR of a rendered case (the reference of the cases that name it in `like`).
+RESULTS = {}
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+def run_case(args, index):
+    """Renders or refuses case `index` in its own folder; (problems, detail)."""
+    name, block, expect, why, opts = CASES[index]
+    case_dir = os.path.join(args.work, "case%02d" % index)
+    shutil.rmtree(case_dir, ignore_errors=True)
+    os.makedirs(case_dir)
+    pt.write_scene(os.path.join(case_dir, "case.pov"), block)
+    w, h = opts.get("w", W), opts.get("h", H)
+    if expect == "rendered":
+        problems, lit = check_rendered(args.povray, case_dir, w, h, opts, RESULTS, name)
+        like = opts.get("like")
+        if not problems and like:
+            if like not in RESULTS:  # the reference case alone (pytest -k)
+                run_case(args, [c[0] for c in CASES].index(like))
+            if like not in RESULTS:
+                problems.append("reference case %r did not render" % like)
+            else:
+                ref = RESULTS[like]
+                cur = RESULTS[name]
+                differs = np.any(np.abs(cur - ref) > 1e-3, axis=2)
+                frac = float(np.mean(differs))
+                if frac > 0.02:
+                    problems.append("differs from %r in %.1f%% of pixels (> 2%%); max difference %.4g" %
+                                    (like, 100 * frac, float(np.max(np.abs(cur - ref)))))
+        detail = "lit %.0f%%" % (100 * lit) if lit is not None else ""
+    else:
+        problems, err = check_refused(args.povray, case_dir, w, h, opts)
+        detail = ("line %d: %s" % (err[1], err[2][:90])) if err else ""
+    return problems, detail
+
+
+@pytest.mark.parametrize("index", range(len(CASES)), ids=[c[0] for c in CASES])
+def test_extremes(args, index):
+    name, block, expect, why, opts = CASES[index]
+    problems, detail = run_case(args, index)
+    assert not problems, "%s: expected %s (%s)\n     %s" % (name, expect, why, "\n     ".join(problems))
+    print("ok   %-55s %-8s %s" % (name, expect, detail))

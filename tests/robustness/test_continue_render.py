@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """An interrupted plenoptic render, continued with POV-Ray's +C, equals one uninterrupted render.
 
@@ -9,7 +8,8 @@ and leaves that state file. With +C, if the output image does not exist, POV-Ray
 state file into its image buffer and renders only the missing blocks; the state file is deleted
 once the render is done. (If the output image already exists, +C renders nothing.)
 
---part image|depth: the render is stopped with SIGINT while rendering with one thread, and continued
+test_continue[image] and test_continue[depth] (ctest robustness_continue_render and
+robustness_continue_depth_map): the render is stopped with SIGINT while rendering with one thread, and continued
 with two (so the continuation also shows the image does not depend on the thread count):
   1. renders the scene uninterrupted into ref/ (the reference image, metadata and depth map);
   2. renders it again into run/, and stops it with the signal once the progress line says that
@@ -19,21 +19,19 @@ with two (so the continuation also shows the image does not depend on the thread
   3. continues it with +C: exit 0, no state file left, the PNG identical to the reference
      (`idiff` says PASS and the pixels are bit-equal), the metadata JSON present and equal to the
      reference's (both are named alike), complete (every top-level field of docs/metadata.md).
-With --part depth it also asks the depth map (`depth_map`) to equal the reference's.
+With part depth it also asks the depth map (`depth_map`) to equal the reference's.
 """
-import argparse
 import os
 import re
 import shutil
 import signal
 import subprocess
-import sys
 import time
 
 import numpy as np
+import pytest
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import rtlib  # noqa: E402
+import plenoptic_testing as pt
 
 CAMERA = """\
 camera {
@@ -88,9 +86,9 @@ def interrupt(povray, cwd, threads, sig, timeout=120):
 
 
 def run(cmd, cwd, timeout=180):
-    res = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                         stdin=subprocess.DEVNULL, timeout=timeout)
-    return res.returncode, res.stdout.decode("utf-8", errors="replace")
+    res = pt.run_process(cmd, cwd=cwd, timeout=timeout)
+    assert not res.timed_out, "%s did not finish within %d s\n%s" % (" ".join(cmd), timeout, pt.tail(res.output))
+    return res.returncode, res.output
 
 
 def check_way(povray, work, name, threads, sig, part):
@@ -100,11 +98,11 @@ def check_way(povray, work, name, threads, sig, part):
     ref, cont = os.path.join(base, "ref"), os.path.join(base, "run")
     for d in (ref, cont):
         os.makedirs(d)
-        rtlib.write_scene(os.path.join(d, "scene.pov"), CAMERA)
+        pt.write_scene(os.path.join(d, "scene.pov"), CAMERA)
 
     status, output = run(command(povray, threads), ref)
     if status != 0 or not os.path.exists(os.path.join(ref, "image.png")):
-        return ["the uninterrupted render failed (exit %d)\n%s" % (status, rtlib.tail(output))]
+        return ["the uninterrupted render failed (exit %d)\n%s" % (status, pt.tail(output))]
 
     for attempt in range(3):
         status, output, fraction = interrupt(povray, cont, threads, sig)
@@ -119,7 +117,7 @@ def check_way(povray, work, name, threads, sig, part):
                 os.remove(os.path.join(cont, f))
     if fraction is None:
         return ["could not stop the render between 10 %% and 60 %% (exit %d): too fast or no progress "
-                "lines?\n%s" % (status, rtlib.tail(output))]
+                "lines?\n%s" % (status, pt.tail(output))]
     files = sorted(os.listdir(cont))
     print("  %s: stopped at %.0f%% done, exit %d, left %s" % (name, 100 * fraction, status, files))
     if status == 0 or status < 0 or status >= 128:
@@ -130,24 +128,23 @@ def check_way(povray, work, name, threads, sig, part):
         if f in files:
             problems.append("interrupted render left %s behind (a cancelled render writes nothing)" % f)
     if problems:
-        return problems + [rtlib.tail(output)]
+        return problems + [pt.tail(output)]
 
     status, output = run(command(povray, 2, ["+C"]), cont)
     files = sorted(os.listdir(cont))
     if status != 0:
-        return ["continued render (+C): exit %d\n%s" % (status, rtlib.tail(output))]
+        return ["continued render (+C): exit %d\n%s" % (status, pt.tail(output))]
     m = PROGRESS.findall(output.encode())
     if m:
         print("  %s: the continuation rendered %s of %s pixels" % (name, m[-1][0].decode(), m[-1][1].decode()))
     if "image.pov-state" in files:
         problems.append("continued render left the state file behind")
-    idiff = subprocess.run(["idiff", os.path.join(ref, "image.png"), os.path.join(cont, "image.png")],
-                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-    if idiff.returncode != 0:
+    code, report = pt.idiff(os.path.join(ref, "image.png"), os.path.join(cont, "image.png"))
+    if code != 0:
         problems.append("idiff: continued image differs from the uninterrupted one (exit %d)\n%s" %
-                        (idiff.returncode, rtlib.tail(idiff.stdout.decode(errors="replace"))))
-    a = rtlib.read_image(os.path.join(ref, "image.png"))
-    b = rtlib.read_image(os.path.join(cont, "image.png"))
+                        (code, pt.tail(report)))
+    a = pt.read_pixels(os.path.join(ref, "image.png"))
+    b = pt.read_pixels(os.path.join(cont, "image.png"))
     if a.shape != b.shape or not np.array_equal(a, b):
         n = int(np.sum(np.any(a != b, axis=2))) if a.shape == b.shape else -1
         problems.append("pixels differ: %d of %d" % (n, W * H))
@@ -156,7 +153,7 @@ def check_way(povray, work, name, threads, sig, part):
     if not os.path.exists(meta):
         problems.append("no metadata JSON after the continued render")
     else:
-        want, got = rtlib.load_json_strict(meta_ref), rtlib.load_json_strict(meta)
+        want, got = pt.load_metadata(meta_ref), pt.load_metadata(meta)
         missing = [k for k in METADATA_FIELDS if k not in got]
         if missing:
             problems.append("metadata lacks %s" % missing)
@@ -168,7 +165,7 @@ def check_way(povray, work, name, threads, sig, part):
         if not os.path.exists(dcont):
             problems.append("no depth map after the continued render")
         else:
-            za, zb = rtlib.read_exr(dref)[..., 0], rtlib.read_exr(dcont)[..., 0]
+            za, zb = pt.read_pixels(dref)[..., 0], pt.read_pixels(dcont)[..., 0]
             differs = za != zb
             if differs.any():
                 rows = np.nonzero(differs.any(axis=1))[0]
@@ -180,30 +177,11 @@ def check_way(povray, work, name, threads, sig, part):
     return problems
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--povray", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--part", choices=["image", "depth"], default="image")
-    args = ap.parse_args()
-    if not shutil.which("idiff"):
-        print("FAIL: OpenImageIO's idiff is not installed (tools/install-deps)")
-        return 1
-    passed = failed = 0
+@pytest.mark.parametrize("part", ["image", "depth"])
+def test_continue(args, part):
+    pt.idiff_command()
     for name, threads, sig in (("sigint-1-thread", 1, signal.SIGINT),):
-        problems = check_way(args.povray, os.path.join(args.work, args.part), name, threads, sig, args.part)
-        if problems:
-            failed += 1
-            print("FAIL %s" % name)
-            for p in problems:
-                print("     " + p)
-        else:
-            passed += 1
-            print("ok   %s: continued image%s equal the uninterrupted render's" %
-                  (name, ", metadata and depth map" if args.part == "depth" else " and metadata"))
-    print("%d passed, %d failed" % (passed, failed))
-    return 1 if failed else 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+        problems = check_way(args.povray, os.path.join(args.work, part), name, threads, sig, part)
+        assert not problems, "%s\n     %s" % (name, "\n     ".join(problems))
+        print("ok   %s: continued image%s equal the uninterrupted render's" %
+              (name, ", metadata and depth map" if part == "depth" else " and metadata"))

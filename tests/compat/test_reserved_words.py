@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Do the reserved words our patches add collide with any identifier in POV-Ray's distribution?
 
@@ -10,10 +9,10 @@ A new reserved word breaks every scene that uses the same name as an identifier
 The new words are not copied from anywhere: they are the difference between the reserved
 word table of the upstream source and that of our patched source.
 """
-import argparse
 import os
 import re
-import sys
+
+import pytest
 
 TABLE_ENTRY = re.compile(r'\{\s*[A-Z0-9_]+_TOKEN\s*,\s*"([^"]+)"\s*\}')
 IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -99,42 +98,39 @@ def sdl_files(dist):
                 yield path, "ini"
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--distribution", required=True, help="UPSTREAM_DIR/distribution")
-    ap.add_argument("--upstream-reswords", required=True, help="reswords.cpp of the unpatched source")
-    ap.add_argument("--patched-reswords", required=True, help="reswords.cpp of our patched source")
-    args = ap.parse_args()
-
-    old = reserved_words(args.upstream_reswords)
-    new = reserved_words(args.patched_reswords)
-    if len(old) < 300 or len(new) < len(old):
-        print("FAIL: could not read the reserved word tables (%d upstream, %d patched words)"
-              % (len(old), len(new)))
-        return 1
-    added = sorted(new - old)
+@pytest.fixture(scope="module")
+def added(args):
+    """The reserved words our patches add (tables of --upstream and --patched-source)."""
+    assert args.upstream and args.patched_source, "need --upstream and --patched-source"
+    old = reserved_words(os.path.join(args.upstream, "source", "backend", "parser", "reswords.cpp"))
+    new = reserved_words(os.path.join(args.patched_source, "source", "backend", "parser", "reswords.cpp"))
+    assert len(old) >= 300 and len(new) >= len(old), (
+        "could not read the reserved word tables (%d upstream, %d patched words)" % (len(old), len(new)))
     removed = sorted(old - new)
-    print("reserved words added by our patches (%d): %s" % (len(added), " ".join(added)))
-    if removed:
-        print("FAIL: our patches remove upstream reserved words: %s" % " ".join(removed))
-        return 1
-    if not added:
-        print("FAIL: no new reserved word found: is --patched-reswords the patched file?")
-        return 1
+    assert not removed, "our patches remove upstream reserved words: %s" % " ".join(removed)
+    words = sorted(new - old)
+    print("reserved words added by our patches (%d): %s" % (len(words), " ".join(words)))
+    assert words, "no new reserved word found: is --patched-source the patched tree?"
+    return words
+
+
+def test_only_plenoptic_is_added(added):
     # Only the camera's type word may be global; every other word of the camera is read in
     # context (docs/specification.md, section 6; source/povray_glue/parse_plenoptic.cpp).
-    if added != ["plenoptic"]:
-        print("FAIL: our patches may add only 'plenoptic' to POV-Ray's reserved words; they add: %s"
-              % " ".join(added))
-        return 1
+    assert added == ["plenoptic"], ("our patches may add only 'plenoptic' to POV-Ray's reserved words; they add: %s"
+                                    % " ".join(added))
+
+
+def test_no_new_word_is_an_identifier(args, added):
+    distribution = os.path.join(args.upstream, "distribution")
     added_set = set(added)
     lower = {w.lower(): w for w in added}
 
     collisions, harmless, case_only = [], {}, {}
     nfiles = 0
-    for path, kind in sdl_files(args.distribution):
+    for path, kind in sdl_files(distribution):
         nfiles += 1
-        rel = os.path.relpath(path, args.distribution)
+        rel = os.path.relpath(path, distribution)
         with open(path, errors="replace") as f:
             text = f.read()
         if kind == "ini":
@@ -152,20 +148,12 @@ def main():
             if w in added_set:
                 harmless.setdefault(w, []).append("%s:%d (%s)" % (rel, line, where))
 
-    print("scanned %d SDL and .ini files of %s" % (nfiles, args.distribution))
+    print("scanned %d SDL and .ini files of %s" % (nfiles, distribution))
     for w in sorted(harmless):
         print("  harmless: '%s' inside comments/strings: %s" % (w, ", ".join(harmless[w])))
     for w in sorted(case_only):
         print("  harmless: '%s' differs from reserved '%s' in case (SDL is case-sensitive): %s"
               % (w, lower[w.lower()], ", ".join(case_only[w][:5])))
-    if collisions:
-        print("FAIL: %d use(s) of a new reserved word as an identifier:" % len(collisions))
-        for c in collisions:
-            print("  " + c)
-        return 1
-    print("ok: no new reserved word is used as an identifier anywhere in the distribution")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    assert nfiles > 0, "no SDL file found in %s" % distribution
+    assert not collisions, ("%d use(s) of a new reserved word as an identifier:\n  %s"
+                            % (len(collisions), "\n  ".join(collisions)))

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """The plenoptic camera's words are not reserved words (docs/specification.md, section 6).
 
@@ -18,15 +17,14 @@ The words come from the parser's own table (kContextWords in
 source/povray_glue/parse_plenoptic.cpp), so a keyword added later is covered without
 editing this test; the words known when the test was written must all be in that table.
 """
-import argparse
-import json
 import os
 import re
-import subprocess
-import sys
 
 import numpy as np
 import OpenImageIO as oiio
+import pytest
+
+import plenoptic_testing as pt
 
 KNOWN_WORDS = {"main_lens", "microlens_array", "sensor", "thin_lens", "pinhole", "focal_length",
                "focal_lengths", "f_number", "focus_distance", "hexagonal", "rectangular", "pitch",
@@ -37,24 +35,19 @@ def camera_words(parser_source):
     with open(parser_source) as f:
         text = f.read()
     table = re.search(r"kContextWords\[\]\s*=\s*\{(.*?)\};", text, re.S)
-    if not table:
-        raise SystemExit("FAIL: no kContextWords table in %s" % parser_source)
+    assert table, "no kContextWords table in %s" % parser_source
     return sorted(set(re.findall(r'\{\s*"([a-z_0-9]+)"\s*,\s*Word::', table.group(1))))
 
 
 def render(povray, scene_text, name, work, width=96, height=72, extra=()):
-    scene = os.path.join(work, name + ".pov")
+    """(8-bit pixels as int16, or None when the render fails; the console text)."""
+    scene = pt.write_text(os.path.join(work, name + ".pov"), scene_text)
     image = os.path.join(work, name + ".png")
-    with open(scene, "w") as f:
-        f.write(scene_text)
-    for stale in (image, os.path.join(work, name + ".plenoptic.json")):
-        if os.path.exists(stale):
-            os.remove(stale)
-    res = subprocess.run([povray, "+I" + scene, "+O" + image, "+W%d" % width, "+H%d" % height,
-                          "-D", "-P", "+FN8", "-GS", "-GR", "+WT1"] + list(extra),
-                         cwd=work, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300)
-    out = res.stdout.decode(errors="replace")
-    if res.returncode != 0 or not os.path.exists(image):
+    pt.remove_outputs(work, name)
+    res = pt.run_povray(povray, scene, image, width, height, extra, timeout=300, cwd=work,
+                        options=("-D", "-P", "+FN8", "-GS", "-GR", "+WT1"))
+    out = res.output
+    if res.returncode != 0 or res.timed_out or not os.path.exists(image):
         return None, out
     buf = oiio.ImageBuf(image)
     return buf.get_pixels(oiio.UINT8).astype(np.int16), out
@@ -172,71 +165,61 @@ def compare(a, b, what, max_diff=0, max_fraction=0.0):
 
 
 def metadata(work, name):
-    with open(os.path.join(work, name + ".plenoptic.json")) as f:
-        return json.load(f)
+    return pt.load_metadata(os.path.join(work, name + ".plenoptic.json"))
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--povray", required=True, help="our build's povray")
-    ap.add_argument("--reference", default="/usr/bin/povray", help="Debian's packaged povray")
-    ap.add_argument("--parser-source", required=True, help="source/povray_glue/parse_plenoptic.cpp")
-    ap.add_argument("--work", required=True)
-    args = ap.parse_args()
-    os.makedirs(args.work, exist_ok=True)
-    if not os.path.exists(args.reference):
-        print("FAIL: Debian's povray (%s) is not installed (package povray)" % args.reference)
-        return 1
-
-    words = camera_words(args.parser_source)
+@pytest.fixture(scope="module")
+def words(args):
+    words = camera_words(os.path.join(args.source_dir, "source", "povray_glue", "parse_plenoptic.cpp"))
     print("camera words read in context (%d): %s" % (len(words), " ".join(words)))
-    problems = ["the parser's table lacks '%s'" % w for w in sorted(KNOWN_WORDS - set(words))]
+    return words
 
-    # 1. Stock camera, camera words as identifiers: ours == Debian's.
+
+@pytest.fixture(scope="module")
+def literal(args):
+    literal, log_lit = render(args.povray, CAMERA_LITERAL, "camera-literal", args.work)
+    assert literal is not None, "the literal camera does not render:\n" + log_lit[-1500:]
+    return literal
+
+
+def test_parser_table_has_the_known_words(words):
+    missing = sorted(KNOWN_WORDS - set(words))
+    assert not missing, "the parser's table lacks %s" % ", ".join("'%s'" % w for w in missing)
+
+
+def test_camera_words_as_identifiers_render_as_with_debian(args, words):
+    """1. Stock camera, camera words as identifiers: ours == Debian's."""
+    reference = pt.require_debian_povray(args.reference_povray)
     scene = identifiers_scene(words)
     ours, log_ours = render(args.povray, scene, "identifiers", args.work)
-    theirs, log_theirs = render(args.reference, scene, "identifiers-debian", args.work)
-    if theirs is None:
-        problems.append("Debian's povray does not render the identifier scene (the test is wrong):\n"
-                        + log_theirs[-1500:])
-    if ours is None:
-        problems.append("our povray does not render a scene that Debian's renders:\n" + log_ours[-1500:])
-    else:
-        # Identical up to the rounding our stock comparisons allow (tests/stock/compare_stock.py).
-        problems += compare(ours, theirs, "identifier scene, ours vs Debian's", max_diff=1, max_fraction=0.005)
-        if ours is not None and float(ours.std()) < 5:
-            problems.append("the identifier scene rendered flat: the test scene shows nothing")
+    theirs, log_theirs = render(reference, scene, "identifiers-debian", args.work)
+    assert theirs is not None, ("Debian's povray does not render the identifier scene (the test is wrong):\n"
+                                + log_theirs[-1500:])
+    assert ours is not None, "our povray does not render a scene that Debian's renders:\n" + log_ours[-1500:]
+    # Identical up to the rounding our stock comparisons allow (tests/stock/test_stock_scenes.py).
+    problems = compare(ours, theirs, "identifier scene, ours vs Debian's", max_diff=1, max_fraction=0.005)
+    assert not problems, problems[0]
+    assert float(ours.std()) >= 5, "the identifier scene rendered flat: the test scene shows nothing"
 
-    # 2. Identifiers named like keywords, used as values inside the camera.
-    literal, log_lit = render(args.povray, CAMERA_LITERAL, "camera-literal", args.work)
+
+def test_identifiers_named_like_keywords_as_values(args, literal):
+    """2. Identifiers named like keywords, used as values inside the camera."""
     named, log_named = render(args.povray, CAMERA_IDENTIFIERS, "camera-identifiers", args.work)
-    if literal is None:
-        problems.append("the literal camera does not render:\n" + log_lit[-1500:])
-    if named is None:
-        problems.append("the camera written with identifiers does not render:\n" + log_named[-1500:])
-    if literal is not None and named is not None:
-        problems += compare(literal, named, "camera with identifiers as values vs literal values")
-        a, b = metadata(args.work, "camera-literal"), metadata(args.work, "camera-identifiers")
-        for key in sorted((set(a) | set(b)) - {"depth_map"}):  # depth_map names the file
-            if a.get(key) != b.get(key):
-                problems.append("metadata '%s' differs: %s vs %s" % (key, a.get(key), b.get(key)))
-        if not os.path.exists(os.path.join(args.work, "camera-identifiers.depth.exr")):
-            problems.append("depth_map given as a keyword beside a declared 'depth_map' wrote no depth map")
+    assert named is not None, "the camera written with identifiers does not render:\n" + log_named[-1500:]
+    problems = compare(literal, named, "camera with identifiers as values vs literal values")
+    a, b = metadata(args.work, "camera-literal"), metadata(args.work, "camera-identifiers")
+    for key in sorted((set(a) | set(b)) - {"depth_map"}):  # depth_map names the file
+        if a.get(key) != b.get(key):
+            problems.append("metadata '%s' differs: %s vs %s" % (key, a.get(key), b.get(key)))
+    if not os.path.exists(os.path.join(args.work, "camera-identifiers.depth.exr")):
+        problems.append("depth_map given as a keyword beside a declared 'depth_map' wrote no depth map")
+    assert not problems, "\n".join(problems)
 
-    # 3. Block words declared as other kinds of identifier still work as keywords.
+
+def test_block_words_declared_as_other_kinds_stay_keywords(args, literal):
+    """3. Block words declared as other kinds of identifier still work as keywords."""
     other, log_other = render(args.povray, CAMERA_OTHER_KINDS, "camera-other-kinds", args.work)
-    if other is None:
-        problems.append("the camera beside identifiers of other kinds does not render:\n" + log_other[-1500:])
-    elif literal is not None:
-        problems += compare(literal, other, "camera beside identifiers of other kinds vs literal")
-
-    for p in problems:
-        print("FAIL: " + p)
-    if problems:
-        return 1
-    print("ok: the camera's words are identifiers outside the camera and keywords inside it")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    assert other is not None, ("the camera beside identifiers of other kinds does not render:\n"
+                               + log_other[-1500:])
+    problems = compare(literal, other, "camera beside identifiers of other kinds vs literal")
+    assert not problems, problems[0]
