@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """The installed program works from anywhere, without the build tree, after its prefix is moved.
 
@@ -16,19 +15,17 @@
 5. plenoptic-project and plenoptic-decode from the moved prefix: the projection prints what
    the build tree's plenoptic-project prints, the decoder writes its contact sheet.
 
-Exit status 0 when all holds, 1 with a list of what failed.
+One pytest test (ctest install_relocatable); the first step that fails ends it with its message.
 
-    check_install.py --build-dir BUILD --source-dir SRC --povray BUILD/povray
-                     --project BUILD/plenoptic-project --cmake CMAKE --work WORK
 """
-import argparse
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 
 from PIL import Image
+
+import plenoptic_testing as pt
 
 LAYOUT = [
     "bin/povray-plenoptic",
@@ -71,18 +68,9 @@ light_source { <2, 3, -4> rgb 1 }
 sphere { 0, 1 pigment { rgb <1, 0.5, 0.2> } }
 """
 
-failures = []
-
-
-def check(condition, message):
-    if not condition:
-        failures.append(message)
-    return condition
-
-
-def run(cmd, cwd, env, timeout=300, stdin=None):
-    return subprocess.run(cmd, cwd=cwd, env=env, input=stdin, stdout=subprocess.PIPE,
-                          stderr=subprocess.PIPE, text=True, timeout=timeout)
+def run(cmd, cwd, env, timeout=300):
+    """A Run with .returncode, .stdout and .stderr (text); killed at the time limit."""
+    return pt.run_process(cmd, cwd=cwd, env=env, timeout=timeout, separate=True)
 
 
 def pixels(path):
@@ -105,15 +93,7 @@ def packaged_path(rel):
     return "/" + rel if rel.startswith("etc/") else "/usr/" + rel
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--build-dir", required=True)
-    ap.add_argument("--source-dir", required=True)
-    ap.add_argument("--povray", required=True)
-    ap.add_argument("--project", required=True)
-    ap.add_argument("--cmake", default="cmake")
-    ap.add_argument("--work", required=True)
-    args = ap.parse_args()
+def test_install_relocatable(args):
     build = os.path.realpath(args.build_dir)
     source = os.path.realpath(args.source_dir)
 
@@ -129,10 +109,9 @@ def main():
 
     # 1. Install.
     r = run([args.cmake, "--install", build, "--prefix", prefix], cwd=work, env=os.environ)
-    if not check(r.returncode == 0, "cmake --install failed:\n" + r.stdout + r.stderr):
-        return report()
+    assert r.returncode == 0, "cmake --install failed:\n" + r.stdout + r.stderr
     for rel in LAYOUT:
-        check(os.path.isfile(os.path.join(prefix, rel)), "not installed: PREFIX/" + rel)
+        assert os.path.isfile(os.path.join(prefix, rel)), "not installed: PREFIX/" + rel
     installed = []
     for dirpath, _dirs, files in os.walk(prefix):
         for f in files:
@@ -142,16 +121,15 @@ def main():
         print("check_install: dpkg does not know Debian's povray here; file clashes not checked")
     else:
         clashes = sorted(packaged_path(rel) for rel in installed if packaged_path(rel) in debian)
-        check(not clashes, "files Debian's povray/povray-includes also install: %s" % clashes[:10])
+        assert not clashes, "files Debian's povray/povray-includes also install: %s" % clashes[:10]
     for name in ("povray.ini", "povray.conf"):
         with open(os.path.join(prefix, "etc/povray-plenoptic", name)) as f:
             text = f.read()
-        check(build not in text and prefix not in text and source not in text,
-              "installed %s names the build, source or install directory" % name)
+        assert (build not in text and prefix not in text and source not in text), "installed %s names the build, source or install directory" % name
 
     # 2. Move the prefix; run from elsewhere with the installed binaries only.
     os.rename(prefix, moved)
-    check(not os.path.exists(prefix), "the prefix did not move")
+    assert not os.path.exists(prefix), "the prefix did not move"
     env = {k: v for k, v in os.environ.items() if k not in ("POVINI", "POVINC", "PLENOPTIC_PROJECT",
                                                             "PYTHONPATH")}
     env["HOME"] = home
@@ -162,33 +140,29 @@ def main():
     conf = os.path.join(moved, "etc", "povray-plenoptic")
 
     r = run([pov, "--version"], cwd=run_dir, env=env)
-    check(r.returncode == 0 and "plenoptic" in (r.stdout + r.stderr),
-          "povray-plenoptic --version does not name the fork:\n" + r.stdout + r.stderr)
+    assert (r.returncode == 0 and "plenoptic" in (r.stdout + r.stderr)), "povray-plenoptic --version does not name the fork:\n" + r.stdout + r.stderr
 
     # 3. Same pixels as the build tree, from another directory; relative output into the cwd.
     size = ["+W160", "+H120", "-D", "-GA"]
     r = run([pov, "+I" + os.path.join(data, "scenes", "demo.pov"), "+Odemo.png"] + size,
             cwd=run_dir, env=env)
-    if check(r.returncode == 0, "installed demo render failed:\n" + r.stderr[-2000:]):
-        check(os.path.isfile(os.path.join(run_dir, "demo.plenoptic.json")),
-              "no demo.plenoptic.json beside the installed render")
+    assert r.returncode == 0, "installed demo render failed:\n" + r.stderr[-2000:]
+    assert os.path.isfile(os.path.join(run_dir, "demo.plenoptic.json")), "no demo.plenoptic.json beside the installed render"
     ref_dir = os.path.join(work, "reference")
     os.makedirs(ref_dir)
     r = run([os.path.realpath(args.povray), "+I" + os.path.join(source, "scenes", "demo.pov"),
              "+O" + os.path.join(ref_dir, "demo.png")] + size, cwd=ref_dir, env=dict(env, HOME=home))
-    check(r.returncode == 0, "build/povray's demo render failed:\n" + r.stderr[-2000:])
+    assert r.returncode == 0, "build/povray's demo render failed:\n" + r.stderr[-2000:]
     if os.path.isfile(os.path.join(run_dir, "demo.png")) and os.path.isfile(os.path.join(ref_dir, "demo.png")):
-        check(pixels(os.path.join(run_dir, "demo.png")) == pixels(os.path.join(ref_dir, "demo.png")),
-              "the installed binary's demo.png differs from build/povray's")
+        assert pixels(os.path.join(run_dir, "demo.png")) == pixels(os.path.join(ref_dir, "demo.png")), "the installed binary's demo.png differs from build/povray's"
     for d in (run_dir, ref_dir):
         with open(os.path.join(d, "stock.pov"), "w") as f:
             f.write(STOCK_SCENE)
     r1 = run([pov, "+Istock.pov", "+Ostock.png"] + size, cwd=run_dir, env=env)
     r2 = run([os.path.realpath(args.povray), "+Istock.pov", "+Ostock.png"] + size, cwd=ref_dir, env=env)
-    if check(r1.returncode == 0 and r2.returncode == 0,
-             "stock scene with colors.inc/textures.inc failed:\n" + r1.stderr[-1500:] + r2.stderr[-1500:]):
-        check(pixels(os.path.join(run_dir, "stock.png")) == pixels(os.path.join(ref_dir, "stock.png")),
-              "the installed binary's stock.png differs from build/povray's")
+    assert r1.returncode == 0 and r2.returncode == 0, (
+        "stock scene with colors.inc/textures.inc failed:\n" + r1.stderr[-1500:] + r2.stderr[-1500:])
+    assert pixels(os.path.join(run_dir, "stock.png")) == pixels(os.path.join(ref_dir, "stock.png")), "the installed binary's stock.png differs from build/povray's"
 
     # 4. The moved tree is the one read; I/O restrictions.
     with open(os.path.join(conf, "povray.ini"), "a") as f:
@@ -198,15 +172,13 @@ def main():
     with open(os.path.join(run_dir, "marker.pov"), "w") as f:
         f.write(MARKER_SCENE)
     r = run([pov, "+Imarker.pov", "+Omarker.png", "+W32", "+H24"], cwd=run_dir, env=env)
-    check(r.returncode == 0 and os.path.isfile(os.path.join(run_dir, "marker.png")),
-          "the moved povray.ini or include/ is not the one in use:\n" + r.stderr[-2000:])
+    assert (r.returncode == 0 and os.path.isfile(os.path.join(run_dir, "marker.png"))), "the moved povray.ini or include/ is not the one in use:\n" + r.stderr[-2000:]
 
     tmp_out = tempfile.NamedTemporaryFile(prefix="plenoptic-install-", suffix=".png", dir="/tmp", delete=False)
     tmp_out.close()
     try:
         r = run([pov, "+Imarker.pov", "+O" + tmp_out.name, "+W32", "+H24"], cwd=run_dir, env=env)
-        check(r.returncode == 0 and os.path.getsize(tmp_out.name) > 0,
-              "writing to /tmp was refused:\n" + r.stderr[-1500:])
+        assert (r.returncode == 0 and os.path.getsize(tmp_out.name) > 0), "writing to /tmp was refused:\n" + r.stderr[-1500:]
     finally:
         os.unlink(tmp_out.name)
 
@@ -216,7 +188,7 @@ def main():
     with open(os.path.join(run_dir, "home.pov"), "w") as f:
         f.write('#include "%s"\n' % os.path.join(home, "home_marker.inc") + scene)
     r = run([pov, "+Ihome.pov", "+Ohome.png", "+W16", "+H12"], cwd=run_dir, env=env)
-    check(r.returncode == 0, "reading from $HOME was refused:\n" + r.stderr[-1500:])
+    assert r.returncode == 0, "reading from $HOME was refused:\n" + r.stderr[-1500:]
 
     # The system povray.conf is looked for in the moved tree: without it, POV-Ray names the
     # file it could not open. (POV-Ray 3.7.0.10's Unix front end reads the [File I/O Security]
@@ -224,13 +196,11 @@ def main():
     # to test, only which povray.conf is read. See docs/install.md.)
     conf_file = os.path.join(conf, "povray.conf")
     r = run([pov, "+Ihome.pov", "+Ohome.png", "+W16", "+H12"], cwd=run_dir, env=env)
-    check("cannot open the system configuration file" not in r.stderr,
-          "the moved povray.conf was not read:\n" + r.stderr[-1500:])
+    assert "cannot open the system configuration file" not in r.stderr, "the moved povray.conf was not read:\n" + r.stderr[-1500:]
     os.rename(conf_file, conf_file + ".away")
     try:
         r = run([pov, "+Ihome.pov", "+Ohome.png", "+W16", "+H12"], cwd=run_dir, env=env)
-        check("cannot open the system configuration file " + conf_file in r.stderr,
-              "povray.conf is not looked for in the moved tree:\n" + r.stderr[-1500:])
+        assert "cannot open the system configuration file " + conf_file in r.stderr, "povray.conf is not looked for in the moved tree:\n" + r.stderr[-1500:]
     finally:
         os.rename(conf_file + ".away", conf_file)
 
@@ -239,38 +209,20 @@ def main():
     points = ["0", "0.06", "0", "0.1", "0.1", "0.5"]
     mine = run([os.path.join(moved, "bin", "plenoptic-project"), meta] + points, cwd=run_dir, env=env)
     ref = run([os.path.realpath(args.project), meta] + points, cwd=run_dir, env=env)
-    check(mine.returncode == 0 and mine.stdout.strip() != "",
-          "installed plenoptic-project failed or printed nothing:\n" + mine.stderr)
-    check(mine.stdout == ref.stdout, "installed plenoptic-project disagrees with the build tree's")
+    assert (mine.returncode == 0 and mine.stdout.strip() != ""), "installed plenoptic-project failed or printed nothing:\n" + mine.stderr
+    assert mine.stdout == ref.stdout, "installed plenoptic-project disagrees with the build tree's"
     r = run([os.path.join(moved, "bin", "plenoptic-project"), "--help"], cwd=run_dir, env=env)
-    check(r.returncode == 0 and "usage" in r.stdout, "plenoptic-project --help failed")
+    assert (r.returncode == 0 and "usage" in r.stdout), "plenoptic-project --help failed"
 
     decoded = os.path.join(run_dir, "decoded")
     r = run([os.path.join(moved, "bin", "plenoptic-decode"), "demo.png", "-o", decoded,
              "--contact-sheet", "sheet.png", "--no-gif", "--no-npy", "-q"], cwd=run_dir, env=env, timeout=600)
-    check(r.returncode == 0 and os.path.isfile(os.path.join(run_dir, "sheet.png")),
-          "installed plenoptic-decode failed:\n" + r.stdout[-1500:] + r.stderr[-1500:])
+    assert (r.returncode == 0 and os.path.isfile(os.path.join(run_dir, "sheet.png"))), "installed plenoptic-decode failed:\n" + r.stdout[-1500:] + r.stderr[-1500:]
     r = run([os.path.join(moved, "bin", "plenoptic-decode"), "--help"], cwd=run_dir, env=env)
-    check(r.returncode == 0 and "usage" in r.stdout, "plenoptic-decode --help failed:\n" + r.stderr)
+    assert (r.returncode == 0 and "usage" in r.stdout), "plenoptic-decode --help failed:\n" + r.stderr
     # The launcher's imports without its main(): where plenoptic_lf came from.
     probe = ("import runpy, sys; runpy.run_path(%r, run_name='probe'); "
              "print(sys.modules['plenoptic_lf'].__file__)" % os.path.join(moved, "bin", "plenoptic-decode"))
     r = run(["/usr/bin/python3", "-c", probe], cwd=run_dir, env=env)
-    check(r.stdout.strip().startswith(moved + "/"),
-          "plenoptic-decode does not load plenoptic_lf from the moved prefix: " + r.stdout + r.stderr)
+    assert r.stdout.strip().startswith(moved + "/"), "plenoptic-decode does not load plenoptic_lf from the moved prefix: " + r.stdout + r.stderr
 
-    return report()
-
-
-def report():
-    if failures:
-        print("check_install: %d problem(s):" % len(failures))
-        for f in failures:
-            print("  - " + f)
-        return 1
-    print("check_install: installed, moved and run from elsewhere: all checks passed")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

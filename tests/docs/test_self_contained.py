@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """The repository is self-contained: no tracked file points outside it, and no Markdown link
 is broken.
@@ -16,16 +15,15 @@ once it is added), except *.patch files (they quote POV-Ray's own sources) and b
    names a heading of that file (GitHub's rule: lower case, punctuation dropped, spaces
    become hyphens).
 
-Exit status 0 when all is well, 1 with one `file:line: message` per problem, 77 (ctest's
-SKIP_RETURN_CODE) when the source directory is not a git checkout.
-
-    check_self_contained.py [--root SOURCE_DIR]
+The test fails with one `file:line: message` per problem, and is skipped when the source
+directory (--source-dir, default this checkout) is not a git checkout (ctest then reports it as
+skipped).
 """
-import argparse
 import os
 import re
 import subprocess
-import sys
+
+import pytest
 
 # 1. Paths outside the repository. The work directory counts only as the start of an absolute
 # path, not after a name (a build folder's own `work` subfolder is fine).
@@ -119,11 +117,11 @@ def link_targets(line):
         yield m.group(1)
 
 
-def check(root):
+def test_self_contained(args):
+    root = os.path.abspath(args.source_dir)
     files = tracked_files(root)
     if files is None:
-        print("check_self_contained: %s is not a git checkout; nothing checked" % root)
-        return 77
+        pytest.skip("check_self_contained: %s is not a git checkout; nothing checked" % root)
     tracked = set(files)
     directories = {os.path.dirname(p) for p in files}
     for p in list(directories):
@@ -177,24 +175,7 @@ def check(root):
                         problems.append("%s:%d: link to '%s': %s has no heading with anchor '#%s'"
                                         % (rel, number, target, resolved, anchor))
 
-    for line in problems:
-        print(line)
-    if problems:
-        print("check_self_contained: %d problem(s) in %d tracked files" % (len(problems), len(files)))
-        return 1
+    assert not problems, ("%d problem(s) in %d tracked files:\n%s"
+                          % (len(problems), len(files), "\n".join(problems)))
     print("check_self_contained: %d tracked files, no reference outside the repository, "
           "no broken Markdown link" % len(files))
-    return 0
-
-
-def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--root", default=os.path.normpath(os.path.join(here, "..", "..")),
-                        help="the repository's source directory (default: this script's checkout)")
-    args = parser.parse_args()
-    return check(os.path.abspath(args.root))
-
-
-if __name__ == "__main__":
-    sys.exit(main())
