@@ -1,0 +1,218 @@
+# SPDX-License-Identifier: AGPL-3.0-or-later
+"""BENCHMARKS.md from results.json, and the plots."""
+import os
+
+from .util import ROOT, log
+
+
+def fmt(x, digits=3):
+    return "-" if x is None else ("%.*g" % (digits, x))
+
+
+def fixed(x, digits=3):
+    return "-" if x is None else ("%.*f" % (digits, x))
+
+
+def pct(x, digits=1):
+    return "-" if x is None else ("%.*f %%" % (digits, 100 * x))
+
+
+def mega(x):
+    return "-" if x is None else ("%.1f" % (x / 1e6))
+
+
+def report_path(target, report):
+    """How the report names a file: relative to the report's folder (a link that works there)."""
+    return os.path.relpath(target, os.path.dirname(os.path.abspath(report)))
+
+
+def lens_table(L, o):
+    L.append("| lenses | pixels lit | trace time, s | ratio to 100 lenses | time per lit pixel, us"
+             " | ratio to 100 lenses (per lit pixel) | peak RSS, MiB |\n|---|---|---|---|---|---|---|")
+    for r in o["rows"]:
+        L.append("| %d | %s | %.3f | %.3f | %s | %s | %.1f |" % (
+            r["lenses"], pct(r.get("lit_pixel_fraction")), r["median_s"], r["ratio_to_100"],
+            fixed(r.get("us_per_lit_pixel")), fixed(r.get("per_lit_pixel_ratio_to_100")), r["peak_rss_mib"]))
+    L.append("")
+
+
+def write_report(results, path, plots, results_path):
+    """BENCHMARKS.md from results.json: every figure with the command that reproduces it."""
+    L = []
+    L.append("# Benchmarks\n")
+    L.append("Every figure here comes from `tools/bench` (results in `%s`;" % report_path(results_path, path))
+    L.append("one section alone: `tools/bench --only SECTION`). Times are medians of %d runs (the overhead"
+             " section: of its own count, at least 9) of POV-Ray's own" % results.get("runs", 0))
+    L.append("*Trace Time* (its fixed start-up of about 0.5 s excluded); compared variants ran interleaved in")
+    L.append("one session. Peak memory is the process's maximum resident set. Timings are never asserted in")
+    L.append("tests; CI only runs `tools/bench --quick`.\n")
+    L.append("Machine: %s.\n" % results.get("machine", "?"))
+    if "build" in results:
+        b = results["build"]
+        L.append("## Build and test times\n")
+        L.append("`tools/bench --only build` (ccache off, Ninja, 2 jobs):\n")
+        L.append("| what | seconds |\n|---|---|")
+        L.append("| clean build of POV-Ray and the camera | %.0f |" % b["clean_s"])
+        L.append("| rebuild after touching `source/plenoptic/plenoptic_optics.cpp` (median of 3) | %.1f |" % b["rebuild_after_touch_s"])
+        L.append("")
+    if "overhead" in results:
+        o = results["overhead"]
+        L.append("## Camera overhead (`--only overhead`)\n")
+        L.append("Benchmark scene (`benchmarks/scene.inc`), %dx%d, one ray per pixel, same field of view;"
+                 " %s interleaved runs, perspective rendered between the two others in every round. The"
+                 " paired ratio divides each run by the perspective run rendered right next to it; its"
+                 " median is robust to the slow drift of a shared machine.\n"
+                 % (o["size"], o["size"], o.get("runs", results.get("runs", "?"))))
+        L.append("| camera | trace time, s (median) | ratio of medians to perspective | median of paired ratios"
+                 " | fastest run, s | ratio of fastest runs | peak RSS, MiB | RSS - perspective, MiB |"
+                 "\n|---|---|---|---|---|---|---|---|")
+        fastest_base = min(next(r for r in o["rows"] if r["camera"] == "perspective")["runs_s"])
+        for r in o["rows"]:
+            L.append("| %s | %.3f | %.3f | %s | %.3f | %.3f | %.1f | %+.1f |" % (r["camera"], r["median_s"], r["ratio"],
+                     fixed(r.get("median_paired_ratio")), min(r["runs_s"]), min(r["runs_s"]) / fastest_base,
+                     r["peak_rss_mib"], r["rss_minus_perspective_mib"]))
+        if all("cpu_ratio" in r for r in o["rows"]):
+            L.append("\nCPU time of the same runs (user + system, all threads; medians, minus the CPU time of a"
+                     " 16x16 render of the same scene, i.e. start-up and parsing). The clock above also counts the"
+                     " time the virtual machine's host lends the cores to others; CPU time does not, so it is the"
+                     " steadier measure of the work done here.\n")
+            L.append("| camera | CPU time for the render, s | ratio to perspective |\n|---|---|---|")
+            for r in o["rows"]:
+                L.append("| %s | %.3f | %.3f |" % (r["camera"], r["cpu_render_s"], r["cpu_ratio"]))
+        L.append("")
+    if results.get("overhead_callgrind"):
+        o = results["overhead_callgrind"]
+        L.append("Instruction counts of the same cameras (callgrind, one thread, %dx%d; these repeat exactly"
+                 " whatever the machine does). Per-pixel work is the inclusive count of"
+                 " `TracePixel::operator()` (everything done for the pixels), scene the inclusive count of"
+                 " the outermost `Trace::TraceRay` (the rays traced into the scene, and what they cost);"
+                 " camera instructions per pixel = (per-pixel work - scene) / pixels.\n" % (o["size"], o["size"]))
+        L.append("| camera | total, M instructions | total ratio to perspective | per-pixel work, M instructions"
+                 " | per-pixel work ratio to perspective | scene, M instructions | scene rays per pixel"
+                 " | camera instructions per pixel |\n|---|---|---|---|---|---|---|---|")
+        for r in o["rows"]:
+            L.append("| %s | %s | %.4f | %s | %.4f | %s | %.3f | %.0f |" % (
+                r["camera"], mega(r["total_ir"]), r["total_ratio"], mega(r["pixel_work_ir"]), r["pixel_work_ratio"],
+                mega(r["trace_ray_ir"]), r["trace_ray_calls"] / r["pixels"], r["camera_ir_per_pixel"]))
+        L.append("")
+    if "lenses" in results:
+        o = results["lenses"]
+        L.append("## Cost against lens count (`--only lenses`)\n")
+        L.append("10^2, 10^4 and 10^6 lenses over the same %dx%d sensor (10 um pixels), 1 sample. The fraction"
+                 " of pixels that receive light changes with the lens count when there is a main lens (round"
+                 " microimages in square cells at 100 lenses, about one pixel per lens at 10^6), and a dark"
+                 " pixel traces no scene ray: *pixels lit* counts the pixels that are not black in a render of"
+                 " a white world, and *time per lit pixel* is the trace time divided by their number.\n"
+                 % (o["size"], o["size"]))
+    for key in ("lenses", "lenses_empty_scene", "lenses_array", "lenses_array_empty_scene"):
+        if key not in results:
+            continue
+        o = results[key]
+        scene = o.get("scene", "empty" if key.endswith("empty_scene") else "benchmark")
+        camera = o.get("camera", "thin main lens + rectangular pinhole array")
+        if scene == "empty":
+            L.append("%s, empty scene (a plain background: every ray costs the same and almost nothing, so what"
+                     " remains is the camera's own cost):\n" % (camera[0].upper() + camera[1:]))
+        else:
+            L.append("%s, benchmark scene:\n" % (camera[0].upper() + camera[1:]))
+        lens_table(L, o)
+    if results.get("lenses_callgrind"):
+        o = results["lenses_callgrind"]
+        L.append("Instruction counts (callgrind, one thread, %s scene, %dx%d): camera instructions per pixel ="
+                 " (inclusive `TracePixel::operator()` - inclusive outermost `Trace::TraceRay`) / pixels, which"
+                 " leaves out the scene whatever fraction of the pixels is lit.\n" % (o["scene"], o["size"], o["size"]))
+        L.append("| camera | lenses | scene rays per pixel | camera instructions per pixel | ratio to 100 lenses"
+                 " | total, M instructions |\n|---|---|---|---|---|---|")
+        for fam in o["families"].values():
+            for r in fam["rows"]:
+                L.append("| %s | %d | %.3f | %.0f | %.4f | %s |" % (fam["camera"], r["lenses"], r["traced_per_pixel"],
+                         r["camera_ir_per_pixel"], r["camera_ratio_to_100"], mega(r["total_ir"])))
+        L.append("")
+    if "trade" in results:
+        t = results["trade"]
+        L.append("## Speed against accuracy (`--only trade`)\n")
+        L.append("%dx%d, error against a %d-sample render of the same camera (RMSE over linear RGB, PSNR"
+                 " with peak 1)." % (t["size"][0], t["size"][1], t["reference_samples"]))
+        trade_plots = [p for p in plots if os.path.basename(p) == "trade.png"]
+        if trade_plots:
+            L.append("\n![trade](%s)\n" % report_path(trade_plots[0], path))
+        for label, points in t["configs"].items():
+            L.append("### %s\n" % label)
+            L.append("| form | time, s | RMSE | PSNR, dB | fixed-count time for the same RMSE, s | adaptive / fixed |"
+                     " oracle allocation bound |\n|---|---|---|---|---|---|---|")
+            for p in points:
+                L.append("| `%s` | %.3f | %.4f | %.1f | %s | %s | %s |" % (p["text"], p["median_s"], p["rmse"], p["psnr_db"],
+                         fmt(p.get("fixed_time_for_same_error_s")), fmt(p.get("time_ratio_to_fixed")),
+                         fmt(p.get("allocation_bound"))))
+            L.append("")
+        L.append("*Oracle allocation bound*: the fraction of a fixed count's samples with which a per-pixel adaptive"
+                 " scheme that knew every pixel's error could reach the same RMSE, (mean e)^2 / mean(e^2) over the"
+                 " per-pixel errors e of that fixed-count render (errors falling as 1/sqrt(samples)). No stopping"
+                 " rule does better than its oracle.\n")
+    if "dark" in results:
+        d = results["dark"]
+        L.append("## Pixels no light reaches (`--only dark`)\n")
+        L.append("Lytro-class camera (1.4 um pixels, 20 um hexagonal pitch, f/2), %dx%d, 4 samples; %.1f%% of its"
+                 " pixels receive no light (black in a white scene)." % (d["size"], d["size"], 100 * d["dark_pixel_fraction"]))
+        if d.get("lit_sample_fraction") is not None:
+            L.append("Of the samples, %.1f%% pass the apertures (mean pixel value of the white-scene render at %d"
+                     " samples: a lit sample returns 1, a blocked one 0). A blocked sample traces no scene ray, so,"
+                     " *as an estimate from the lit fraction* (every traced sample costing the same), the"
+                     " Lytro-class render leaves out %s s of scene rays (its time x (1 / lit fraction - 1))."
+                     % (100 * d["lit_sample_fraction"], d.get("white_samples", 16), fixed(d.get("estimated_untraced_s"))))
+        L.append("The measured comparison traces every sample of every pixel over the same sensor.\n")
+        L.append("| render | trace time, s |\n|---|---|")
+        for r in d["rows"]:
+            L.append("| %s | %.3f |" % (r["camera"], r["median_s"]))
+        L.append("")
+    if "threads" in results:
+        t = results["threads"]
+        L.append("## Threads (`--only threads`)\n")
+        L.append("| threads | trace time, s |\n|---|---|\n| 1 | %.3f |\n| 2 | %.3f |\n\nSpeed-up %.2fx (%dx%d plenoptic 1.0, 4 samples).\n"
+                 % (t["one_thread_s"], t["two_threads_s"], t["speedup"], t["size"], t["size"]))
+    if "fullsize" in results:
+        f = results["fullsize"]
+        L.append("## Full-size raw (`--only fullsize`)\n")
+        L.append("Lytro Illum-class sensor, %dx%d (%.1f Mpx), 1 sample, benchmark scene: trace time %.1f s (median of %d),"
+                 " peak RSS %.0f MiB.\n" % (f["size"][0], f["size"][1], f["size"][0] * f["size"][1] / 1e6, f["median_s"], f["runs"], f["peak_rss_mib"]))
+    analysis = os.path.join(ROOT, "benchmarks", "analysis.md")
+    if os.path.exists(analysis):
+        with open(analysis) as fh:
+            L.append(fh.read())
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    with open(path, "w") as fh:
+        fh.write("\n".join(L))
+
+
+def plot(results, outdir):
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        log("matplotlib missing: no plots")
+        return []
+    files = []
+    if "trade" in results:
+        fig, ax = plt.subplots(figsize=(7, 4.5))
+        for label, points in results["trade"]["configs"].items():
+            fixed = [p for p in points if p["form"] == "fixed"]
+            adapt = [p for p in points if p["form"] == "adaptive"]
+            line, = ax.loglog([p["median_s"] for p in fixed], [p["rmse"] for p in fixed], "o-", label=label + " (fixed)")
+            if adapt:
+                ax.loglog([p["median_s"] for p in adapt], [p["rmse"] for p in adapt], "s--", color=line.get_color(),
+                          label=label + " (adaptive)")
+            for p in fixed:
+                ax.annotate(str(p["samples"]), (p["median_s"], p["rmse"]), fontsize=7, xytext=(3, 3),
+                            textcoords="offset points")
+        ax.set_xlabel("render time, s (median)")
+        ax.set_ylabel("RMSE against %d-sample reference" % results["trade"]["reference_samples"])
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+        ax.set_title("Speed/accuracy trade (%dx%d)" % tuple(results["trade"]["size"]))
+        fig.tight_layout()
+        path = os.path.join(outdir, "trade.png")
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        files.append(path)
+    return files
