@@ -25,7 +25,7 @@ import pytest
 import plenoptic_testing as pt
 
 # Import name -> distribution name on PyPI, for every third-party module the package may import.
-DISTRIBUTIONS = {"numpy": "numpy", "PIL": "Pillow", "OpenImageIO": "OpenImageIO"}
+DISTRIBUTIONS = {"numpy": "numpy", "scipy": "scipy", "PIL": "Pillow", "OpenImageIO": "OpenImageIO"}
 
 
 def requirement_name(requirement):
