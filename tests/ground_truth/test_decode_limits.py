@@ -24,7 +24,9 @@ import os
 import resource
 import shutil
 import subprocess
-import sys
+import types
+
+import pytest
 
 import plenoptic_testing as pt
 
@@ -63,8 +65,9 @@ def run_measured(command, cwd):
     return child.returncode, text, usage.ru_maxrss / 1024.0  # Linux: kilobytes
 
 
-def test_decode_limits(args):
-    decode = pt.decoder(args.tools)
+@pytest.fixture(scope="module")
+def renders(args):
+    """The wide render, the normal one, the hand-edited metadata and the spacings they hold."""
     wide_png, _, _ = pt.render_ground_truth(args.povray, args.work, "limits_wide", SCENE_WIDE, 64, 48)
     png, meta_path, _ = pt.render_ground_truth(args.povray, args.work, "limits_normal", SCENE_NORMAL, 96, 72)
     good = pt.read_json(meta_path)
@@ -84,37 +87,45 @@ def test_decode_limits(args):
         json.dump(data, f, indent=1)
     edited_spacing = (good["microimage_lattice"]["basis_px"][0][0] ** 2
                       + good["microimage_lattice"]["basis_px"][0][1] ** 2) ** 0.5 * 1000.0
+    return types.SimpleNamespace(wide_png=wide_png, png=png, meta_path=meta_path, edited=edited,
+                                 spacing=spacing, edited_spacing=edited_spacing)
 
-    cases = [
-        ("microimages larger than the image (render)", [wide_png],
-         ["microimage_lattice.basis_px", "%.1f" % spacing, "64 x 48"]),
-        ("hand-edited basis x 1000", [png, edited],
-         ["microimage_lattice.basis_px", "%.1f" % edited_spacing, "96 x 72"]),
-        ("--step 0.001", [png, "--step", "0.001"], ["limit", "4 GiB", "--step", "--angular"]),
-        ("--angular 30001", [png, "--angular", "30001"], ["limit", "4 GiB", "--step", "--angular"]),
-    ]
-    for label, arguments, words in cases:
-        out = os.path.join(args.work, "limits_out_" + "".join(c if c.isalnum() else "_" for c in label))
-        shutil.rmtree(out, ignore_errors=True)
-        status, stderr, peak = run_measured(decode + arguments + ["-o", out, "-q"], args.work)
-        lines = [l for l in stderr.splitlines() if l.strip()]
-        assert (status == 2 and len(lines) == 1 and lines[0].startswith("plenoptic-decode: error:")
-                     and all(w in lines[0] for w in words) and "Traceback" not in stderr
-                     and not os.path.exists(os.path.join(out, "contact_sheet.png"))), ("%s: exit %d (want 2), stderr %r (want one line with %s)"
-                     % (label, status, stderr.strip()[-600:], words))
-        assert peak < PEAK_LIMIT_MIB, "%s: peak memory %.0f MiB (want < %d)" % (label, peak, PEAK_LIMIT_MIB)
 
-    # Positive control, and the up-front size is the size of what gets built.
+# label, the decoder's arguments and the words of its one error line (functions of the renders).
+CASES = [
+    ("microimages larger than the image (render)", lambda r: [r.wide_png],
+     lambda r: ["microimage_lattice.basis_px", "%.1f" % r.spacing, "64 x 48"]),
+    ("hand-edited basis x 1000", lambda r: [r.png, r.edited],
+     lambda r: ["microimage_lattice.basis_px", "%.1f" % r.edited_spacing, "96 x 72"]),
+    ("--step 0.001", lambda r: [r.png, "--step", "0.001"], lambda r: ["limit", "4 GiB", "--step", "--angular"]),
+    ("--angular 30001", lambda r: [r.png, "--angular", "30001"], lambda r: ["limit", "4 GiB", "--step", "--angular"]),
+]
+
+
+@pytest.mark.parametrize("label, arguments, words", CASES, ids=[c[0] for c in CASES])
+def test_refused_up_front(args, renders, label, arguments, words):
+    arguments, words = arguments(renders), words(renders)
+    out = os.path.join(args.work, "limits_out_" + "".join(c if c.isalnum() else "_" for c in label))
+    shutil.rmtree(out, ignore_errors=True)
+    status, stderr, peak = run_measured(pt.decoder(args.tools) + arguments + ["-o", out, "-q"], args.work)
+    lines = [l for l in stderr.splitlines() if l.strip()]
+    assert (status == 2 and len(lines) == 1 and lines[0].startswith("plenoptic-decode: error:")
+            and all(w in lines[0] for w in words) and "Traceback" not in stderr
+            and not os.path.exists(os.path.join(out, "contact_sheet.png"))), (
+        "%s: exit %d (want 2), stderr %r (want one line with %s)" % (label, status, stderr.strip()[-600:], words))
+    assert peak < PEAK_LIMIT_MIB, "%s: peak memory %.0f MiB (want < %d)" % (label, peak, PEAK_LIMIT_MIB)
+
+
+def test_normal_render_decodes_as_planned(args, renders):
+    """Positive control, and the up-front size is the size of what gets built."""
     out = os.path.join(args.work, "limits_normal.lightfield")
     shutil.rmtree(out, ignore_errors=True)
-    status, stderr, peak = run_measured(decode + [png, "-o", out, "-q", "--no-gif"], args.work)
+    status, stderr, peak = run_measured(pt.decoder(args.tools) + [renders.png, "-o", out, "-q", "--no-gif"], args.work)
     assert (status == 0 and peak < PEAK_LIMIT_MIB), ("the normal render decodes: exit %d, peak memory %.0f MiB (want 0, < %d)%s"
-                 % (status, peak, PEAK_LIMIT_MIB, "; stderr %r" % stderr[-400:] if status else ""))
-    if status == 0:
-        import plenoptic_lf
-        plan = getattr(plenoptic_lf, "plan_decode", None)
-        written = json.load(open(os.path.join(out, "lightfield.json")))["shape"]
-        predicted = list(plan(plenoptic_lf.load_metadata(meta_path)).shape) if plan else None
-        assert (predicted == written), ("plan_decode predicts the light field's shape %s = written %s"
-                     % (predicted, written))
-
+                                                     % (status, peak, PEAK_LIMIT_MIB, "; stderr %r" % stderr[-400:] if status else ""))
+    import plenoptic_lf
+    plan = getattr(plenoptic_lf, "plan_decode", None)
+    written = json.load(open(os.path.join(out, "lightfield.json")))["shape"]
+    predicted = list(plan(plenoptic_lf.load_metadata(renders.meta_path)).shape) if plan else None
+    assert (predicted == written), ("plan_decode predicts the light field's shape %s = written %s"
+                                    % (predicted, written))
