@@ -30,6 +30,8 @@ import subprocess
 
 import numpy as np
 
+import pytest
+
 import plenoptic_testing as pt
 
 W, H = 96, 72
@@ -135,46 +137,74 @@ def decode(args, image, out, extra=()):
     return run.returncode, run.stderr, data[:, :, n_v // 2, n_u // 2, :].astype(np.float64)
 
 
-def test_decode_encoding(args):
-    expected = np.array(C)
-
-    # What povray writes and OpenImageIO reports.
-    files = {}
+@pytest.fixture(scope="module")
+def files(args):
+    """name -> the render of each case (what povray writes and OpenImageIO reports)."""
+    out = {}
     for name, ext, options, bits, curve in CASES:
-        files[name] = render(args, name, ext, options)
-    chunks = {name: png_chunks(files[name]) for name, ext, _, _, _ in CASES if ext == "png"}
-
-    def gama(name):
-        return [struct.unpack(">I", c)[0] for c in chunks[name].get("gAMA", [])]
-
-    for name in ("linear16", "linear8"):
-        assert (gama(name) == [100000] and "sRGB" not in chunks[name] and "iCCP" not in chunks[name]), ("%s (File_Gamma=1.0): gAMA %s, sRGB chunk %s, iCCP %s (want gAMA 100000 alone)"
-                     % (name, gama(name), "sRGB" in chunks[name], "iCCP" in chunks[name]))
-    for name in ("srgb16", "srgb8"):
-        assert ("sRGB" in chunks[name] and gama(name) == [45455]), ("%s (default File_Gamma, sRGB): sRGB chunk %s, gAMA %s (want an sRGB chunk and gAMA 45455)"
-                     % (name, "sRGB" in chunks[name], gama(name)))
-    assert (gama("gamma22_16") == [45455] and "sRGB" not in chunks["gamma22_16"]), ("gamma22_16 (File_Gamma=2.2): gAMA %s, sRGB chunk %s (want gAMA 45455 alone)"
-                 % (gama("gamma22_16"), "sRGB" in chunks["gamma22_16"]))
+        out[name] = render(args, name, ext, options)
     for name, ext, options, bits, curve in CASES:
         print("      %-11s %s %-28s OpenImageIO: oiio:ColorSpace %r, oiio:Gamma %g"
-              % (name, ext, " ".join(options), *oiio_attributes(files[name])))
+              % (name, ext, " ".join(options), *oiio_attributes(out[name])))
+    return out
 
-    # Decode each with the default encoding: the centre view is C everywhere.
+
+# PNG chunks: File_Gamma=1.0 -> gAMA 100000 alone; default (sRGB) -> an sRGB chunk and gAMA 45455;
+# File_Gamma=2.2 -> gAMA 45455 alone.
+CHUNKS = [("linear16", "linear"), ("linear8", "linear"), ("srgb16", "srgb"), ("srgb8", "srgb"),
+          ("gamma22_16", "gamma22")]
+
+
+@pytest.mark.parametrize("name, kind", CHUNKS, ids=[c[0] for c in CHUNKS])
+def test_png_gamma_chunks(files, name, kind):
+    chunks = png_chunks(files[name])
+    gama = [struct.unpack(">I", c)[0] for c in chunks.get("gAMA", [])]
+    if kind == "linear":
+        assert (gama == [100000] and "sRGB" not in chunks and "iCCP" not in chunks), (
+            "%s (File_Gamma=1.0): gAMA %s, sRGB chunk %s, iCCP %s (want gAMA 100000 alone)"
+            % (name, gama, "sRGB" in chunks, "iCCP" in chunks))
+    elif kind == "srgb":
+        assert ("sRGB" in chunks and gama == [45455]), (
+            "%s (default File_Gamma, sRGB): sRGB chunk %s, gAMA %s (want an sRGB chunk and gAMA 45455)"
+            % (name, "sRGB" in chunks, gama))
+    else:
+        assert (gama == [45455] and "sRGB" not in chunks), (
+            "%s (File_Gamma=2.2): gAMA %s, sRGB chunk %s (want gAMA 45455 alone)" % (name, gama, "sRGB" in chunks))
+
+
+@pytest.fixture(scope="module")
+def decoded(args, files):
+    """name -> (exit status, stderr, centre view) of plenoptic-decode with the default encoding."""
+    return {name: decode(args, files[name], os.path.join(args.work, "encoding_%s.lightfield" % name))
+            for name, ext, options, bits, curve in CASES}
+
+
+@pytest.mark.parametrize("name, ext, options, bits, curve", CASES, ids=[c[0] for c in CASES])
+def test_default_encoding(decoded, name, ext, options, bits, curve):
+    """Decoded with the file's own encoding, the centre view is C everywhere."""
+    expected = np.array(C)
+    status, stderr, centre = decoded[name]
+    assert status == 0 and centre is not None, ("%s: plenoptic-decode exits 0 (got %d%s)"
+                                                % (name, status, "; stderr %r" % stderr[-400:] if status else ""))
+    want_word = "encoding %s" % (curve if isinstance(curve, str) else "gamma %g" % curve)
+    assert (want_word in stderr), ("%s: the decoder says which encoding it applied: %r in %r"
+                                   % (name, want_word, [l for l in stderr.splitlines() if "encoding" in l]))
+    bound = quantisation_bound(expected, bits, curve)
+    error = np.abs(centre - expected).reshape(-1, 3).max(axis=0)
+    assert (np.all(error <= bound)), (
+        "%s (%s, %s %s): centre view of %d lenses = C within the quantisation bound: mean %s, "
+        "worst error %s <= %s" % (name, ext, "%d-bit" % bits if bits else "half float", curve,
+                                 centre.shape[0] * centre.shape[1],
+                                 np.round(centre.reshape(-1, 3).mean(axis=0), 6), error, bound))
+
+
+def test_central_views_agree(decoded):
+    expected = np.array(C)
     centres = {}
     for name, ext, options, bits, curve in CASES:
-        status, stderr, centre = decode(args, files[name], os.path.join(args.work, "encoding_%s.lightfield" % name))
-        assert status == 0 and centre is not None, ("%s: plenoptic-decode exits 0 (got %d%s)"
-                                                    % (name, status, "; stderr %r" % stderr[-400:] if status else ""))
-        want_word = "encoding %s" % (curve if isinstance(curve, str) else "gamma %g" % curve)
-        assert (want_word in stderr), ("%s: the decoder says which encoding it applied: %r in %r"
-                     % (name, want_word, [l for l in stderr.splitlines() if "encoding" in l]))
-        bound = quantisation_bound(expected, bits, curve)
-        error = np.abs(centre - expected).reshape(-1, 3).max(axis=0)
-        assert (np.all(error <= bound)), ("%s (%s, %s %s): centre view of %d lenses = C within the quantisation bound: mean %s, "
-                     "worst error %s <= %s" % (name, ext, "%d-bit" % bits if bits else "half float", curve,
-                                              centre.shape[0] * centre.shape[1],
-                                              np.round(centre.reshape(-1, 3).mean(axis=0), 6), error, bound))
-        centres[name] = (centre, bound)
+        status, stderr, centre = decoded[name]
+        if status == 0 and centre is not None:
+            centres[name] = (centre, quantisation_bound(expected, bits, curve))
     names = sorted(centres)
     worst = []
     for i, a in enumerate(names):
@@ -185,23 +215,27 @@ def test_decode_encoding(args):
             difference = np.abs(centres[a][0] - centres[b][0]).reshape(-1, 3).max(axis=0)
             if np.any(difference > centres[a][1] + centres[b][1]):
                 worst.append((a, b, difference))
-    assert (len(names) == len(CASES) and not worst), ("the %d central views agree pairwise within the sum of their quantisation bounds%s"
-                 % (len(names), "; not: %s" % worst if worst else ""))
+    assert (len(names) == len(CASES) and not worst), (
+        "the %d central views agree pairwise within the sum of their quantisation bounds%s"
+        % (len(names), "; not: %s" % worst if worst else ""))
 
-    # --encoding overrides the file.
-    for name, option, want, bits, curve in (
-            ("linear16", "srgb", decode_curve(expected, "srgb"), 16, "linear"),
-            ("srgb16", "linear", encode(expected, "srgb"), 16, "srgb")):
-        status, stderr, centre = decode(args, files[name], os.path.join(args.work, "encoding_%s_as_%s.lightfield"
-                                                                        % (name, option)), ["--encoding", option])
-        assert status == 0 and centre is not None, ("%s --encoding %s: exit 0 (got %d%s)"
-                                                    % (name, option, status, "; stderr %r" % stderr[-400:] if status else ""))
-        # The stored value's error, carried through the override's curve instead of the file's.
-        bound = np.abs(decode_curve(encode(expected, curve) + 0.5 / 65535, option) - want) * 1.05 + 1e-6
-        error = np.abs(centre - want).reshape(-1, 3).max(axis=0)
-        assert (np.all(error <= bound)), ("%s --encoding %s overrides the file: centre %s, want %s (worst error %s <= %s)"
-                     % (name, option, np.round(centre.reshape(-1, 3).mean(axis=0), 6), np.round(want, 6), error,
-                        bound))
-        assert ("encoding %s (--encoding)" % option in stderr), ("%s --encoding %s: the decoder says so: %r"
-                     % (name, option, [l for l in stderr.splitlines() if "encoding" in l]))
 
+OVERRIDES = [("linear16", "srgb", 16, "linear"), ("srgb16", "linear", 16, "srgb")]
+
+
+@pytest.mark.parametrize("name, option, bits, curve", OVERRIDES, ids=["%s-as-%s" % c[:2] for c in OVERRIDES])
+def test_encoding_option_overrides_the_file(args, files, name, option, bits, curve):
+    expected = np.array(C)
+    want = decode_curve(expected, "srgb") if option == "srgb" else encode(expected, "srgb")
+    status, stderr, centre = decode(args, files[name], os.path.join(args.work, "encoding_%s_as_%s.lightfield"
+                                                                    % (name, option)), ["--encoding", option])
+    assert status == 0 and centre is not None, ("%s --encoding %s: exit 0 (got %d%s)"
+                                                % (name, option, status, "; stderr %r" % stderr[-400:] if status else ""))
+    # The stored value's error, carried through the override's curve instead of the file's.
+    bound = np.abs(decode_curve(encode(expected, curve) + 0.5 / 65535, option) - want) * 1.05 + 1e-6
+    error = np.abs(centre - want).reshape(-1, 3).max(axis=0)
+    assert (np.all(error <= bound)), ("%s --encoding %s overrides the file: centre %s, want %s (worst error %s <= %s)"
+                                      % (name, option, np.round(centre.reshape(-1, 3).mean(axis=0), 6),
+                                         np.round(want, 6), error, bound))
+    assert ("encoding %s (--encoding)" % option in stderr), ("%s --encoding %s: the decoder says so: %r"
+                                                             % (name, option, [l for l in stderr.splitlines() if "encoding" in l]))
