@@ -67,6 +67,21 @@ inline void estimate(const SampleSums* sums, int lenses, double value[4], double
     }
 }
 
+// Sample n of `count` samples of pixel (i, j) whose light comes through `lenses` lenses (overlap
+// modelling): it goes through lens slot n mod lenses (*slot), as sample n / lenses of that
+// lens's own stream of make_sample. So each lens gets a whole low-discrepancy pattern over the
+// pixel and the aperture, and the lenses' shares differ by one sample at most. (Every L-th point
+// of one Halton sequence is not such a pattern: with L = 2, the even points have their base-2
+// coordinate, the aperture's u, all in one half of [0, 1).) With one lens this is exactly
+// make_sample(i, j, n, count).
+inline CameraSample lens_sample(int i, int j, int n, int count, int lenses, int* slot)
+{
+    *slot = n % lenses;
+    // `count`, not the lens's share of it: only a 1-sample pixel is sampled at its centre, and a
+    // lens that gets one sample of several gets a random point (point 0 of its rotated stream).
+    return make_sample(i, j, n / lenses, count, *slot);
+}
+
 // How many of samples from .. to-1 of pixel (i, j) pass the apertures through the pixel's own
 // lenses (geometry only); *first is the first of them (-1 if none).
 inline int passing_samples(const Model& model, int i, int j, int W, int H, int from, int to, int* first)
@@ -123,8 +138,9 @@ Rgbt vignetted_value(const Model& model, int i, int j, int W, int H, int n, int 
 // value is detail::vignetted_value: the mean of the traced colours times the fraction of 4n
 // sample points that pass (no scene ray for those). With one sample, the chief ray alone.
 // With overlap modelling, sample n goes through the pixel's lens n mod L (L lenses from
-// overlap_lenses) and the value is the sum over lenses of each lens's mean; t is clamped to
-// [0, 1]. A pixel that no lens reaches is black and opaque, never background.
+// overlap_lenses) as sample n / L of that lens's own sample stream (detail::lens_sample), and
+// the value is the sum over lenses of each lens's mean; t is clamped to [0, 1]. A pixel that no
+// lens reaches is black and opaque, never background.
 template <class TraceFn>
 Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
 {
@@ -168,8 +184,8 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
     for (;;) {
         const int stop = std::min(count, n + batch);
         for (; n < stop; ++n) {
-            const int slot = model.model_overlap ? n % lens_count : 0;
-            const CameraSample sample = make_sample(i, j, n, count);
+            int slot = 0;
+            const CameraSample sample = detail::lens_sample(i, j, n, count, lens_count, &slot);
             OpticsRay ray;
             Rgbt colour{0, 0, 0, 0};
             if (generate_ray(model, W, H, i, j, sample, model.model_overlap ? &lenses[slot] : nullptr, &ray)) {

@@ -47,7 +47,7 @@ double radical_inverse(std::uint32_t n)
 
 } // namespace
 
-CameraSample make_sample(int i, int j, int n, int count)
+CameraSample make_sample(int i, int j, int n, int count, int stream)
 {
     if (count <= 1)
         return CameraSample{0.5, 0.5, 0.5, 0.5};
@@ -59,7 +59,10 @@ CameraSample make_sample(int i, int j, int n, int count)
                               radical_inverse<3>(index)};
     const std::uint64_t key = (std::uint64_t(std::uint32_t(i)) << 32) | std::uint64_t(std::uint32_t(j));
     double value[4];
+    // Stream 0 keeps the pixel's own rotation; another stream hashes its number in first.
     std::uint64_t hash = key;
+    if (stream != 0)
+        hash = mix64(key ^ (std::uint64_t(std::uint32_t(stream)) * 0xD6E8FEB86659FD93ull));
     for (int d = 0; d < 4; ++d) {
         hash = mix64(hash);
         // Cranley-Patterson rotation: shift the whole point set by a per-pixel offset, modulo 1.

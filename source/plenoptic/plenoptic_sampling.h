@@ -17,11 +17,13 @@ struct CameraSample {
     double lens_u, lens_v;    // [0,1)^2 over the aperture; (0.5, 0.5) maps to its centre
 };
 
-// Sample n of `count` samples of pixel (i, j). Depends on (i, j, n, count) only: no state, so
-// any thread order gives the same image. A 1-sample pixel gets exactly the pixel centre and the
-// aperture centre; otherwise point n of the Halton sequence (bases 5, 7 for the pixel, 2, 3 for
-// the aperture) with a per-pixel Cranley-Patterson rotation from an integer hash of (i, j).
-CameraSample make_sample(int i, int j, int n, int count);
+// Sample n of `count` samples of pixel (i, j). Depends on (i, j, n, count, stream) only: no
+// state, so any thread order gives the same image. A 1-sample pixel gets exactly the pixel centre
+// and the aperture centre; otherwise point n of the Halton sequence (bases 5, 7 for the pixel,
+// 2, 3 for the aperture) with a per-pixel Cranley-Patterson rotation from an integer hash of
+// (i, j) and, for streams other than 0, of the stream: each stream of a pixel is a whole
+// low-discrepancy sequence of its own (overlap modelling gives each lens of a pixel one).
+CameraSample make_sample(int i, int j, int n, int count, int stream = 0);
 
 // Shirley-Chiu concentric map of [0,1)^2 onto the unit disc; (0.5, 0.5) -> (0, 0).
 Vec2 concentric_disc(double u, double v);
