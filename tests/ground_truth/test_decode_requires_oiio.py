@@ -19,6 +19,9 @@ import os
 import shutil
 import subprocess
 import sys
+import types
+
+import pytest
 
 import plenoptic_testing as pt
 
@@ -38,7 +41,9 @@ raise ImportError("No module named 'OpenImageIO' (hidden by the test)", name="Op
 '''
 
 
-def test_decode_requires_oiio(args):
+@pytest.fixture(scope="module")
+def setup(args):
+    """The render, and the environments that hide OpenImageIO (launcher; module from python/)."""
     png, _, _ = pt.render_ground_truth(args.povray, args.work, "no_oiio", SCENE, 96, 72)
     blocker = os.path.join(args.work, "no_oiio_path")
     shutil.rmtree(blocker, ignore_errors=True)
@@ -48,47 +53,61 @@ def test_decode_requires_oiio(args):
     python_dir = os.path.abspath(args.python)
     env = dict(os.environ, PYTHONPATH=blocker, PYTHONDONTWRITEBYTECODE="1")
     env_module = dict(env, PYTHONPATH=blocker + os.pathsep + python_dir)
+    return types.SimpleNamespace(png=png, env=env, env_module=env_module)
 
-    # The blocker works, and a fallback would have what it needs.
+
+def test_blocker_works(setup):
+    """The blocker works, and a fallback would have what it needs."""
     probe = subprocess.run([sys.executable, "-c", "import numpy, PIL\ntry:\n import OpenImageIO\n"
-                            "except ImportError as e:\n print('blocked', e)"], env=env, capture_output=True, text=True)
-    assert (probe.returncode == 0 and probe.stdout.startswith("blocked")), ("with the blocker on PYTHONPATH, numpy and Pillow import and OpenImageIO does not: %r %r"
-                 % (probe.stdout.strip(), probe.stderr.strip()[-300:]))
+                            "except ImportError as e:\n print('blocked', e)"], env=setup.env, capture_output=True, text=True)
+    assert (probe.returncode == 0 and probe.stdout.startswith("blocked")), (
+        "with the blocker on PYTHONPATH, numpy and Pillow import and OpenImageIO does not: %r %r"
+        % (probe.stdout.strip(), probe.stderr.strip()[-300:]))
 
-    launcher = pt.decoder(args.tools)
-    as_module = [sys.executable, "-m", "plenoptic_lf"]
-    for label, command, environment in (("tools/plenoptic-decode", launcher, env),
-                                        ("python3 -m plenoptic_lf", as_module, env_module)):
-        out = os.path.join(args.work, "no_oiio_%s.lightfield" % ("module" if "-m" in command else "launcher"))
-        shutil.rmtree(out, ignore_errors=True)
-        run = subprocess.run(command + [png, "-o", out], env=environment, capture_output=True, text=True,
-                             cwd=args.work)
-        lines = [l for l in run.stderr.splitlines() if l.strip()]
-        assert (run.returncode != 0 and len(lines) == 1 and lines[0].startswith("plenoptic-decode: error:")
-                     and "python3-openimageio" in lines[0] and "pip install OpenImageIO" in lines[0]
-                     and "Traceback" not in run.stderr and not os.path.exists(os.path.join(out, "contact_sheet.png"))), ("%s without OpenImageIO: exit %d (want non-zero), stderr %r (want one line naming "
-                     "python3-openimageio and 'pip install OpenImageIO'), outputs written: %s"
-                     % (label, run.returncode, run.stderr.strip()[-500:], os.path.exists(out)))
-        assert (run.returncode == 1), ("%s without OpenImageIO: exit status %d (want 1, as for a missing numpy)"
-                     % (label, run.returncode))
-        help_run = subprocess.run(command + ["--help"], env=environment, capture_output=True, text=True,
-                                  cwd=args.work)
-        assert (help_run.returncode == 0 and help_run.stdout.startswith("usage: plenoptic-decode")), ("%s --help without OpenImageIO: exit %d, %r" % (label, help_run.returncode,
-                                                                     help_run.stdout[:60] + help_run.stderr[-200:]))
 
-    # The library: importable without OpenImageIO, read_raw refuses with the same message.
+@pytest.mark.parametrize("label", ["tools/plenoptic-decode", "python3 -m plenoptic_lf"])
+def test_command_without_oiio(args, setup, label):
+    if label == "tools/plenoptic-decode":
+        command, environment = pt.decoder(args.tools), setup.env
+    else:
+        command, environment = [sys.executable, "-m", "plenoptic_lf"], setup.env_module
+    png = setup.png
+    out = os.path.join(args.work, "no_oiio_%s.lightfield" % ("module" if "-m" in command else "launcher"))
+    shutil.rmtree(out, ignore_errors=True)
+    run = subprocess.run(command + [png, "-o", out], env=environment, capture_output=True, text=True,
+                         cwd=args.work)
+    lines = [l for l in run.stderr.splitlines() if l.strip()]
+    assert (run.returncode != 0 and len(lines) == 1 and lines[0].startswith("plenoptic-decode: error:")
+                 and "python3-openimageio" in lines[0] and "pip install OpenImageIO" in lines[0]
+                 and "Traceback" not in run.stderr and not os.path.exists(os.path.join(out, "contact_sheet.png"))), ("%s without OpenImageIO: exit %d (want non-zero), stderr %r (want one line naming "
+                 "python3-openimageio and 'pip install OpenImageIO'), outputs written: %s"
+                 % (label, run.returncode, run.stderr.strip()[-500:], os.path.exists(out)))
+    assert (run.returncode == 1), ("%s without OpenImageIO: exit status %d (want 1, as for a missing numpy)"
+                 % (label, run.returncode))
+    help_run = subprocess.run(command + ["--help"], env=environment, capture_output=True, text=True,
+                              cwd=args.work)
+    assert (help_run.returncode == 0 and help_run.stdout.startswith("usage: plenoptic-decode")), ("%s --help without OpenImageIO: exit %d, %r" % (label, help_run.returncode,
+                                                                 help_run.stdout[:60] + help_run.stderr[-200:]))
+
+
+def test_library_without_oiio(setup):
+    """The library: importable without OpenImageIO, read_raw refuses with the same message."""
+    png = setup.png
     snippet = ("import plenoptic_lf\n"
                "try:\n"
                "    plenoptic_lf.read_raw(%r)\n"
                "    print('read')\n"
                "except ImportError as e:\n"
                "    print('ImportError', type(e).__name__, e)\n" % png)
-    run = subprocess.run([sys.executable, "-c", snippet], env=env_module, capture_output=True, text=True)
+    run = subprocess.run([sys.executable, "-c", snippet], env=setup.env_module, capture_output=True, text=True)
     assert (run.returncode == 0 and run.stdout.startswith("ImportError") and "python3-openimageio" in run.stdout
                  and "pip install OpenImageIO" in run.stdout), ("library without OpenImageIO: import plenoptic_lf works and read_raw raises an ImportError "
                  "naming both packages: %r %r" % (run.stdout.strip(), run.stderr.strip()[-300:]))
 
-    # Positive control.
+
+def test_decodes_with_oiio(args, setup):
+    """Positive control."""
+    png, launcher = setup.png, pt.decoder(args.tools)
     out = os.path.join(args.work, "no_oiio_control.lightfield")
     shutil.rmtree(out, ignore_errors=True)
     run = subprocess.run(launcher + [png, "-o", out, "-q", "--no-gif"], capture_output=True, text=True)
