@@ -55,11 +55,24 @@ std::size_t DepthMap::allocated_rows() const
 }
 
 DepthBackfill::DepthBackfill(const std::vector<PixelRect>& untraced, long long pixels_to_trace)
-    : pixels_to_trace_(std::max(pixels_to_trace, 0LL)), traced_(0), handed_out_(0)
+    : total_runs_(0), pixels_to_trace_(std::max(pixels_to_trace, 0LL)), traced_(0), handed_out_(0)
 {
-    for (const PixelRect& r : untraced)
-        for (int row = r.top; row <= r.bottom && r.left <= r.right; ++row)
-            runs_.push_back(PixelRun{row, r.left, r.right});
+    for (const PixelRect& r : untraced) {
+        if (r.left > r.right || r.top > r.bottom)
+            continue;
+        rects_.push_back(r);
+        rows_before_.push_back(total_runs_);
+        total_runs_ += r.bottom - r.top + 1;
+    }
+}
+
+PixelRun DepthBackfill::run(long long index) const
+{
+    // The last rectangle whose first run is at or before `index`.
+    const std::size_t k =
+        std::size_t(std::upper_bound(rows_before_.begin(), rows_before_.end(), index) - rows_before_.begin()) - 1;
+    const PixelRect& r = rects_[k];
+    return PixelRun{r.top + int(index - rows_before_[k]), r.left, r.right};
 }
 
 void DepthBackfill::pixel_traced()
@@ -69,7 +82,7 @@ void DepthBackfill::pixel_traced()
 
 PixelRun DepthBackfill::next_due()
 {
-    const long long total = (long long)runs_.size();
+    const long long total = total_runs_;
     const long long traced = traced_.load(std::memory_order_relaxed);
     // Runs due after `traced` of the pixels: the same share of all runs, rounded up, so the
     // first traced pixel starts the work and the last one has every run handed out.
@@ -79,7 +92,7 @@ PixelRun DepthBackfill::next_due()
     long long next = handed_out_.load(std::memory_order_relaxed);
     while (next < std::min(due, total)) {
         if (handed_out_.compare_exchange_weak(next, next + 1, std::memory_order_relaxed))
-            return runs_[std::size_t(next)];
+            return run(next);
     }
     return PixelRun{-1, 0, -1};
 }
@@ -87,8 +100,10 @@ PixelRun DepthBackfill::next_due()
 long long DepthBackfill::pixels_not_handed_out() const
 {
     long long pixels = 0;
-    for (std::size_t k = std::size_t(std::min<long long>(handed_out_.load(), (long long)runs_.size())); k < runs_.size(); ++k)
-        pixels += runs_[k].right - runs_[k].left + 1;
+    for (long long k = std::min(handed_out_.load(), total_runs_); k < total_runs_; ++k) {
+        const PixelRun r = run(k);
+        pixels += r.right - r.left + 1;
+    }
     return pixels;
 }
 

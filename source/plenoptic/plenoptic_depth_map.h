@@ -63,12 +63,19 @@ public:
     // The next run due at this point of the render, or none (each run is handed out once).
     PixelRun next_due();
 
-    std::size_t runs() const { return runs_.size(); }
+    std::size_t runs() const { return std::size_t(total_runs_); }
     // Runs not yet handed out (after the render: pixels whose depth is unknown).
     long long pixels_not_handed_out() const;
 
 private:
-    std::vector<PixelRun> runs_;
+    PixelRun run(long long index) const;
+
+    // The runs are the rows of the rectangles in order; run k is found from the running row
+    // counts (memory per rectangle, not per row: a continued 20000x20000 render has ~400,000
+    // finished blocks of 32 rows).
+    std::vector<PixelRect> rects_;
+    std::vector<long long> rows_before_;  // rows of the rectangles before each one
+    long long total_runs_;
     long long pixels_to_trace_;
     std::atomic<long long> traced_;
     std::atomic<long long> handed_out_;

@@ -107,6 +107,27 @@ TEST(DepthBackfill, HandsOutEveryUntracedPixelOnceByTheLastTracedPixel)
     EXPECT_LE(most_in_one_pixel, 36);
 }
 
+TEST(DepthBackfill, RunsAreTheRowsOfTheRectanglesInOrder)
+{
+    // Rectangles of different heights (one empty, skipped), handed out all at once (one pixel
+    // left to trace): every row of each, in order.
+    const std::vector<PixelRect> done = {{0, 0, 31, 2}, {5, 10, 4, 20}, {32, 7, 40, 7}, {100, 50, 131, 53}};
+    DepthBackfill backfill(done, 1);
+    EXPECT_EQ(backfill.runs(), 3u + 1u + 4u);
+    backfill.pixel_traced();
+    std::vector<PixelRun> got;
+    for (PixelRun run = backfill.next_due(); !run.none(); run = backfill.next_due())
+        got.push_back(run);
+    const std::vector<PixelRun> want = {{0, 0, 31}, {1, 0, 31}, {2, 0, 31}, {7, 32, 40},
+                                        {50, 100, 131}, {51, 100, 131}, {52, 100, 131}, {53, 100, 131}};
+    ASSERT_EQ(got.size(), want.size());
+    for (size_t k = 0; k < want.size(); ++k) {
+        EXPECT_EQ(got[k].row, want[k].row) << k;
+        EXPECT_EQ(got[k].left, want[k].left) << k;
+        EXPECT_EQ(got[k].right, want[k].right) << k;
+    }
+}
+
 TEST(DepthBackfill, FewPixelsLeftCarryTheWholeBackfillBetweenThem)
 {
     const std::vector<PixelRect> done = {{0, 0, 9, 99}};

@@ -196,7 +196,7 @@ Traced trace(const Prescription& lens, const LensRay& in, bool from_image)
 
 ParsedPrescription parse_lens_file(const std::string& text)
 {
-    ParsedPrescription parsed;
+    ParsedPrescription parsed = ParsedPrescription();
     std::istringstream lines(text);
     std::string line;
     int number = 0;
@@ -274,7 +274,7 @@ PrescriptionError check_prescription(const Prescription& lens)
         return PrescriptionError{row_name(lens.surfaces.back(), int(lens.surfaces.size()) - 1) +
                                      ": the last surface must open into air (index 1), where the sensor is",
                                  lens.surfaces.back().line};
-    return PrescriptionError{};
+    return PrescriptionError{"", 0};
 }
 
 std::vector<double> vertex_positions(const Prescription& lens)

@@ -40,8 +40,8 @@ struct Prescription {
 
 // A refusal: what is wrong, at which 1-based line of the input (0: not tied to a line).
 struct PrescriptionError {
-    std::string message;
-    int line = 0;
+    std::string message;  // empty: no error
+    int line;
     bool any() const { return !message.empty(); }
 };
 
