@@ -115,11 +115,6 @@ def first_error(text, code):
     return ("exit %d: %s" % (code, lines[-1] if lines else "no output"))[:400]
 
 
-def one_line(text):
-    """POV-Ray wraps its messages: the text with every run of white space made one space."""
-    return " ".join(text.split())
-
-
 CRASH_MARKERS = ("Segmentation", "core dumped", "Aborted", "terminate called", "Bus error",
                  "Floating point exception", "AddressSanitizer", "runtime error:", "Assertion")
 
