@@ -31,7 +31,6 @@ public:
     bool frame_orthonormal() const { return frame_orthonormal_; }
     int width() const { return width_; }
     int height() const { return height_; }
-    PixelRect area() const { return area_; }
     // nullptr unless the camera asked for a depth map.
     DepthMap* depth() { return depth_.get(); }
     const DepthMap* depth() const { return depth_.get(); }
@@ -43,7 +42,6 @@ private:
     CameraFrame frame_;
     bool frame_orthonormal_;
     int width_, height_;
-    PixelRect area_;
     std::unique_ptr<DepthMap> depth_;
     std::unique_ptr<DepthBackfill> backfill_;
 };
