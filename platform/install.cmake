@@ -11,6 +11,7 @@
 #   P/lib/python3/dist-packages/plenoptic_lf/    the decoder (python/plenoptic_lf/)
 #   P/share/povray-plenoptic/include/, ini/      POV-Ray's own include and ini files
 #   P/share/povray-plenoptic/scenes/             the repository's scenes/
+#   P/share/povray-plenoptic/lenses/             the repository's lenses/ (main-lens prescriptions)
 #   P/share/povray-plenoptic/docs/               docs/*.md, docs/metadata.schema.json, README.md, LICENSE
 #   P/share/man/man1/*.1                         povray-plenoptic, plenoptic-project, plenoptic-decode
 #   P/share/doc/povray-plenoptic/copyright       the licence (Debian's place for it)
@@ -28,10 +29,11 @@ endif()")
 endif()
 
 # Data: POV-Ray's include/ and ini/ (from the fetched source, as staged in the build tree),
-# our scenes and documentation.
+# our scenes, lens prescriptions and documentation.
 install(DIRECTORY "${_upstream}/distribution/include" "${_upstream}/distribution/ini"
         DESTINATION "${PLENOPTIC_DATA_DEST}")
 install(DIRECTORY "${CMAKE_SOURCE_DIR}/scenes/" DESTINATION "${PLENOPTIC_DATA_DEST}/scenes")
+install(DIRECTORY "${CMAKE_SOURCE_DIR}/lenses/" DESTINATION "${PLENOPTIC_DATA_DEST}/lenses")
 install(DIRECTORY "${CMAKE_SOURCE_DIR}/docs/" DESTINATION "${PLENOPTIC_DATA_DEST}/docs"
         FILES_MATCHING PATTERN "*.md" PATTERN "*.schema.json")
 install(FILES "${CMAKE_SOURCE_DIR}/README.md" "${CMAKE_SOURCE_DIR}/LICENSE"
