@@ -53,7 +53,7 @@ def write_report(results, path, plots, results_path):
         L.append("`tools/bench --only build` (ccache off, Ninja, 2 jobs):\n")
         L.append("| what | seconds |\n|---|---|")
         L.append("| clean build of POV-Ray and the camera | %.0f |" % b["clean_s"])
-        L.append("| rebuild after touching `source/plenoptic/plenoptic_optics.cpp` (median of 3) | %.1f |" % b["rebuild_after_touch_s"])
+        L.append("| rebuild after touching `source/plenoptic/plenoptic_rays.cpp` (median of 3) | %.1f |" % b["rebuild_after_touch_s"])
         L.append("")
     if "overhead" in results:
         o = results["overhead"]
