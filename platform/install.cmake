@@ -78,7 +78,7 @@ set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)  # povray-plenoptic_<version>_<arch>.deb
 # Shared libraries of the two binaries from dpkg-shlibdeps; the decoder's Python modules by hand
 # (python/plenoptic_lf imports numpy, PIL and OpenImageIO).
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
-set(CPACK_DEBIAN_PACKAGE_DEPENDS "python3, python3-numpy, python3-pil, python3-openimageio")
+set(CPACK_DEBIAN_PACKAGE_DEPENDS "python3, python3-numpy, python3-scipy, python3-pil, python3-openimageio")
 # Installed with the prefix /usr into a staging DESTDIR, so the configuration lands in /etc.
 set(CPACK_SET_DESTDIR ON)
 set(CPACK_INSTALL_PREFIX /usr)
