@@ -22,16 +22,13 @@ of those points' images through it weighted by the part of each point's light th
     where microimages overlap, a sphere's images through neighbouring lenses can merge into one
     blob. Its centroid must lie within TOLERANCE_PX of the energy-weighted mean of the predicted
     images it holds (LIGHT_TOLERANCE_PX when they are all lighter than REQUIRED_ENERGY: a
-    partly lit cell's few noisy pixels). In the two overlapping set-ups the renders sit up to
-    0.34 px from the prediction for a single image (OVERLAP_TOLERANCE_PX) and 1.3 px for the
-    merged pair of the sphere at 2.06 m (MERGED_TOLERANCE_PX: the render splits its light 0.60 /
-    0.40 between the two lenses where the cell areas say 0.65 / 0.35), steady from 900 to 3600
-    samples, so not noise. The renderer causes it, not the prediction: its pixel loop sends
-    sample n through lens n mod L of the pixel's L overlap lenses, and those subsequences of the
-    sample sequence are not uniform over pixel and cell. Shading the same pixels with the optics
-    library and independent uniform samples per lens (generate_ray, overlap_lenses) puts these
-    blobs within 0.02 px of the predictions (48.660, 50.218 against 48.656, 50.198; 107.506,
-    51.596 against 107.498, 51.586) while shade_pixel reproduces the render (106.17, 51.62).
+    partly lit cell's few noisy pixels). In the two overlapping set-ups the bounds are
+    OVERLAP_TOLERANCE_PX for a single image and MERGED_TOLERANCE_PX for the merged pair of the
+    sphere at 2.06 m. Until issue 12 the renderer sent sample n of a pixel through lens n mod L of
+    its L overlap lenses, and those subsequences of one sample sequence are not uniform over pixel
+    and cell: the merged pair rendered 1.3 px from the prediction (the light split 0.60 / 0.40
+    where the cell areas say 0.65 / 0.35). Each lens now takes its own whole sample stream; the
+    worst offsets measured since are 0.16 px (single image) and 0.11 px (merged pair).
   - each sphere's centre, projected alone as a point, must image at least once, and each of its
     images carrying at least REQUIRED_ENERGY of its strongest must lie in a blob (the old code printed nothing for a point imaged on a cell border).
   - no blob may be left unexplained, except noise: blobs with less than NOISE_FLUX of the flux of

@@ -14,7 +14,7 @@ computed for a +SR/+ER partial render too. These tests fail on that code:
   sensor pixels there: pixel i of a W-wide image sits at (i - (W - 1) / 2) pixels from the axis),
   and every pixel outside the region must read -1 (docs/ground-truth.md).
 
-Run by ctest (robustness_depth_as_rendered) with POVRAY and TEST_WORK in the environment.
+Run by ctest as robustness_depth_as_rendered (the options come through tests/conftest.py).
 """
 import os
 import re
@@ -23,11 +23,8 @@ import subprocess
 import time
 
 import numpy as np
-import OpenImageIO as oiio
-import pytest
 
-POVRAY = os.environ.get("POVRAY", "povray")
-WORK = os.path.join(os.environ.get("TEST_WORK", "/tmp"), "robustness", "depth_as_rendered")
+import plenoptic_testing as pt
 
 SCENE = """\
 // SPDX-License-Identifier: AGPL-3.0-or-later
@@ -59,8 +56,8 @@ STOP_SECONDS = 10
 PEAK_MEMORY_MB = 100
 
 
-def scene_dir(name, pixel, samples):
-    path = os.path.join(WORK, name)
+def scene_dir(args, name, pixel, samples):
+    path = os.path.join(args.work, name)
     os.makedirs(path, exist_ok=True)
     for f in os.listdir(path):
         os.remove(os.path.join(path, f))
@@ -69,16 +66,9 @@ def scene_dir(name, pixel, samples):
     return path
 
 
-def command(width, height, extra=()):
-    return [POVRAY, "+Iscene.pov", "+Oimage.png", "+W%d" % width, "+H%d" % height,
+def command(povray, width, height, extra=()):
+    return [povray, "+Iscene.pov", "+Oimage.png", "+W%d" % width, "+H%d" % height,
             "-D", "-P", "-GS", "-GR", "+FN16", "File_Gamma=1.0"] + list(extra)
-
-
-def read_float_image(path):
-    buf = oiio.ImageBuf(path)
-    pixels = buf.get_pixels(oiio.FLOAT)
-    assert pixels is not None and pixels.size > 0, "cannot read %s: %s" % (path, buf.geterror())
-    return pixels
 
 
 def peak_memory_mb(proc, timeout):
@@ -102,9 +92,9 @@ def peak_memory_mb(proc, timeout):
     return peak_kb / 1024.0
 
 
-def test_progress_at_once_and_stop_within_seconds_of_sigint():
-    cwd = scene_dir("stop", "0.0025", 4)
-    proc = subprocess.Popen(command(6000, 6000, ["+WT2"]), cwd=cwd, stdout=subprocess.PIPE,
+def test_progress_at_once_and_stop_within_seconds_of_sigint(args):
+    cwd = scene_dir(args, "stop", "0.0025", 4)
+    proc = subprocess.Popen(command(args.povray, 6000, 6000, ["+WT2"]), cwd=cwd, stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, start_new_session=True)
     os.set_blocking(proc.stdout.fileno(), False)
     out = b""
@@ -152,12 +142,12 @@ def test_progress_at_once_and_stop_within_seconds_of_sigint():
     assert left == [], "a cancelled render left %s behind" % left
 
 
-def test_partial_render_computes_and_holds_only_its_region():
+def test_partial_render_computes_and_holds_only_its_region(args):
     W = H = 6000
     first, last = 2990, 3009   # a 20x20 region at the centre (0-based; +SC/+EC/+SR/+ER count from 1)
-    cwd = scene_dir("partial", "0.001", 1)
+    cwd = scene_dir(args, "partial", "0.001", 1)
     with open(os.path.join(cwd, "output.txt"), "wb") as log:
-        proc = subprocess.Popen(command(W, H, ["+WT2"] + ["%s%d" % (o, v + 1) for o, v in
+        proc = subprocess.Popen(command(args.povray, W, H, ["+WT2"] + ["%s%d" % (o, v + 1) for o, v in
                                                 (("+SC", first), ("+EC", last), ("+SR", first), ("+ER", last))]),
                                 cwd=cwd, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
         peak_mb = peak_memory_mb(proc, timeout=900)
@@ -167,7 +157,7 @@ def test_partial_render_computes_and_holds_only_its_region():
     print("peak resident memory of the partial render: %.0f MB" % peak_mb)
     assert peak_mb < PEAK_MEMORY_MB, "a 20x20 region of a 6000x6000 depth render peaked at %.0f MB" % peak_mb
 
-    depth = read_float_image(os.path.join(cwd, "image.depth.exr"))[..., 0]
+    depth = pt.read_pixels(os.path.join(cwd, "image.depth.exr"))[..., 0]
     assert depth.shape == (H, W), "the depth map is %s, the image %dx%d" % (depth.shape, W, H)
     inside = np.zeros((H, W), bool)
     inside[first:last + 1, first:last + 1] = True
@@ -175,19 +165,16 @@ def test_partial_render_computes_and_holds_only_its_region():
     assert outside_wrong == 0, "%d pixels outside the region do not read -1" % outside_wrong
 
     # The reference: the same camera, a 20x20 image, rendered whole.
-    ref = scene_dir("partial_reference", "0.001", 1)
-    res = subprocess.run(command(20, 20, ["+WT1"]), cwd=ref, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+    ref = scene_dir(args, "partial_reference", "0.001", 1)
+    res = subprocess.run(command(args.povray, 20, 20, ["+WT1"]), cwd=ref, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                          stdin=subprocess.DEVNULL, timeout=300)
     assert res.returncode == 0, res.stdout.decode(errors="replace")[-2000:]
-    want = read_float_image(os.path.join(ref, "image.depth.exr"))[..., 0]
+    want = pt.read_pixels(os.path.join(ref, "image.depth.exr"))[..., 0]
     got = depth[first:last + 1, first:last + 1]
     assert np.isfinite(want).sum() > 100, "the reference region sees too little of the scene"
     assert np.array_equal(got, want), "region depth differs from the 20x20 render in %d pixels (max %g)" % (
         int(np.count_nonzero(got != want)), float(np.nanmax(np.abs(np.where(got == want, 0, got - want)))))
-    image = read_float_image(os.path.join(cwd, "image.png"))[first:last + 1, first:last + 1]
-    want_image = read_float_image(os.path.join(ref, "image.png"))
+    image = pt.read_pixels(os.path.join(cwd, "image.png"))[first:last + 1, first:last + 1]
+    want_image = pt.read_pixels(os.path.join(ref, "image.png"))
     assert np.array_equal(image, want_image), "region pixels differ from the 20x20 render"
 
-
-if __name__ == "__main__":
-    raise SystemExit(pytest.main([__file__, "-v", "-s"]))
