@@ -20,11 +20,13 @@ bool local_to_px(const Model& m, int W, int H, Vec2 local, Vec2* px)
     const Vec3 c = to_optics(m, Vec3{local.x, local.y, 0});
     double x = c.x, y = c.y;
     if (m.main_lens != MainLensType::None) {
-        if (!(c.z < 0))
+        // The central projection from the exit pupil's centre e onto the sensor plane.
+        const Vec3 e = m.lens->exit_pupil_centre();
+        if (!(c.z < e.z))
             return false;
-        const double s = m.sensor_z_mm / c.z;
-        x *= s;
-        y *= s;
+        const double s = (m.sensor_z_mm - e.z) / (c.z - e.z);
+        x = e.x + (c.x - e.x) * s;
+        y = e.y + (c.y - e.y) * s;
     }
     sensor_to_pixel(m, W, H, x, y, &px->x, &px->y);
     return is_finite(*px);

@@ -93,6 +93,7 @@ Model make_model(const CameraParams& params)
 
     const MainLensParams& main = params.main;
     m.main_lens = main.given ? main.type : MainLensType::None;
+    m.lens = make_main_lens(main);
     m.focal_length_mm = 0;
     m.aperture_mm = 0;
     m.f_number = 0;

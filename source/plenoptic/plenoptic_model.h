@@ -4,9 +4,11 @@
 #ifndef PLENOPTIC_MODEL_H
 #define PLENOPTIC_MODEL_H
 
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "plenoptic_main_lens.h"
 #include "plenoptic_params.h"
 #include "plenoptic_vec.h"
 
@@ -35,6 +37,7 @@ struct Model {
     double mm_per_unit;
 
     MainLensType main_lens;
+    std::shared_ptr<const MainLens> lens;  // the main lens's optics; nullptr without one
     double focal_length_mm;      // F; 0 unless thin lens
     double aperture_mm;          // A (diameter); 0 unless thin lens
     double f_number;             // F / A; 0 unless thin lens

@@ -20,10 +20,7 @@ using detail::to_local;
 using detail::to_optics;
 
 // Homogeneous point (x, y, z, w): the point (x/w, y/w, z/w), or the direction (x, y, z) if w = 0.
-struct Homogeneous {
-    Vec3 xyz;
-    double w;
-};
+typedef HomogeneousPoint Homogeneous;
 
 // Candidate lenses are enumerated in a box of array-local coordinates.
 struct Box {
@@ -168,6 +165,7 @@ double distance_to_origin(const Vec2* corner, int count)
 // point onto the main-lens plane, must meet the aperture disc.
 bool lens_sees(const Model& m, Homogeneous image, LensIndex lens)
 {
+    const Vec3 pupil = m.lens->exit_pupil_centre();
     const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
     Vec2 local[6];
     int count = 1;
@@ -179,16 +177,16 @@ bool lens_sees(const Model& m, Homogeneous image, LensIndex lens)
     for (int i = 0; i < count; ++i) {
         const Vec3 corner = to_optics(m, Vec3{c.x + local[i].x, c.y + local[i].y, 0});
         Homogeneous hit;
-        if (!line_meets_plane(image, corner, Vec3{0, 0, 1}, Vec3{0, 0, 0}, &hit))
+        if (!line_meets_plane(image, corner, Vec3{0, 0, 1}, pupil, &hit))
             return m.microlens == MicrolensType::ThinLens;  // projection unbounded: keep (conservative)
         const double sign = hit.w > 0 ? 1 : -1;
         if (i == 0)
             first_sign = sign;
         else if (sign != first_sign)
             return true;  // the cell straddles the vanishing line: unbounded, keep
-        projected[i] = Vec2{hit.xyz.x / hit.w, hit.xyz.y / hit.w};
+        projected[i] = Vec2{hit.xyz.x / hit.w - pupil.x, hit.xyz.y / hit.w - pupil.y};
     }
-    const double radius = 0.5 * m.aperture_mm;
+    const double radius = m.lens->exit_pupil_radius();
     if (count == 1)
         return dot(projected[0], projected[0]) <= radius * radius;
     return distance_to_origin(projected, count) <= radius;
@@ -201,12 +199,13 @@ const int kFootprintSides = 96;
 
 bool cone_footprint(const Model& m, Homogeneous image, Vec2 footprint[kFootprintSides])
 {
-    const double r = 0.5 * m.aperture_mm;
+    const Vec3 pupil = m.lens->exit_pupil_centre();
+    const double r = m.lens->exit_pupil_radius();
     double first_sign = 0;
     for (int i = 0; i < kFootprintSides; ++i) {
         const double angle = 2 * 3.14159265358979323846 * i / kFootprintSides;
         Homogeneous hit;
-        if (!line_meets_plane(image, Vec3{r * std::cos(angle), r * std::sin(angle), 0}, m.pose.normal,
+        if (!line_meets_plane(image, pupil + Vec3{r * std::cos(angle), r * std::sin(angle), 0}, m.pose.normal,
                               m.pose.centre_mm, &hit))
             return false;
         const double sign = hit.w > 0 ? 1 : -1;
@@ -485,20 +484,21 @@ bool cell_spot_may_reach_picture(const Model& m, LensIndex lens, Homogeneous ima
 
 void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::vector<PixelHit>* hits)
 {
-    const Homogeneous image{point, 1 - point.z / m.focal_length_mm};
+    const Homogeneous image = m.lens->paraxial_image(point);
+    const Vec3 pupil = m.lens->exit_pupil_centre();
     const Vec3 n = m.pose.normal;
     const Vec3 centre = m.pose.centre_mm;
 
     // Footprint of the cone (main aperture -> image) on the array: project the aperture's
     // bounding square from the image point; bounded when all four corners project to one side.
     Box footprint{false, 0, 0, 0, 0};
-    const double r = 0.5 * m.aperture_mm;
+    const double r = m.lens->exit_pupil_radius();
     const double square[4][2] = {{-r, -r}, {r, -r}, {r, r}, {-r, r}};
     double first_sign = 0;
     bool bounded = true;
     for (int i = 0; i < 4 && bounded; ++i) {
         Homogeneous hit;
-        if (!line_meets_plane(image, Vec3{square[i][0], square[i][1], 0}, n, centre, &hit)) {
+        if (!line_meets_plane(image, pupil + Vec3{square[i][0], square[i][1], 0}, n, centre, &hit)) {
             bounded = false;
             break;
         }
@@ -538,14 +538,14 @@ void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::ve
             if (length(h - lens_centre_mm(m, lens)) > 1e-9 * m.pitch_mm)
                 return;  // a pinhole passes light only at its centre
             Vec3 hit;
-            if (sensor_hit_through_lens(m, lens, h, h, &hit))
+            if (sensor_hit_through_lens(m, lens, h, h - pupil, &hit))
                 add_point_hit(m, W, H, lens, hit, 1.0, hits);
             return;
         }
         std::vector<Vec2> spot;
         for (int i = 0; i < kFootprintSides; ++i) {
             const double angle = 2 * 3.14159265358979323846 * i / kFootprintSides;
-            const Vec3 on_aperture{r * std::cos(angle), r * std::sin(angle), 0};
+            const Vec3 on_aperture = pupil + Vec3{r * std::cos(angle), r * std::sin(angle), 0};
             Vec3 hit;
             if (!sensor_hit_through_lens(m, lens, h, h - on_aperture, &hit))
                 return;

@@ -22,11 +22,13 @@ bool project_to_array(const Model& m, Vec3 p, Vec2* local)
             return false;
         q = Vec3{p.x, p.y, p.z + dot(n, m.pose.centre_mm - p) / n.z};
     } else {
-        const double along = dot(n, p);
-        const double s = dot(n, m.pose.centre_mm) / along;
+        // The line from the exit pupil's centre e through p: q = e + s (p - e).
+        const Vec3 e = m.lens->exit_pupil_centre();
+        const double along = dot(n, p - e);
+        const double s = dot(n, m.pose.centre_mm - e) / along;
         if (!(s > 0) || !std::isfinite(s))
             return false;
-        q = s * p;
+        q = e + s * (p - e);
     }
     const Vec3 l = to_local(m, q);
     *local = Vec2{l.x, l.y};
@@ -42,32 +44,22 @@ using detail::project_to_array;
 using detail::to_local;
 using detail::to_optics;
 
-// Whether (x, y) lies in the disc of this radius about the origin: squares where they cannot
-// overflow (cheaper than hypot: this runs for every ray), hypot for absurdly large apertures.
-bool inside_disc(double x, double y, double radius)
+// The ray into the scene as the renderer takes it; false when it does not pass (blocked, not
+// finite, or bent back towards the camera body: see scene_ray).
+bool emit(const SceneRay& ray, OpticsRay* out)
 {
-    if (radius < 1e150)
-        return x * x + y * y <= radius * radius;  // an overflowing x * x is +inf: outside, as it should be
-    return std::hypot(x, y) <= radius;
-}
-
-bool finish(Vec3 origin, Vec3 direction, OpticsRay* out)
-{
-    const Vec3 unit = normalized(direction);
-    if (!is_finite(origin) || !is_finite(unit))
+    if (!ray.passed)
         return false;
-    // A lens of high power, or a steeply tilted one, can bend a ray back towards the camera:
-    // it would meet the camera body, not the scene.
-    if (!(unit.z > 0))
-        return false;
-    out->origin_mm[0] = origin.x;
-    out->origin_mm[1] = origin.y;
-    out->origin_mm[2] = origin.z;
-    out->dir[0] = unit.x;
-    out->dir[1] = unit.y;
-    out->dir[2] = unit.z;
+    out->origin_mm[0] = ray.origin.x;
+    out->origin_mm[1] = ray.origin.y;
+    out->origin_mm[2] = ray.origin.z;
+    out->dir[0] = ray.dir.x;
+    out->dir[1] = ray.dir.y;
+    out->dir[2] = ray.dir.z;
     return true;
 }
+
+bool finish(Vec3 origin, Vec3 direction, OpticsRay* out) { return emit(scene_ray(origin, direction), out); }
 
 // Ray from sensor point p through the microlens `lens` to the pinhole main lens at the origin.
 // The microlens images the pinhole O to the homogeneous point I = (o, 1 - o_z/f) (lens-relative
@@ -103,17 +95,11 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
                         bool check_apertures, OpticsRay* out)
 {
     if (m.grid == GridType::None) {
+        // The sensor point towards a point of the exit pupil, through the lens.
+        const Vec3 on_pupil = m.lens->exit_pupil_point(lens_u, lens_v);
         if (m.main_lens == MainLensType::Pinhole)
-            return finish(Vec3{0, 0, 0}, -p, out);
-        // Thin main lens: a point on the aperture disc; the ray p -> m with unit z component
-        // is refracted by w' = w - m / F.
-        const Vec2 disc = concentric_disc(lens_u, lens_v);
-        const double radius = 0.5 * m.aperture_mm;
-        const Vec3 on_lens{radius * disc.x, radius * disc.y, 0};
-        const double rise = -p.z;  // = D
-        const double wx = (on_lens.x - p.x) / rise - on_lens.x / m.focal_length_mm;
-        const double wy = (on_lens.y - p.y) / rise - on_lens.y / m.focal_length_mm;
-        return finish(on_lens, Vec3{wx, wy, 1}, out);
+            return finish(on_pupil, on_pupil - p, out);
+        return emit(m.lens->to_scene(p, on_pupil - p, false), out);
     }
 
     LensIndex lens;
@@ -155,18 +141,8 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
     if (m.main_lens == MainLensType::Pinhole)
         return false;  // pinhole + pinhole: refused at parse time, no ray passes both points
 
-    // On to the main-lens plane z = 0, then w' = w - m / F.
-    if (!(direction.z > 0) || !(leave.z < 0))
-        return false;
-    const double travel = -leave.z / direction.z;
-    const double mx = leave.x + travel * direction.x;
-    const double my = leave.y + travel * direction.y;
-    const double radius = 0.5 * m.aperture_mm;
-    if (check_apertures && !inside_disc(mx, my, radius))
-        return false;  // misses the main-lens aperture: carries no light
-    const double wx = direction.x / direction.z - mx / m.focal_length_mm;
-    const double wy = direction.y / direction.z - my / m.focal_length_mm;
-    return finish(Vec3{mx, my, 0}, Vec3{wx, wy, 1}, out);
+    // On through the main lens (a ray that misses its apertures carries no light).
+    return emit(m.lens->to_scene(leave, direction, check_apertures), out);
 }
 
 // Whether light through `lens` can reach some point of the pixel centred at p. With k = D/d
@@ -178,20 +154,23 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
 // a margin that grows with the tilt (validated against brute force in the unit tests).
 bool lens_reaches_pixel(const Model& m, LensIndex lens, Vec3 p)
 {
+    if (!m.lens)
+        return true;
     const Vec3 c = lens_centre_mm(m, lens);
-    const double main_distance = -c.z;
+    const Vec3 e = m.lens->exit_pupil_centre();
+    const double main_distance = e.z - c.z;
     const double array_distance = c.z - m.sensor_z_mm;
     if (!(main_distance > 0) || !(array_distance > 0))
         return true;
     const double k = main_distance / array_distance;
-    const double mx = c.x * (1 + k) - p.x * k;
-    const double my = c.y * (1 + k) - p.y * k;
+    const double mx = (c.x - e.x) * (1 + k) - (p.x - e.x) * k;
+    const double my = (c.y - e.y) * (1 + k) - (p.y - e.y) * k;
     double spread = 0.5 * std::hypot(m.pixel_size_mm[0], m.pixel_size_mm[1]) * k;
     if (m.microlens == MicrolensType::ThinLens)
         spread += m.cell_circumradius_mm * std::fabs(1 + k - main_distance / microlens_focal(m, lens));
     if (m.pose.tilted)
         spread *= 1.25 + 4 * m.pose.tilt_sine;
-    return std::hypot(mx, my) <= (0.5 * m.aperture_mm + spread) * (1 + 1e-9);
+    return std::hypot(mx, my) <= (m.lens->exit_pupil_radius() + spread) * (1 + 1e-9);
 }
 
 } // namespace
@@ -281,8 +260,9 @@ OpticsRay chief_ray(const Model& m, int W, int H, int i, int j)
     if (chief_ray_through(m, W, H, i + 0.5, j + 0.5, nullptr, &ray))
         return ray;
     const Vec3 p = sensor_point(m, W, H, i + 0.5, j + 0.5);
-    if (!finish(Vec3{0, 0, 0}, -p, &ray))
-        finish(Vec3{0, 0, 0}, Vec3{0, 0, 1}, &ray);
+    const Vec3 e = m.lens ? m.lens->exit_pupil_centre() : Vec3{0, 0, 0};
+    if (!finish(e, e - p, &ray))
+        finish(e, Vec3{0, 0, 1}, &ray);
     return ray;
 }
 
