@@ -99,6 +99,21 @@ void include(Box* box, Vec2 p)
     box->y1 = std::max(box->y1, p.y);
 }
 
+// The smallest box holding the points (not valid when there are none).
+Box bounding_box(const std::vector<Vec2>& points)
+{
+    Box box{false, 0, 0, 0, 0};
+    for (const Vec2& q : points)
+        include(&box, q);
+    return box;
+}
+
+// Whether two valid boxes share a point (touching counts).
+bool overlap(Box a, Box b)
+{
+    return !(a.x1 < b.x0 || a.x0 > b.x1 || a.y1 < b.y0 || a.y0 > b.y1);
+}
+
 // The part of the array plane whose lenses can image into the picture: the image corners
 // projected onto the array, grown by two pitches. Invalid if a corner does not project.
 Box sensor_box(const Model& m, int W, int H)
@@ -344,13 +359,8 @@ double delivered_area(const Model& m, int W, int H, LensIndex lens, const std::v
     const std::vector<Vec2> inside = clip_polygon(light, picture_polygon(m, W, H));
     if (inside.size() < 3)
         return 0;
-    double x0 = inside[0].x, x1 = x0, y0 = inside[0].y, y1 = y0;
-    for (const Vec2& q : inside) {
-        x0 = std::min(x0, q.x);
-        x1 = std::max(x1, q.x);
-        y0 = std::min(y0, q.y);
-        y1 = std::max(y1, q.y);
-    }
+    const Box lit = bounding_box(inside);
+    const double x0 = lit.x0, x1 = lit.x1, y0 = lit.y0, y1 = lit.y1;
     const int rings = receiving_rings(m);
     if (!m.pose.tilted && m.main_lens != MainLensType::None) {
         // Fast path: the cells within `rings` rings cover the disc of radius rings * row spacing
@@ -389,14 +399,7 @@ double delivered_area(const Model& m, int W, int H, LensIndex lens, const std::v
             const std::vector<Vec2> cell = microimage_cell(m, other);
             if (cell.empty())
                 continue;
-            double cx0 = cell[0].x, cx1 = cx0, cy0 = cell[0].y, cy1 = cy0;
-            for (const Vec2& q : cell) {
-                cx0 = std::min(cx0, q.x);
-                cx1 = std::max(cx1, q.x);
-                cy0 = std::min(cy0, q.y);
-                cy1 = std::max(cy1, q.y);
-            }
-            if (cx1 < x0 || cx0 > x1 || cy1 < y0 || cy0 > y1)
+            if (!overlap(bounding_box(cell), lit))
                 continue;
             Vec2 c;
             const double a = area_centroid(clip_polygon(inside, cell), &c);
@@ -453,13 +456,7 @@ void add_spot_hit(const Model& m, int W, int H, LensIndex lens, const std::vecto
 }
 
 // The picture on the sensor plane (x, y, mm), as a box.
-Box picture_box(const Model& m, int W, int H)
-{
-    Box box{false, 0, 0, 0, 0};
-    for (const Vec2& q : picture_polygon(m, W, H))
-        include(&box, q);
-    return box;
-}
+Box picture_box(const Model& m, int W, int H) { return bounding_box(picture_polygon(m, W, H)); }
 
 // Whether light through `lens` from a part of its cell (array-local corners) towards the sensor,
 // along lines from the image point, can land in the picture: false only when the bounding box of
@@ -478,8 +475,7 @@ bool cell_spot_may_reach_picture(const Model& m, LensIndex lens, Homogeneous ima
             return true;
         include(&spot, Vec2{hit.x, hit.y});
     }
-    return !spot.valid || !picture.valid ||
-           !(spot.x1 < picture.x0 || spot.x0 > picture.x1 || spot.y1 < picture.y0 || spot.y0 > picture.y1);
+    return !spot.valid || !picture.valid || overlap(spot, picture);
 }
 
 void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::vector<PixelHit>* hits)
