@@ -84,7 +84,7 @@ class ThickMainLens : public MainLens {
 public:
     ThickMainLens(double efl, double front_h, double rear_h, double pupil_z, double pupil_radius)
         : focal_(efl), front_h_(front_h), rear_h_(rear_h), pupil_z_(pupil_z), radius_(pupil_radius) {}
-    MainLensType type() const override { return MainLensType::ThinLens; }
+    MainLensType type() const override { return MainLensType::ThickLens; }
     Vec3 exit_pupil_centre() const override { return Vec3{0, 0, pupil_z_}; }
     double exit_pupil_radius() const override { return radius_; }
     Vec3 exit_pupil_point(double u, double v) const override
@@ -129,7 +129,7 @@ class ExactMainLens : public MainLens {
 public:
     ExactMainLens(const Prescription& lens, double length, const ThickMainLens& paraxial)
         : lens_(lens), length_(length), paraxial_(paraxial) {}
-    MainLensType type() const override { return MainLensType::ThinLens; }
+    MainLensType type() const override { return MainLensType::Prescription; }
     Vec3 exit_pupil_centre() const override { return paraxial_.exit_pupil_centre(); }
     double exit_pupil_radius() const override { return paraxial_.exit_pupil_radius(); }
     Vec3 exit_pupil_point(double u, double v) const override { return paraxial_.exit_pupil_point(u, v); }
@@ -195,6 +195,9 @@ std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& p)
         const double aperture = p.has_aperture ? p.aperture_mm : p.focal_length_mm / p.f_number;
         return std::make_shared<ThinMainLens>(p.focal_length_mm, aperture);
     }
+    case MainLensType::ThickLens:
+    case MainLensType::Prescription:
+        return make_prescription_lens(effective_prescription(p), 0, p.type == MainLensType::Prescription);
     case MainLensType::None:
         break;
     }

@@ -86,20 +86,71 @@ const char* main_lens_name(MainLensType type)
     switch (type) {
     case MainLensType::ThinLens: return "thin_lens";
     case MainLensType::Pinhole: return "pinhole";
+    case MainLensType::ThickLens: return "thick_lens";
+    case MainLensType::Prescription: return "prescription";
     default: return "none";
     }
 }
 
+// The surfaces as the render used them (the stop at its working diameter), object side first.
+Json prescription_json(const Model& m)
+{
+    Json surfaces = Json::array();
+    for (const LensSurface& s : m.prescription.surfaces) {
+        Json row = Json::object();
+        row["stop"] = s.stop;
+        row["radius_mm"] = number(s.radius_mm);
+        row["thickness_mm"] = number(s.thickness_mm);
+        row["ior"] = number(s.ior);
+        row["aperture_mm"] = number(s.aperture_mm);
+        surfaces.push_back(row);
+    }
+    Json json = Json::object();
+    json["lens_file"] = m.lens_file.empty() ? Json(nullptr) : Json(m.lens_file);
+    json["blades"] = m.prescription.blades;
+    json["blade_rotation_deg"] = number(m.prescription.blade_rotation_deg);
+    json["surfaces"] = surfaces;
+    return json;
+}
+
+// First-order data in the optics frame (z from the rear vertex towards the scene, mm).
+Json paraxial_json(const Model& m)
+{
+    const ParaxialData& p = m.paraxial;
+    const double length = m.lens_length_mm;
+    const double exit_pupil_z = length - p.exit_pupil_z;
+    Json json = Json::object();
+    json["effective_focal_length_mm"] = number(p.efl_mm);
+    json["back_focal_distance_mm"] = number(p.bfd_mm);
+    json["front_focal_distance_mm"] = number(p.ffd_mm);
+    json["length_mm"] = number(length);
+    json["front_vertex_z_mm"] = number(length);
+    json["front_principal_plane_z_mm"] = number(length - p.front_principal_z);
+    json["rear_principal_plane_z_mm"] = number(length - p.rear_principal_z);
+    json["entrance_pupil_z_mm"] = number(length - p.entrance_pupil_z);
+    json["entrance_pupil_diameter_mm"] = number(p.entrance_pupil_mm);
+    json["exit_pupil_z_mm"] = number(exit_pupil_z);
+    json["exit_pupil_diameter_mm"] = number(p.exit_pupil_mm);
+    json["f_number"] = number(p.f_number);
+    // Image side, as f-number matching needs it: exit pupil to the array (or sensor) over its diameter.
+    json["working_f_number"] = number((exit_pupil_z + m.distance_mm) / p.exit_pupil_mm);
+    return json;
+}
+
 Json main_lens(const Model& m)
 {
-    const bool thin = m.main_lens == MainLensType::ThinLens;
+    const bool has_focal = m.main_lens == MainLensType::ThinLens || is_prescription_type(m.main_lens);
     Json json = Json::object();
     json["type"] = main_lens_name(m.main_lens);
-    json["focal_length_mm"] = number_or_null(thin, m.focal_length_mm);
-    json["aperture_mm"] = number_or_null(thin, m.aperture_mm);
-    json["f_number"] = number_or_null(thin, m.f_number);
+    json["focal_length_mm"] = number_or_null(has_focal, m.focal_length_mm);
+    json["aperture_mm"] = number_or_null(has_focal, m.aperture_mm);
+    json["f_number"] = number_or_null(has_focal, m.f_number);
     json["distance_mm"] = number_or_null(m.main_lens != MainLensType::None, m.distance_mm);
     json["focus_distance"] = number_or_null(m.has_focus_distance, m.focus_distance_units);
+    if (is_prescription_type(m.main_lens)) {
+        json["prescription"] = prescription_json(m);
+        json["paraxial"] = paraxial_json(m);
+    }
     return json;
 }
 
@@ -134,10 +185,11 @@ Json lattice_json(const Model& m, const MicroimageLattice& lattice)
     const int types = m.microlens == MicrolensType::ThinLens ? m.lens_type_count : 1;
     json["lens_types"] = types;
     json["lens_type_rule"] = types == 3 ? "type(k, l) = (k - l) mod 3, focal_lengths_mm[type]" : "type(k, l) = 0";
-    // Diameter of the main aperture's image behind a lens centre (the f-number-matched disc).
+    // Diameter of the main lens's exit pupil imaged through a lens centre (the f-number-matched disc).
+    const bool has_pupil = m.lens && m.main_lens != MainLensType::Pinhole;
+    const double pupil_mm = m.main_lens == MainLensType::ThinLens ? m.aperture_mm : has_pupil ? 2 * m.lens->exit_pupil_radius() : 0;
     json["microimage_diameter_px"] =
-        number_or_null(m.main_lens == MainLensType::ThinLens,
-                       m.aperture_mm * effective_array_distance_mm(m) / effective_main_distance_mm(m) / m.pixel_size_mm[0]);
+        number_or_null(has_pupil, pupil_mm * effective_array_distance_mm(m) / effective_main_distance_mm(m) / m.pixel_size_mm[0]);
     return json;
 }
 

@@ -48,8 +48,10 @@ OverlapGeometry overlap_geometry(const Model& m)
     const double main_distance = effective_main_distance_mm(m);
     const double array_distance = effective_array_distance_mm(m);
     g.magnification = array_distance / main_distance;
-    if (m.main_lens == MainLensType::ThinLens)
-        g.disc_mm = 0.5 * m.aperture_mm * g.magnification;
+    if (m.pupil_bounds)
+        g.disc_mm = m.pupil_bounds->reach_mm() * g.magnification;
+    else if (m.lens)
+        g.disc_mm = m.lens->exit_pupil_radius() * g.magnification;
     if (m.microlens == MicrolensType::ThinLens) {
         double worst = 0;
         for (int t = 0; t < m.lens_type_count; ++t)
@@ -78,7 +80,7 @@ Mat3 rotation_from_degrees(const double degrees[3])
 
 double effective_main_distance_mm(const Model& model)
 {
-    return model.main_lens == MainLensType::None ? 0.0 : -model.pose.centre_mm.z;
+    return model.lens ? model.lens->exit_pupil_centre().z - model.pose.centre_mm.z : 0.0;
 }
 
 double effective_array_distance_mm(const Model& model)
@@ -100,22 +102,25 @@ Model make_model(const CameraParams& params)
     m.distance_mm = 0;
     m.has_focus_distance = false;
     m.focus_distance_units = 0;
+    m.lens_length_mm = 0;
     if (m.main_lens == MainLensType::ThinLens) {
         m.focal_length_mm = main.focal_length_mm;
         m.aperture_mm = main.has_aperture ? main.aperture_mm : main.focal_length_mm / main.f_number;
         m.f_number = main.has_f_number ? main.f_number : main.focal_length_mm / main.aperture_mm;
     }
+    if (is_prescription_type(m.main_lens)) {
+        m.prescription = effective_prescription(main);
+        m.paraxial = paraxial_data(m.prescription);
+        m.lens_file = main.lens_file;
+        m.lens_length_mm = m.paraxial.rear_vertex_z;
+        m.focal_length_mm = m.paraxial.efl_mm;
+        m.aperture_mm = m.paraxial.stop_mm;
+        m.f_number = m.paraxial.f_number;
+    }
     if (m.main_lens != MainLensType::None) {
-        if (main.has_focus_distance && m.main_lens == MainLensType::ThinLens) {
-            // 1/F = 1/z + 1/D, written so that a huge z gives D -> F without overflow;
-            // check_main_lens guarantees z > F.
-            const double z_mm = main.focus_distance_units * params.mm_per_unit;
-            m.distance_mm = m.focal_length_mm / (1.0 - m.focal_length_mm / z_mm);
-            m.has_focus_distance = true;
-            m.focus_distance_units = main.focus_distance_units;
-        } else {
-            m.distance_mm = main.distance_mm;
-        }
+        m.distance_mm = main_lens_distance_mm(main, params.mm_per_unit);
+        m.has_focus_distance = main.has_focus_distance && m.main_lens != MainLensType::Pinhole;
+        m.focus_distance_units = m.has_focus_distance ? main.focus_distance_units : 0;
     }
 
     const ArrayParams& array = params.array;
@@ -153,6 +158,14 @@ Model make_model(const CameraParams& params)
         m.sensor_z_mm = -m.distance_mm;
     else
         m.sensor_z_mm = array_z - m.array_distance_mm;
+
+    if (m.main_lens == MainLensType::Prescription) {
+        // The round stop holds the iris: bounds from the lens without blades hold the lens with them.
+        Prescription round = m.prescription;
+        round.blades = 0;
+        const std::shared_ptr<const MainLens> traced = make_prescription_lens(round, 0, true);
+        m.pupil_bounds = std::make_shared<PupilBounds>(round, *traced, m.grid == GridType::None ? m.sensor_z_mm : m.pose.centre_mm.z);
+    }
 
     for (int a = 0; a < 2; ++a) {
         m.pixel_size_mm[a] = params.sensor.pixel_size_mm[a];

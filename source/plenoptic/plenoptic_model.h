@@ -10,6 +10,7 @@
 
 #include "plenoptic_main_lens.h"
 #include "plenoptic_params.h"
+#include "plenoptic_pupil_bounds.h"
 #include "plenoptic_vec.h"
 
 namespace plenoptic {
@@ -31,17 +32,27 @@ struct ArrayPose {
 // Above this tilt (sine of the angle, about 11.5 degrees) a pixel's overlap lenses are not pruned.
 const double kMaxPrunedTiltSine = 0.2;
 
-// Optics frame: origin at the main-lens centre (the array centre when there is no main lens),
-// +z towards the scene, +x right, +y up; millimetres throughout.
+// Optics frame: origin at the main-lens centre (a real lens's rear vertex; the array centre when
+// there is no main lens), +z towards the scene, +x right, +y up; millimetres throughout.
 struct Model {
     double mm_per_unit;
 
     MainLensType main_lens;
     std::shared_ptr<const MainLens> lens;  // the main lens's optics; nullptr without one
-    double focal_length_mm;      // F; 0 unless thin lens
-    double aperture_mm;          // A (diameter); 0 unless thin lens
-    double f_number;             // F / A; 0 unless thin lens
-    double distance_mm;          // D; 0 without main lens
+    double focal_length_mm;      // F (a real lens's effective focal length); 0 for pinhole and none
+    double aperture_mm;          // A (diameter; a real lens's stop); 0 for pinhole and none
+    double f_number;             // F / A (a real lens's: F / entrance-pupil diameter); 0 for pinhole and none
+    double distance_mm;          // D (from a real lens's rear vertex); 0 without main lens
+    // A real lens (thick_lens or prescription): its surfaces as used (stop sized, iris applied),
+    // their paraxial data, the file they came from ("" when inline), and its length from the
+    // front vertex (where the scene's location puts it) to the rear vertex (the frame's origin).
+    Prescription prescription;
+    ParaxialData paraxial;
+    std::string lens_file;
+    double lens_length_mm;
+    // Where light passes a traced real lens, for points of the sensor (no array) or of the array
+    // plane: what ray generation samples, and what the overlap bound reaches. nullptr otherwise.
+    std::shared_ptr<const PupilBounds> pupil_bounds;
     bool has_focus_distance;     // D came from focus_distance
     double focus_distance_units; // as given; 0 when D was given directly
 
@@ -84,7 +95,9 @@ std::vector<std::string> warnings(const Model& model);
 Mat3 rotation_from_degrees(const double degrees[3]);
 
 // Main-lens -> array and array -> sensor distances measured at the array centre, including the
-// array's z translation. Without a main lens the first is 0.
+// array's z translation. The first is measured from the main lens's exit-pupil centre, from which
+// microimage centres are projected (the lens's plane for a thin lens, the pinhole); without a main
+// lens it is 0.
 double effective_main_distance_mm(const Model& model);
 double effective_array_distance_mm(const Model& model);
 

@@ -119,6 +119,14 @@ std::string check_confidence(double value)
     return "confidence must be between 0 and 1 (0 < confidence < 1), got " + format_number(value);
 }
 
+std::string check_blades(double value)
+{
+    if (std::isfinite(value) && is_whole(value) && value >= 3 && value <= kMaxBlades)
+        return "";
+    return "blades must be a whole number of iris blades from 3 to " + std::to_string(kMaxBlades) + ", got " +
+           format_number(value);
+}
+
 std::string check_variance(double value)
 {
     std::string finite = check_finite("variance", value);
@@ -129,49 +137,17 @@ std::string check_variance(double value)
     return "variance must be positive (> 0), got " + format_number(value);
 }
 
-std::string check_main_lens(const MainLensParams& main, double mm_per_unit)
+namespace {
+
+// The thin lens: focal_length, f_number or aperture, focus_distance or distance.
+std::string check_thin_lens(const MainLensParams& main, double mm_per_unit)
 {
-    if (!main.given)
-        return "";
-    if (main.type == MainLensType::None)
-        return "main_lens needs thin_lens or pinhole";
-
-    // Values again: a backstop for a caller that filled the struct without the token checks.
-    std::string message;
-    if (main.has_focal_length && !(message = check_positive_length("focal_length", main.focal_length_mm)).empty())
-        return message;
-    if (main.has_f_number && !(message = check_f_number(main.f_number)).empty())
-        return message;
-    if (main.has_aperture && !(message = check_positive_length("aperture", main.aperture_mm)).empty())
-        return message;
-    if (main.has_focus_distance && !(message = check_focus_distance(main.focus_distance_units)).empty())
-        return message;
-    if (main.has_distance && !(message = check_positive_length("distance", main.distance_mm)).empty())
-        return message;
-
-    if (main.has_focus_distance && main.has_distance)
-        return "main_lens: give focus_distance or distance, not both";
-
-    if (main.type == MainLensType::Pinhole) {
-        // A pinhole has no focal length, so neither can it focus nor have an f-number.
-        if (main.has_focal_length)
-            return "main_lens pinhole takes no focal_length (a pinhole has no focal length); "
-                   "give distance (D in mm) only";
-        if (main.has_f_number)
-            return "main_lens pinhole takes no f_number (a pinhole has no aperture to size); "
-                   "give distance (D in mm) only";
-        if (main.has_aperture)
-            return "main_lens pinhole takes no aperture (a pinhole has no aperture to size); "
-                   "give distance (D in mm) only";
-        if (main.has_focus_distance)
-            return "main_lens pinhole takes distance (D in mm), not focus_distance: "
-                   "a pinhole has no focal length to focus with";
-        if (!main.has_distance)
-            return "main_lens pinhole needs distance (D: main lens to microlens array, "
-                   "or to the sensor when there is no array, in mm)";
-        return "";
-    }
-
+    if (main.has_prescription)
+        return "main_lens thin_lens takes focal_length, not " + std::string(main.lens_file.empty() ? "a prescription" : "a lens_file") +
+               ": leave thin_lens out to trace the real lens surface by surface, or write thick_lens for its "
+               "paraxial equivalent";
+    if (main.blades != 0)
+        return "main_lens blades needs a real lens (lens_file or prescription { }); a thin_lens aperture is round";
     if (!main.has_focal_length)
         return "main_lens thin_lens needs focal_length (F in mm)";
     if (main.has_f_number && main.has_aperture)
@@ -198,14 +174,154 @@ std::string check_main_lens(const MainLensParams& main, double mm_per_unit)
                    ") is at or inside the focal length " + format_number(main.focal_length_mm) +
                    " mm; it must be greater than " + format_number(main.focal_length_mm / mm_per_unit) +
                    " scene units";
-        const double f = main.focal_length_mm;
-        const double D = f / (1.0 - f / z_mm);
+        const double D = main_lens_distance_mm(main, mm_per_unit);
         if (!(D >= kMinLengthMm && D <= kMaxLengthMm))
             return "main_lens: focus_distance " + format_number(main.focus_distance_units) + " puts the image "
                    "at D = F z / (z - F) = " + format_number(D) + " mm, outside " + format_number(kMinLengthMm) +
                    " to " + format_number(kMaxLengthMm) + " mm; focus farther from the focal length";
     }
     return "";
+}
+
+// A real lens (traced, or its thick lens): the prescription, its stop, its focus.
+std::string check_real_lens(const MainLensParams& main, double mm_per_unit)
+{
+    const char* kind = main.type == MainLensType::ThickLens ? "main_lens thick_lens" : "main_lens";
+    if (!main.has_prescription)
+        return std::string(kind) + " needs the lens: lens_file \"name.dat\" or prescription { surface { ... } stop { ... } ... }";
+    if (main.has_focal_length)
+        return std::string(kind) + " takes no focal_length: a real lens's focal length follows from its surfaces";
+    if (main.has_f_number && main.has_aperture)
+        return "main_lens: give f_number or aperture, not both";
+    if (main.blades != 0 && main.type == MainLensType::ThickLens)
+        return "main_lens thick_lens takes no blades: its paraxial equivalent has a round exit pupil; leave thick_lens "
+               "out to trace the iris";
+    const PrescriptionError error = check_prescription(main.prescription);
+    if (error.any())
+        return "main_lens " + std::string(main.lens_file.empty() ? "prescription" : "lens_file \"" + main.lens_file + "\"") +
+               (error.line > 0 ? " (line " + std::to_string(error.line) + ")" : "") + ": " + error.message;
+    const ParaxialData bare = paraxial_data(main.prescription);
+    if (!bare.valid)
+        return "main_lens: the prescription forms no image (it is afocal, or its stop's image lies at infinity)";
+    if (main.has_f_number) {
+        const double stop = stop_diameter_for_f_number(main.prescription, main.f_number);
+        if (!(stop >= kMinLengthMm && stop <= kMaxLengthMm))
+            return "main_lens: f_number " + format_number(main.f_number) + " needs a stop diameter of " +
+                   format_number(stop) + " mm, outside " + format_number(kMinLengthMm) + " to " +
+                   format_number(kMaxLengthMm) + " mm";
+    }
+    if (!main.has_focus_distance && !main.has_distance)
+        return std::string(kind) + " needs focus_distance (scene units from the front vertex) or distance "
+               "(D in mm from the rear vertex)";
+    if (main.has_focus_distance) {
+        std::string scale = check_mm_per_unit(mm_per_unit);
+        if (!scale.empty())
+            return scale;
+        const double z_mm = main.focus_distance_units * mm_per_unit;
+        const ImageDistance image = paraxial_image_distance(main.prescription, z_mm);
+        if (!image.real || !(image.mm >= kMinLengthMm && image.mm <= kMaxLengthMm))
+            return "main_lens: the lens cannot focus at focus_distance " + format_number(main.focus_distance_units) +
+                   " (" + format_number(z_mm) + " mm in front of its front vertex): the paraxial image lies " +
+                   (image.real ? "at " + format_number(image.mm) + " mm behind the rear vertex, outside " +
+                                     format_number(kMinLengthMm) + " to " + format_number(kMaxLengthMm) + " mm"
+                               : std::string("at infinity or in front of the rear vertex")) +
+                   "; the front focal point is " + format_number(bare.ffd_mm) + " mm in front of the front vertex "
+                   "(focal length " + format_number(bare.efl_mm) + " mm): focus farther than that";
+    }
+    const double D = main_lens_distance_mm(main, mm_per_unit);
+    const double pupil_behind = bare.exit_pupil_z - bare.rear_vertex_z;  // the stop's size does not move it
+    if (!(D > pupil_behind))
+        return "main_lens: the array (or sensor) at D = " + format_number(D) + " mm behind the rear vertex lies in "
+               "front of the lens's exit pupil, " + format_number(pupil_behind) + " mm behind the rear vertex; "
+               "the image side of a lens starts there";
+    return "";
+}
+
+} // namespace
+
+Prescription effective_prescription(const MainLensParams& main)
+{
+    Prescription lens = main.prescription;
+    lens.blades = main.blades;
+    lens.blade_rotation_deg = main.blade_rotation_deg;
+    double stop_mm = 0;
+    if (main.has_aperture)
+        stop_mm = main.aperture_mm;
+    else if (main.has_f_number)
+        stop_mm = stop_diameter_for_f_number(main.prescription, main.f_number);
+    if (stop_mm > 0)
+        for (LensSurface& surface : lens.surfaces)
+            if (surface.stop)
+                surface.aperture_mm = stop_mm;
+    return lens;
+}
+
+double main_lens_distance_mm(const MainLensParams& main, double mm_per_unit)
+{
+    if (!main.has_focus_distance)
+        return main.distance_mm;
+    const double z_mm = main.focus_distance_units * mm_per_unit;
+    if (is_prescription_type(main.type))
+        return paraxial_image_distance(main.prescription, z_mm).mm;
+    // 1/F = 1/z + 1/D, written so that a huge z gives D -> F without overflow.
+    const double f = main.focal_length_mm;
+    return f / (1.0 - f / z_mm);
+}
+
+std::string check_main_lens(const MainLensParams& main, double mm_per_unit)
+{
+    if (!main.given)
+        return "";
+    if (main.type == MainLensType::None)
+        return "main_lens needs thin_lens, pinhole, or a real lens (lens_file \"name.dat\" or prescription { }, "
+               "with thick_lens for its paraxial equivalent)";
+
+    // Values again: a backstop for a caller that filled the struct without the token checks.
+    std::string message;
+    if (main.has_focal_length && !(message = check_positive_length("focal_length", main.focal_length_mm)).empty())
+        return message;
+    if (main.has_f_number && !(message = check_f_number(main.f_number)).empty())
+        return message;
+    if (main.has_aperture && !(message = check_positive_length("aperture", main.aperture_mm)).empty())
+        return message;
+    if (main.has_focus_distance && !(message = check_focus_distance(main.focus_distance_units)).empty())
+        return message;
+    if (main.has_distance && !(message = check_positive_length("distance", main.distance_mm)).empty())
+        return message;
+    if (main.blades != 0 && !(message = check_blades(main.blades)).empty())
+        return message;
+    if (!(message = check_angle("blade_rotation", main.blade_rotation_deg)).empty())
+        return message;
+
+    if (main.has_focus_distance && main.has_distance)
+        return "main_lens: give focus_distance or distance, not both";
+
+    if (main.type == MainLensType::Pinhole) {
+        // A pinhole has no focal length, so neither can it focus nor have an f-number.
+        if (main.has_prescription)
+            return "main_lens pinhole takes no lens_file or prescription; give distance (D in mm) only";
+        if (main.blades != 0)
+            return "main_lens pinhole takes no blades (a pinhole has no iris); give distance (D in mm) only";
+        if (main.has_focal_length)
+            return "main_lens pinhole takes no focal_length (a pinhole has no focal length); "
+                   "give distance (D in mm) only";
+        if (main.has_f_number)
+            return "main_lens pinhole takes no f_number (a pinhole has no aperture to size); "
+                   "give distance (D in mm) only";
+        if (main.has_aperture)
+            return "main_lens pinhole takes no aperture (a pinhole has no aperture to size); "
+                   "give distance (D in mm) only";
+        if (main.has_focus_distance)
+            return "main_lens pinhole takes distance (D in mm), not focus_distance: "
+                   "a pinhole has no focal length to focus with";
+        if (!main.has_distance)
+            return "main_lens pinhole needs distance (D: main lens to microlens array, "
+                   "or to the sensor when there is no array, in mm)";
+        return "";
+    }
+    if (main.type == MainLensType::ThinLens)
+        return check_thin_lens(main, mm_per_unit);
+    return check_real_lens(main, mm_per_unit);
 }
 
 std::string check_array(const ArrayParams& array)
@@ -333,12 +449,7 @@ std::string check_camera(const CameraParams& camera)
     if (!has_main)
         return "";
 
-    double main_distance = camera.main.distance_mm;
-    if (camera.main.type == MainLensType::ThinLens && camera.main.has_focus_distance) {
-        const double z_mm = camera.main.focus_distance_units * camera.mm_per_unit;
-        const double f = camera.main.focal_length_mm;
-        main_distance = f / (1.0 - f / z_mm);
-    }
+    const double main_distance = main_lens_distance_mm(camera.main, camera.mm_per_unit);
     // The sensor must stay a separate plane from the array in double precision.
     if (!((main_distance + d_eff) - main_distance > 0.5 * d_eff))
         return "microlens_array distance d = " + format_number(d_eff) + " mm is too small beside D = " +
@@ -347,6 +458,14 @@ std::string check_camera(const CameraParams& camera)
     if (!(main_eff > 0))
         return "microlens_array translate z = " + format_number(tz) + " mm moves the array onto or in front "
                "of the main lens (distance D = " + format_number(main_distance) + " mm)";
+    if (is_prescription_type(camera.main.type)) {
+        const ParaxialData p = paraxial_data(effective_prescription(camera.main));
+        const double pupil_behind = p.exit_pupil_z - p.rear_vertex_z;  // exit pupil behind the rear vertex (mm)
+        if (!(main_eff > pupil_behind))
+            return "microlens_array at " + format_number(main_eff) + " mm behind the lens's rear vertex lies in front "
+                   "of its exit pupil (" + format_number(pupil_behind) + " mm behind the rear vertex), from which "
+                   "microimage centres are projected; move the array farther back";
+    }
 
     // Pinhole main lens: a thin microlens that images the sensor plane onto the pinhole sends every
     // ray from a sensor point back to that point, so only one point per microimage would be lit.
@@ -391,7 +510,7 @@ std::string check_placement(const double right[3], const double up[3], const dou
 int default_samples(const CameraParams& camera)
 {
     const bool thin_microlenses = camera.array.given && camera.array.lens == MicrolensType::ThinLens;
-    const bool bare_thin_main = !camera.array.given && camera.main.given && camera.main.type == MainLensType::ThinLens;
+    const bool bare_thin_main = !camera.array.given && camera.main.given && camera.main.type != MainLensType::Pinhole;
     return thin_microlenses || bare_thin_main ? kDefaultSamplesApertures : kDefaultSamplesPinholes;
 }
 

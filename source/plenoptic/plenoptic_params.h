@@ -6,9 +6,13 @@
 
 #include <string>
 
+#include "plenoptic_prescription.h"
+
 namespace plenoptic {
 
-enum class MainLensType { None, Pinhole, ThinLens };
+// Pinhole and ThinLens are ideal; ThickLens is a prescription's paraxial equivalent (issue 13);
+// Prescription is the real lens, traced surface by surface.
+enum class MainLensType { None, Pinhole, ThinLens, ThickLens, Prescription };
 enum class GridType { None, Rectangular, Hexagonal };
 enum class MicrolensType { Pinhole, ThinLens };
 
@@ -34,21 +38,45 @@ const int kMaxSamples = 1000000;
 const double kMinLengthMm = 1e-12;
 const double kMaxLengthMm = 1e12;
 
+// Most blades of a polygonal iris.
+const int kMaxBlades = 1000;
+
 // main_lens { ... }. `given` is false when the scene has no main_lens block (type stays None).
 struct MainLensParams {
     bool given = false;
-    MainLensType type = MainLensType::None; // None inside a given block: no thin_lens/pinhole keyword
+    // None inside a given block until a thin_lens, pinhole or thick_lens keyword is read; a
+    // lens_file or prescription { } without one of them makes it Prescription when the block closes.
+    MainLensType type = MainLensType::None;
+    bool has_prescription = false;          // lens_file or prescription { } was read
+    Prescription prescription;              // its surfaces (blades below are applied by the model)
+    std::string lens_file;                  // the name as the scene wrote it; "" for an inline prescription
+    int blades = 0;                         // polygonal iris at the stop; 0: round
+    double blade_rotation_deg = 0;
     bool has_focal_length = false;
     double focal_length_mm = 0;             // F
     bool has_f_number = false;
     double f_number = 0;                    // N = F / A
     bool has_aperture = false;
-    double aperture_mm = 0;                 // A, diameter
+    double aperture_mm = 0;                 // A, diameter (of the stop, for a prescription)
     bool has_focus_distance = false;
-    double focus_distance_units = 0;        // scene units in front of the lens
+    double focus_distance_units = 0;        // scene units in front of the lens (its front vertex)
     bool has_distance = false;
-    double distance_mm = 0;                 // D: main lens -> array (-> sensor without array)
+    double distance_mm = 0;                 // D: main lens (rear vertex) -> array (-> sensor without array)
 };
+
+// Whether the main lens is given by a prescription (traced exactly, or as its thick lens).
+inline bool is_prescription_type(MainLensType type)
+{
+    return type == MainLensType::ThickLens || type == MainLensType::Prescription;
+}
+
+// A prescription main lens as the camera uses it: its surfaces with the iris applied and the
+// stop at the diameter that `aperture` or `f_number` asks for (as written when neither is given).
+Prescription effective_prescription(const MainLensParams& main);
+
+// D for a main lens whose block passed check_main_lens: as given, or the paraxial image distance
+// of focus_distance (thin lens: F z / (z - F); prescription: from its rear vertex).
+double main_lens_distance_mm(const MainLensParams& main, double mm_per_unit);
 
 // microlens_array { ... }. `given` is false when the scene has no array (grid stays None).
 struct ArrayParams {
@@ -104,6 +132,7 @@ std::string check_translation(const char* keyword, double value_mm);      // tra
 std::string check_samples(const char* keyword, double value);             // a whole number 1..kMaxSamples
 std::string check_adaptive_minimum(double value);                           // samples MIN, MAX: MIN >= 2
 std::string check_confidence(double value);
+std::string check_blades(double value);                                     // a whole number 3..kMaxBlades
 std::string check_variance(double value);
 
 // ---- Cross-field checks, run when a block's closing brace is read. ----

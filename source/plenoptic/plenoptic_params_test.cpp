@@ -161,7 +161,7 @@ TEST(Params, MainLensCrossFieldRefusals)
     m = MainLensParams();
     m.given = true;
     message = check_main_lens(m, 1000);
-    EXPECT_TRUE(contains(message, "thin_lens or pinhole")) << message;
+    EXPECT_TRUE(contains(message, "thin_lens, pinhole, or a real lens")) << message;
 }
 
 TEST(Params, PinholeMainLensTakesDistanceOnly)

@@ -21,6 +21,17 @@ const int kVignettingProbesPerSample = 4;
 
 namespace detail {
 
+// The colour a ray brings, scaled by its weight (the sampled area of a real lens's exit pupil
+// relative to its paraxial pupil; 1 for every other ray).
+template <class TraceFn>
+Rgbt traced(TraceFn& trace, const OpticsRay& ray)
+{
+    const Rgbt c = trace(ray);
+    if (ray.weight == 1)
+        return c;
+    return Rgbt{c.r * ray.weight, c.g * ray.weight, c.b * ray.weight, c.t * ray.weight};
+}
+
 // Running sums of one lens's samples.
 struct SampleSums {
     double sum[4];
@@ -114,7 +125,7 @@ Rgbt vignetted_value(const Model& model, int i, int j, int W, int H, int n, int 
     if (passed == 0 && first_untraced >= 0) {
         OpticsRay ray;
         generate_ray(model, W, H, i, j, make_sample(i, j, first_untraced, probes), nullptr, &ray);
-        const Rgbt c = trace(static_cast<const OpticsRay&>(ray));
+        const Rgbt c = detail::traced(trace, ray);
         sum[0] = c.r;
         sum[1] = c.g;
         sum[2] = c.b;
@@ -153,7 +164,7 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
         for (int n = 0; n < count; ++n) {
             OpticsRay ray;
             if (generate_ray(model, W, H, i, j, make_sample(i, j, n, count), nullptr, &ray)) {
-                const Rgbt c = trace(static_cast<const OpticsRay&>(ray));
+                const Rgbt c = detail::traced(trace, ray);
                 sum[0] += c.r;
                 sum[1] += c.g;
                 sum[2] += c.b;
@@ -189,7 +200,7 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
             OpticsRay ray;
             Rgbt colour{0, 0, 0, 0};
             if (generate_ray(model, W, H, i, j, sample, model.model_overlap ? &lenses[slot] : nullptr, &ray)) {
-                colour = trace(static_cast<const OpticsRay&>(ray));
+                colour = detail::traced(trace, ray);
                 ++passed;
             }
             detail::add_sample(&sums[slot], colour);

@@ -264,7 +264,7 @@ PrescriptionError check_prescription(const Prescription& lens)
         }
         if (!(s.ior >= 1))
             return PrescriptionError{name + ": the index of refraction must be >= 1", s.line};
-        if (s.aperture_mm > 2 * std::fabs(s.radius_mm))
+        if (s.radius_mm != 0 && s.aperture_mm > 2 * std::fabs(s.radius_mm))
             return PrescriptionError{name + ": the aperture diameter exceeds the surface's sphere (diameter 2 |radius|)",
                                      s.line};
     }

@@ -59,7 +59,7 @@ ParsedPrescription parse_lens_file(const std::string& text);
 
 // The refusals of issue 13: no surface, no stop or more than one, a non-positive or non-finite
 // number where one is needed, an index below 1, a surface whose clear aperture exceeds its
-// sphere (aperture > 2 |radius|), a negative thickness.
+// sphere (aperture > 2 |radius|; a surface of radius 0, possible only inline, is flat), a negative thickness.
 PrescriptionError check_prescription(const Prescription& lens);
 
 // The z of each surface's vertex (the first at 0).

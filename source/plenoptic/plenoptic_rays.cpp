@@ -56,6 +56,7 @@ bool emit(const SceneRay& ray, OpticsRay* out)
     out->dir[0] = ray.dir.x;
     out->dir[1] = ray.dir.y;
     out->dir[2] = ray.dir.z;
+    out->weight = 1;
     return true;
 }
 
@@ -94,6 +95,21 @@ bool through_pinhole_main(const Model& m, Vec3 p, LensIndex lens, bool check_cel
 bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double lens_u, double lens_v,
                         bool check_apertures, OpticsRay* out)
 {
+    if (m.grid == GridType::None && m.pupil_bounds && check_apertures) {
+        // A real lens: towards a point of the region of the exit pupil's plane where light from p
+        // can pass, weighted by that region's area (see OpticsRay::weight). Chief rays (no
+        // aperture check) aim at the exit pupil's centre, below.
+        const PupilDisc disc = m.pupil_bounds->disc_for(p);
+        if (!(disc.radius > 0))
+            return false;
+        const Vec2 d = concentric_disc(lens_u, lens_v);
+        const Vec3 on_pupil{disc.centre.x + disc.radius * d.x, disc.centre.y + disc.radius * d.y, disc.centre.z};
+        if (!emit(m.lens->to_scene(p, on_pupil - p, true), out))
+            return false;
+        const double ratio = disc.radius / m.lens->exit_pupil_radius();
+        out->weight = ratio * ratio;
+        return true;
+    }
     if (m.grid == GridType::None) {
         // The sensor point towards a point of the exit pupil, through the lens.
         const Vec3 on_pupil = m.lens->exit_pupil_point(lens_u, lens_v);
@@ -170,6 +186,11 @@ bool lens_reaches_pixel(const Model& m, LensIndex lens, Vec3 p)
         spread += m.cell_circumradius_mm * std::fabs(1 + k - main_distance / microlens_focal(m, lens));
     if (m.pose.tilted)
         spread *= 1.25 + 4 * m.pose.tilt_sine;
+    if (m.pupil_bounds) {
+        // A real lens: the region where light from the lens centre passes its apertures.
+        const PupilDisc disc = m.pupil_bounds->disc_for(c);
+        return std::hypot(mx - disc.centre.x, my - disc.centre.y) <= (disc.radius + spread) * (1 + 1e-9);
+    }
     return std::hypot(mx, my) <= (m.lens->exit_pupil_radius() + spread) * (1 + 1e-9);
 }
 

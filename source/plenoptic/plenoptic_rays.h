@@ -16,6 +16,11 @@ namespace plenoptic {
 struct OpticsRay {
     double origin_mm[3];
     double dir[3];  // unit length, towards the scene (+z component)
+    // What the ray's colour counts for in its pixel: 1, except for a real lens without an array,
+    // whose samples cover a region of its exit pupil's plane (PupilBounds) rather than the paraxial
+    // pupil: the region's area over the paraxial pupil's, so that a pixel's value does not depend
+    // on the region sampled.
+    double weight;
 };
 
 // Point on the sensor (optics frame, mm) at continuous pixel coordinates (pu, pv), where pixel

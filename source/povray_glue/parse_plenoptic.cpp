@@ -17,6 +17,7 @@
 #include "backend/frame.h"
 #include "backend/parser/parse.h"
 #include "backend/scene/camera.h"
+#include "backend/support/fileutil.h"
 #include "plenoptic/plenoptic_light_check.h"
 #include "povray_glue/plenoptic_setup.h"
 
@@ -32,7 +33,11 @@ const char *kPlenopticKeywords =
 	"main_lens { }, microlens_array { }, sensor { }, mm_per_unit, samples, confidence, variance, depth_map, "
 	"and the placement keywords of every camera (location, look_at, sky, right, up, direction, rotate, "
 	"translate, scale, matrix, transform)";
-const char *kMainLensKeywords = "thin_lens, pinhole, focal_length, f_number, aperture, focus_distance, distance";
+const char *kMainLensKeywords = "thin_lens, pinhole, thick_lens, lens_file, prescription { }, focal_length, f_number, aperture, "
+	"focus_distance, distance, blades, blade_rotation";
+const char *kPrescriptionKeywords = "surface { }, stop { }";
+const char *kSurfaceKeywords = "radius, thickness, ior, aperture";
+const char *kStopKeywords = "thickness, aperture";
 const char *kArrayKeywords = "hexagonal, rectangular, pitch, focal_length, focal_lengths, pinhole, distance, rotate, translate";
 const char *kSensorKeywords = "pixel_size, offset";
 
@@ -45,8 +50,10 @@ enum class Word
 	// the camera's own words: identifiers everywhere else
 	MainLens, MicrolensArray, Sensor, ThinLens, Pinhole, FocalLength, FocalLengths, FNumber,
 	FocusDistance, Hexagonal, Rectangular, Pitch, PixelSize, DepthMap,
+	ThickLens, LensFile, Prescription, Surface, Stop, Blades, BladeRotation,
 	// stock reserved words
-	MmPerUnit, Aperture, Distance, Offset, Rotate, Translate, Samples, Confidence, Variance
+	MmPerUnit, Aperture, Distance, Offset, Rotate, Translate, Samples, Confidence, Variance,
+	Radius, Thickness, Ior
 };
 
 struct ContextWord { const char *text; Word word; };
@@ -55,7 +62,9 @@ const ContextWord kContextWords[] = {
 	{"thin_lens", Word::ThinLens}, {"pinhole", Word::Pinhole}, {"focal_length", Word::FocalLength},
 	{"focal_lengths", Word::FocalLengths}, {"f_number", Word::FNumber}, {"focus_distance", Word::FocusDistance},
 	{"hexagonal", Word::Hexagonal}, {"rectangular", Word::Rectangular}, {"pitch", Word::Pitch},
-	{"pixel_size", Word::PixelSize}, {"depth_map", Word::DepthMap}
+	{"pixel_size", Word::PixelSize}, {"depth_map", Word::DepthMap}, {"thick_lens", Word::ThickLens},
+	{"lens_file", Word::LensFile}, {"prescription", Word::Prescription}, {"surface", Word::Surface},
+	{"stop", Word::Stop}, {"blades", Word::Blades}, {"blade_rotation", Word::BladeRotation}
 };
 
 struct StockWord { TOKEN token; Word word; };
@@ -63,7 +72,8 @@ const StockWord kStockWords[] = {
 	{RIGHT_CURLY_TOKEN, Word::CloseBlock}, {MM_PER_UNIT_TOKEN, Word::MmPerUnit}, {APERTURE_TOKEN, Word::Aperture},
 	{DISTANCE_TOKEN, Word::Distance}, {OFFSET_TOKEN, Word::Offset}, {ROTATE_TOKEN, Word::Rotate},
 	{TRANSLATE_TOKEN, Word::Translate}, {SAMPLES_TOKEN, Word::Samples}, {CONFIDENCE_TOKEN, Word::Confidence},
-	{VARIANCE_TOKEN, Word::Variance}
+	{VARIANCE_TOKEN, Word::Variance}, {RADIUS_TOKEN, Word::Radius}, {THICKNESS_TOKEN, Word::Thickness},
+	{IOR_TOKEN, Word::Ior}
 };
 
 // The keyword the current token stands for. A camera word arrives as an undeclared
@@ -89,6 +99,12 @@ std::string Check_Focus_Distance(const char *, DBL value) { return plenoptic::ch
 std::string Check_Mm_Per_Unit(const char *, DBL value) { return plenoptic::check_mm_per_unit(value); }
 std::string Check_Confidence(const char *, DBL value) { return plenoptic::check_confidence(value); }
 std::string Check_Variance(const char *, DBL value) { return plenoptic::check_variance(value); }
+std::string Check_Blades(const char *, DBL value) { return plenoptic::check_blades(value); }
+std::string Check_Finite_Only(const char *, DBL) { return ""; }
+
+// Most bytes read from a lens file: a prescription is a few hundred; this bounds a wrong file
+// (a device, an image) to a prompt refusal.
+const size_t kMaxLensFileBytes = 1 << 20;
 
 bool Finite(const VECTOR v) { return std::isfinite(v[X]) && std::isfinite(v[Y]) && std::isfinite(v[Z]); }
 
@@ -210,9 +226,27 @@ void Parser::Parse_Plenoptic_Main_Lens(plenoptic::CameraParams& params)
 		{
 			case Word::ThinLens:
 			case Word::Pinhole:
+			case Word::ThickLens:
 				if (lens.type != plenoptic::MainLensType::None)
-					Error("plenoptic camera: main_lens takes one of thin_lens or pinhole, not both.");
-				lens.type = (Word_Of(Token) == Word::ThinLens) ? plenoptic::MainLensType::ThinLens : plenoptic::MainLensType::Pinhole;
+					Error("plenoptic camera: main_lens takes one of thin_lens, pinhole or thick_lens, not several.");
+				lens.type = (Word_Of(Token) == Word::ThinLens) ? plenoptic::MainLensType::ThinLens :
+				            (Word_Of(Token) == Word::Pinhole) ? plenoptic::MainLensType::Pinhole : plenoptic::MainLensType::ThickLens;
+				break;
+			case Word::LensFile:
+			case Word::Prescription:
+				if (lens.has_prescription)
+					Error("plenoptic camera: main_lens takes one lens_file or one prescription { }, not several.");
+				if (Word_Of(Token) == Word::LensFile)
+					Parse_Plenoptic_Lens_File(lens);
+				else
+					Parse_Plenoptic_Prescription(lens);
+				lens.has_prescription = true;
+				break;
+			case Word::Blades:
+				lens.blades = (int)Plenoptic_Float("blades", Check_Blades);
+				break;
+			case Word::BladeRotation:
+				lens.blade_rotation_deg = Plenoptic_Float("blade_rotation", plenoptic::check_angle);
 				break;
 			case Word::FocalLength:
 				lens.focal_length_mm = Plenoptic_Float("main_lens focal_length", plenoptic::check_positive_length);
@@ -238,10 +272,105 @@ void Parser::Parse_Plenoptic_Main_Lens(plenoptic::CameraParams& params)
 				Plenoptic_Unknown("main_lens", kMainLensKeywords);
 		}
 	}
+	// A real lens without thin_lens, pinhole or thick_lens is traced surface by surface.
+	if (lens.type == plenoptic::MainLensType::None && lens.has_prescription)
+		lens.type = plenoptic::MainLensType::Prescription;
 	// The closing brace is current: cross-field errors point at the end of the block.
 	Plenoptic_Check(plenoptic::check_main_lens(lens, params.mm_per_unit));
 	UNGET
 	Parse_End();
+}
+
+// lens_file "name": pbrt's lens-file format (plenoptic_prescription.h), found as POV-Ray finds a
+// file the scene reads (beside the scene, then the library paths), and else in the lenses/
+// folder installed with the program. Errors name the file and its row.
+void Parser::Parse_Plenoptic_Lens_File(plenoptic::MainLensParams& lens)
+{
+	const pov_base::ITextStream::FilePos position = Token.Token_File_Pos;
+	const int column = Token.Token_Col_No;
+	char *name = Parse_C_String(true);
+	const std::string file(name);
+	POV_FREE(name);
+	UCS2String ignored;
+	IStream *stream = Locate_File(this, sceneData, ASCIItoUCS2String(file.c_str()), POV_File_Text_User, ignored, false);
+	if (stream == NULL)
+		stream = Locate_File(this, sceneData, ASCIItoUCS2String(("lenses/" + file).c_str()), POV_File_Text_User, ignored, false);
+	if (stream == NULL)
+		Plenoptic_Check_At("lens_file \"" + file + "\" was not found beside the scene, in the library paths (+L) or in "
+		                   "the lenses folder installed with the program", position, column);
+	std::string text;
+	for (int c = stream->Read_Byte(); c != EOF && text.size() <= kMaxLensFileBytes; c = stream->Read_Byte())
+		text.push_back((char)c);
+	delete stream;
+	if (text.size() > kMaxLensFileBytes)
+		Plenoptic_Check_At("lens_file \"" + file + "\" is larger than " + std::to_string(kMaxLensFileBytes) +
+		                   " bytes: not a lens file", position, column);
+	const plenoptic::ParsedPrescription parsed = plenoptic::parse_lens_file(text);
+	if (parsed.error.any())
+		Plenoptic_Check_At("lens_file \"" + file + "\"" + (parsed.error.line > 0 ? ", line " + std::to_string(parsed.error.line) : std::string()) +
+		                   ": " + parsed.error.message, position, column);
+	lens.prescription.surfaces = parsed.prescription.surfaces;
+	lens.lens_file = file;
+}
+
+// prescription { surface { radius R thickness t ior n aperture a } stop { thickness t aperture a } ... }:
+// the rows of a lens file, object side first, written in the scene. Every value is required.
+void Parser::Parse_Plenoptic_Prescription(plenoptic::MainLensParams& lens)
+{
+	lens.prescription.surfaces.clear();
+	Parse_Begin();
+	for (Get_Token(); Word_Of(Token) != Word::CloseBlock; Get_Token())
+	{
+		const Word row = Word_Of(Token);
+		if (row != Word::Surface && row != Word::Stop)
+			Plenoptic_Unknown("prescription", kPrescriptionKeywords);
+		// A stop keeps the medium it stands in (index 0, as in a lens file); a radius 0 surface is flat.
+		plenoptic::LensSurface surface = {0, 0, row == Word::Stop ? 0.0 : 1.0, 0, row == Word::Stop, (int)Token.Token_File_Pos.lineno};
+		const char *block = surface.stop ? "stop" : "surface";
+		bool has_radius = surface.stop, has_thickness = false, has_ior = surface.stop, has_aperture = false;
+		Parse_Begin();
+		for (Get_Token(); Word_Of(Token) != Word::CloseBlock; Get_Token())
+		{
+			const Word word = Word_Of(Token);
+			if (word == Word::Radius && !surface.stop)
+			{
+				surface.radius_mm = Plenoptic_Float("surface radius", Check_Finite_Only);
+				has_radius = true;
+			}
+			else if (word == Word::Thickness)
+			{
+				surface.thickness_mm = Plenoptic_Float(surface.stop ? "stop thickness" : "surface thickness", plenoptic::check_translation);
+				has_thickness = true;
+			}
+			else if (word == Word::Ior && !surface.stop)
+			{
+				surface.ior = Plenoptic_Float("surface ior", Check_Finite_Only);
+				has_ior = true;
+			}
+			else if (word == Word::Aperture)
+			{
+				surface.aperture_mm = Plenoptic_Float(surface.stop ? "stop aperture" : "surface aperture", plenoptic::check_positive_length);
+				has_aperture = true;
+			}
+			else
+				Plenoptic_Unknown(block, surface.stop ? kStopKeywords : kSurfaceKeywords);
+		}
+		if (!(has_radius && has_thickness && has_ior && has_aperture))
+			Error("plenoptic camera: %s needs %s.", block, surface.stop ? "thickness and aperture" : "radius, thickness, ior and aperture");
+		UNGET
+		Parse_End();
+		lens.prescription.surfaces.push_back(surface);
+	}
+	const plenoptic::PrescriptionError error = plenoptic::check_prescription(lens.prescription);
+	if (error.any())
+	{
+		pov_base::ITextStream::FilePos position = Token.Token_File_Pos;
+		position.lineno = error.line > 0 ? error.line : position.lineno;
+		Plenoptic_Check_At("prescription: " + error.message, position, error.line > 0 ? 1 : (int)Token.Token_Col_No);
+	}
+	UNGET
+	Parse_End();
+	lens.lens_file.clear();
 }
 
 void Parser::Parse_Plenoptic_Array(plenoptic::CameraParams& params)

@@ -238,6 +238,44 @@ std::string parse_message(const std::string& what)
     return printable(message);
 }
 
+// The surfaces as the render used them (stop at its working diameter): no aperture or f_number
+// is applied on top of them.
+void read_prescription(const Json& v, const std::string& parent, MainLensParams* m)
+{
+    const Json& surfaces = member(v, parent, "surfaces");
+    if (!surfaces.is_array())
+        refuse(parent + ".surfaces", "an array of surfaces", surfaces);
+    m->prescription = Prescription();
+    for (size_t i = 0; i < surfaces.size(); ++i) {
+        const std::string row = parent + ".surfaces[" + std::to_string(i) + "]";
+        const Json& s = surfaces[i];
+        if (!s.is_object())
+            refuse(row, "an object", s);
+        const Json& stop = member(s, row, "stop");
+        if (!stop.is_boolean())
+            refuse(row + ".stop", "true or false", stop);
+        LensSurface surface;
+        surface.stop = stop.get<bool>();
+        surface.radius_mm = finite_number(member(s, row, "radius_mm"), row + ".radius_mm");
+        surface.thickness_mm = finite_number(member(s, row, "thickness_mm"), row + ".thickness_mm");
+        surface.ior = finite_number(member(s, row, "ior"), row + ".ior");
+        surface.aperture_mm = positive_number(member(s, row, "aperture_mm"), row + ".aperture_mm");
+        surface.line = 0;
+        m->prescription.surfaces.push_back(surface);
+    }
+    const Json& blades = member(v, parent, "blades");
+    if (!blades.is_number_integer() || !(blades.get<double>() == 0 || (blades.get<double>() >= 3 && blades.get<double>() <= kMaxBlades)))
+        refuse(parent + ".blades", "0 or a whole number from 3 to " + std::to_string(kMaxBlades), blades);
+    m->blades = int(blades.get<double>());
+    m->blade_rotation_deg = finite_number(member(v, parent, "blade_rotation_deg"), parent + ".blade_rotation_deg");
+    const Json& file = member(v, parent, "lens_file");
+    if (file.is_string())
+        m->lens_file = file.get<std::string>();
+    else if (!file.is_null())
+        refuse(parent + ".lens_file", "a file name or null", file);
+    m->has_prescription = true;
+}
+
 void read_main_lens(const Json& root, CameraParams* params)
 {
     const std::string parent = "main_lens";
@@ -259,8 +297,15 @@ void read_main_lens(const Json& root, CameraParams* params)
         const double f_number = positive_number(n, parent + ".f_number");
         check_close(parent + ".f_number", f_number, m.focal_length_mm / m.aperture_mm, f_number,
                     "focal_length_mm / aperture_mm");
+    } else if (type == "thick_lens" || type == "prescription") {
+        m.type = type == "thick_lens" ? MainLensType::ThickLens : MainLensType::Prescription;
+        read_prescription(object_member(main, parent, "prescription"), parent + ".prescription", &m);
+        const double f_number = positive_number(member(main, parent, "f_number"), parent + ".f_number");
+        check_close(parent + ".f_number", f_number, paraxial_data(effective_prescription(m)).f_number, f_number,
+                    "the surfaces of main_lens.prescription");
     } else {
-        refuse(parent + ".type", "\"thin_lens\", \"pinhole\" or \"none\"", member(main, parent, "type"));
+        refuse(parent + ".type", "\"thin_lens\", \"pinhole\", \"thick_lens\", \"prescription\" or \"none\"",
+               member(main, parent, "type"));
     }
     // D as resolved by the render, whether the scene gave focus_distance or distance.
     m.has_distance = true;

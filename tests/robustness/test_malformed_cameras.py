@@ -115,7 +115,7 @@ CASES = [
     ("main_lens thin_lens and pinhole", camera(main=main_with("thin_lens", "pinhole " + MARK, "distance 17", close=BRACE)),
      ["thin_lens", "pinhole"], "both alternatives: one kind of main lens (the later must not silently win)"),
     ("main_lens without type", camera(main=main_with("focal_length 16", "f_number 4", "focus_distance 2", close=BRACE)),
-     ["main_lens", "thin_lens or pinhole"], "the block must say which lens it is"),
+     ["main_lens", "thin_lens, pinhole, or a real lens"], "the block must say which lens it is"),
     ("thin_lens without focal_length", camera(main=main_with("thin_lens", "f_number 4", "focus_distance 2", close=BRACE)),
      ["focal_length"], "a thin lens needs F"),
     ("f_number and aperture both", camera(main=main_with("thin_lens", "focal_length 16", "f_number 4", "aperture 4", "focus_distance 2", close=BRACE)),
