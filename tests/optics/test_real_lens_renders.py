@@ -148,16 +148,7 @@ def test_point_images_without_array_match_reference(args):
                          background="rgb 0", objects=spheres)
     path = pt.render(args.povray, args.work, "real_lens_points", scene, W, H, timeout=300)
     image = pt.read_linear(path)[..., :3].mean(axis=2)
-    labels, count = ndimage.label(image > 0.01)
-    assert count == len(points), count
-    # The whole spot, faint coma included: the centroid over a window around each blob (the
-    # background is black), not over the pixels above the threshold.
-    centroids = []
-    for row, col in ndimage.center_of_mass(image, labels, range(1, count + 1)):
-        r0, c0 = int(round(row)), int(round(col))
-        window = image[max(0, r0 - 6):r0 + 7, max(0, c0 - 6):c0 + 7]
-        rows, cols = np.mgrid[max(0, r0 - 6):r0 + 7, max(0, c0 - 6):c0 + 7][:, :window.shape[0], :window.shape[1]]
-        centroids.append(((window * rows).sum() / window.sum(), (window * cols).sum() / window.sum()))  # (v, u)
+    centroids = blob_centroids(image, len(points))  # (v, u)
 
     # f_number 8: the stop scaled so that the entrance pupil is EFL / 8 (the pupil scales with it).
     stopped = lt.Lens(lt.parse_lens_file(LENS_FILE_TEXT), stop_diameter=par.efl / 8 / (par.entrance_pupil_diameter / 10.0))
@@ -171,3 +162,46 @@ def test_point_images_without_array_match_reference(args):
         nearest = min(centroids, key=lambda c: math.hypot(c[1] - u, c[0] - v))
         errors.append(math.hypot(nearest[1] - u, nearest[0] - v))
     assert max(errors) <= 0.2, errors
+
+
+def blob_centroids(image, expected_count):
+    """Intensity centroids (v, u) of the bright blobs of a black image, each over a window around
+    the blob (faint tails included)."""
+    labels, count = ndimage.label(image > 0.01)
+    assert count == expected_count, count
+    centroids = []
+    for row, col in ndimage.center_of_mass(image, labels, range(1, count + 1)):
+        r0, c0 = int(round(row)), int(round(col))
+        rows, cols = np.mgrid[max(0, r0 - 6):min(image.shape[0], r0 + 7), max(0, c0 - 6):min(image.shape[1], c0 + 7)]
+        window = image[rows, cols]
+        centroids.append(((window * rows).sum() / window.sum(), (window * cols).sum() / window.sum()))
+    return centroids
+
+
+def test_thin_weak_lens_prescription_converges_to_the_thin_lens(args):
+    """One very thin, weak biconvex lens (0.01 mm thick, f = 200 mm) behind a small stop (f/40)
+    images points where the ideal thin lens of the same focal length does: 0.05 px."""
+    W, H = 160, 120
+    pixel = 0.02
+    n, R = 1.5, 200.0  # lensmaker: 1/f = (n - 1) 2 / R = 1/200 for a thin lens
+    prescription = ("prescription { stop { thickness 0 aperture 5 } "
+                    "surface { radius %r thickness 0.01 ior %r aperture 10 } "
+                    "surface { radius %r thickness 0 ior 1 aperture 10 } } focus_distance 3" % (R, n, -R))
+    points = [(x, y) for x in np.linspace(-0.019, 0.019, 4) for y in np.linspace(-0.014, 0.014, 3)]
+    spheres = "".join("sphere { <%r, %r, 0>, 0.001 pigment { rgb 1 } finish { ambient 1 diffuse 0 } }\n" % p
+                      for p in points)
+    rest = "  sensor { pixel_size <%r, %r> } samples 256\n" % (pixel, pixel)
+    real = pt.render(args.povray, args.work, "weak_prescription",
+                     camera_scene(prescription, rest, background="rgb 0", objects=spheres), W, H, timeout=300)
+    efl = pt.metadata_of(real)["main_lens"]["focal_length_mm"]
+    # The thick-lens formula for this lens (independent of the camera's paraxial code).
+    t = 0.01
+    power = (n - 1) * (1 / R - 1 / -R + (n - 1) * t / (n * R * -R))
+    assert efl == pytest.approx(1 / power, rel=1e-12)
+    thin = pt.render(args.povray, args.work, "weak_thin_lens",
+                     camera_scene("thin_lens focal_length %r aperture 5 focus_distance 3" % efl, rest,
+                                  background="rgb 0", objects=spheres), W, H, timeout=300)
+    a = blob_centroids(pt.read_linear(real).mean(axis=2), len(points))
+    b = blob_centroids(pt.read_linear(thin).mean(axis=2), len(points))
+    errors = [min(math.hypot(p[0] - q[0], p[1] - q[1]) for q in b) for p in a]
+    assert max(errors) <= 0.05, errors

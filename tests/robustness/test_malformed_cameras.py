@@ -275,7 +275,40 @@ PLACEMENT_CASES = [
      ["parallel or lie in one plane", "after 'right'"], "the frame must span 3-D space"),
 ]
 
-GROUPS = {"camera": CASES, "placement": PLACEMENT_CASES}
+# Real main lenses (issue 13): the refusals of a prescription, written inline so the scene is
+# self-contained (a lens file's rows are refused the same way, naming the file and its row).
+S1 = "  surface { radius 30 thickness 5 ior 1.5 aperture 20 }"
+S2 = "  surface { radius -30 thickness 0 ior 1 aperture 20 }"
+STOP = "  stop { thickness 2 aperture 8 }"
+REAL = ("prescription {", STOP, S1, S2, "}")
+REAL_LENS_CASES = [
+    ("prescription without a stop", camera(main=main_with("prescription {", S1, S2, "}  " + MARK, "focus_distance 2")),
+     ["no aperture stop"], "a lens has exactly one stop"),
+    ("prescription with two stops", camera(main=main_with("prescription {", STOP, S1, STOP + "  " + MARK, S2, "}", "focus_distance 2")),
+     ["two aperture stops"], "a lens has exactly one stop"),
+    ("surface aperture zero", camera(main=main_with("prescription {", STOP, "  surface { radius 30 thickness 5 ior 1.5 aperture 0 }  " + MARK, S2, "}", "focus_distance 2")),
+     ["surface aperture", "positive"], "a clear aperture is a positive diameter"),
+    ("surface aperture beyond its sphere", camera(main=main_with("prescription {", STOP, "  surface { radius 5 thickness 5 ior 1.5 aperture 12 }  " + MARK, S2, "}", "focus_distance 2")),
+     ["exceeds", "sphere"], "a clear aperture cannot exceed its sphere"),
+    ("surface without ior", camera(main=main_with("prescription {", STOP, "  surface { radius 30 thickness 5 aperture 20 }  " + MARK, S2, "}", "focus_distance 2")),
+     ["surface needs", "ior"], "every number of a row is required"),
+    ("real lens cannot focus", camera(main=main_with(*(REAL + ("focus_distance 0.01",)), close=BRACE)),
+     ["cannot focus", "front focal point"], "an object inside the front focal length has no real image"),
+    ("lens_file not found", camera(main=main_with('lens_file "no-such-lens.dat"  ' + MARK, "focus_distance 2")),
+     ["lens_file", "not found"], "a missing file is named"),
+    ("thin_lens with a prescription", camera(main=main_with("thin_lens", *(REAL + ("focus_distance 2",)), close=BRACE)),
+     ["thin_lens", "thick_lens"], "a thin lens has no surfaces; the error says what to write instead"),
+    ("focal_length with a prescription", camera(main=main_with("focal_length 50", *(REAL + ("focus_distance 2",)), close=BRACE)),
+     ["focal_length", "real lens"], "a real lens's focal length follows from its surfaces"),
+    ("blades two", camera(main=main_with(*(REAL + ("blades 2  " + MARK, "focus_distance 2")))),
+     ["blades", "3"], "an iris has at least three blades"),
+    ("thick_lens with blades", camera(main=main_with("thick_lens", *(REAL + ("blades 6", "focus_distance 2")), close=BRACE)),
+     ["thick_lens", "blades"], "the paraxial equivalent has a round pupil"),
+    ("thick_lens without a lens", camera(main=main_with("thick_lens", "focus_distance 2", close=BRACE)),
+     ["thick_lens", "lens_file"], "the paraxial equivalent of what?"),
+]
+
+GROUPS = {"camera": CASES, "placement": PLACEMENT_CASES, "real_lens": REAL_LENS_CASES}
 
 
 def marked_lines(block):
@@ -350,3 +383,9 @@ def test_camera_table_size():
 def test_placement_keyword(args, index):
     """ctest robustness_malformed_placement."""
     refused(args, "placement", index, *PLACEMENT_CASES[index])
+
+
+@pytest.mark.parametrize("index", range(len(REAL_LENS_CASES)), ids=[c[0] for c in REAL_LENS_CASES])
+def test_real_lens_keyword(args, index):
+    """ctest robustness_malformed_real_lens."""
+    refused(args, "real_lens", index, *REAL_LENS_CASES[index])
