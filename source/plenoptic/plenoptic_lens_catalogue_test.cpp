@@ -31,7 +31,8 @@ namespace {
 
 // The values printed with one design, in the file's scale (published value times the scale
 // factor the file's header states). A tolerance is the rounding of the published figure: half
-// a unit in its last printed digit, times the scale factor.
+// a unit in its last printed digit, times the scale factor, unless the row states a wider one
+// and why (glass indices the source does not print, an image plane that is not the paraxial focus).
 struct Published {
     const char* file;      // name in lenses/
     const char* source;    // patent and example, or book and page
@@ -40,9 +41,18 @@ struct Published {
     double f_number, f_number_tolerance;  // f_number 0: the source states none
 };
 
-// One row a lens file. None yet: no design has been transcribed from its primary source
-// (lenses/README.md).
-const std::vector<Published> kPublished = {};
+// One row a lens file.
+const std::vector<Published> kPublished = {
+    // Laikin, Lens Design, 4th ed., Table 8.1, scaled by 22 / 1.181. Printed EFL 1.181 -> 22 mm.
+    // Not the rounding of the figure but 0.1% (0.022 mm): the book names glasses only, and with
+    // Schott's n_d (the file's index) the EFL is 0.05% longer than printed (the printed value
+    // matches the e line). Back focus: the printed distance from the last surface to the image,
+    // 2.2253 -> 41.4533 mm, is the book's image plane, 0.17% in front of the paraxial focus
+    // (n_d: 2.2291 -> 41.524 mm); tolerance 0.2% (0.083 mm). f/3.5 as printed (the stop's
+    // printed diameter 0.647 gives f/3.499), to the rounding of the printed figure.
+    {"wide_angle_22mm_laikin_f3.5.dat", "Laikin, Lens Design, 4th ed. (CRC), Table 8.1, f/3.5 inverted telephoto",
+     22.0, 0.022, 2.2253 * 22.0 / 1.181, 0.002 * 2.2253 * 22.0 / 1.181, 3.5, 0.05},
+};
 
 std::string lenses_dir()
 {
