@@ -187,7 +187,7 @@ Json lattice_json(const Model& m, const MicroimageLattice& lattice)
     json["lens_type_rule"] = types == 3 ? "type(k, l) = (k - l) mod 3, focal_lengths_mm[type]" : "type(k, l) = 0";
     // Diameter of the main lens's exit pupil imaged through a lens centre (the f-number-matched disc).
     const bool has_pupil = m.lens && m.main_lens != MainLensType::Pinhole;
-    const double pupil_mm = m.main_lens == MainLensType::ThinLens ? m.aperture_mm : has_pupil ? 2 * m.lens->exit_pupil_radius() : 0;
+    const double pupil_mm = has_pupil ? 2 * m.lens->exit_pupil_radius() : 0;  // a thin lens's: A (2 * A/2, exact)
     json["microimage_diameter_px"] =
         number_or_null(has_pupil, pupil_mm * effective_array_distance_mm(m) / effective_main_distance_mm(m) / m.pixel_size_mm[0]);
     return json;
