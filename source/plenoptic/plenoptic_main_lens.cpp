@@ -37,6 +37,14 @@ public:
             return SceneRay{origin, direction, false};
         return scene_ray(Vec3{0, 0, 0}, direction);
     }
+    ImageRay to_image(Vec3 origin, Vec3 direction, bool) const override
+    {
+        const Vec3 to_pinhole = -origin;
+        const Vec3 c = cross(to_pinhole, direction);
+        if (dot(c, c) > 1e-24 * dot(to_pinhole, to_pinhole) * dot(direction, direction) || !(dot(to_pinhole, direction) > 0))
+            return ImageRay{origin, direction, false};
+        return image_ray(Vec3{0, 0, 0}, direction);
+    }
     HomogeneousPoint paraxial_image(Vec3 point) const override { return HomogeneousPoint{point, 1}; }
 };
 
@@ -65,6 +73,21 @@ public:
         const double wx = direction.x / direction.z - mx / focal_;
         const double wy = direction.y / direction.z - my / focal_;
         return scene_ray(Vec3{mx, my, 0}, Vec3{wx, wy, 1});
+    }
+    // The reverse of to_scene: arriving with slope a = direction / |direction.z| at m, the ray
+    // leaves with a - m / F (to_scene's rule read backwards).
+    ImageRay to_image(Vec3 origin, Vec3 direction, bool check_apertures) const override
+    {
+        if (!(direction.z < 0) || !(origin.z > 0))
+            return ImageRay{origin, direction, false};
+        const double travel = -origin.z / direction.z;
+        const double mx = origin.x + travel * direction.x;
+        const double my = origin.y + travel * direction.y;
+        if (check_apertures && !inside_disc(mx, my, radius_))
+            return ImageRay{Vec3{mx, my, 0}, direction, false};
+        const double ax = direction.x / -direction.z - mx / focal_;
+        const double ay = direction.y / -direction.z - my / focal_;
+        return image_ray(Vec3{mx, my, 0}, Vec3{ax, ay, -1});
     }
     // X' = X / (1 - z / F), written homogeneously.
     HomogeneousPoint paraxial_image(Vec3 point) const override { return HomogeneousPoint{point, 1 - point.z / focal_}; }
@@ -109,6 +132,24 @@ public:
         const double wy = direction.y / direction.z - my / focal_;
         return scene_ray(Vec3{mx, my, front_h_}, Vec3{wx, wy, 1});
     }
+    // The reverse: met at height m on the front principal plane, the ray leaves the rear one at
+    // the same height with slope a - m / F, and passes when its line crosses the exit pupil.
+    ImageRay to_image(Vec3 origin, Vec3 direction, bool check_apertures) const override
+    {
+        if (!(direction.z < 0) || !(origin.z > front_h_))
+            return ImageRay{origin, direction, false};
+        const double travel = (front_h_ - origin.z) / direction.z;
+        const double mx = origin.x + travel * direction.x;
+        const double my = origin.y + travel * direction.y;
+        const double ax = direction.x / -direction.z - mx / focal_;
+        const double ay = direction.y / -direction.z - my / focal_;
+        if (check_apertures) {
+            const double to_pupil = rear_h_ - pupil_z_;  // along the outgoing line, per unit of -z
+            if (!inside_disc(mx + to_pupil * ax, my + to_pupil * ay, radius_))
+                return ImageRay{Vec3{mx, my, rear_h_}, direction, false};
+        }
+        return image_ray(Vec3{mx, my, rear_h_}, Vec3{ax, ay, -1});
+    }
     // The thin-lens conjugate about the principal planes: X - H maps to (X - H) / (1 - s / F)
     // about H', s the distance of X in front of H.
     HomogeneousPoint paraxial_image(Vec3 point) const override
@@ -128,7 +169,13 @@ private:
 class ExactMainLens : public MainLens {
 public:
     ExactMainLens(const Prescription& lens, double length, const ThickMainLens& paraxial)
-        : lens_(lens), length_(length), paraxial_(paraxial) {}
+        : lens_(lens), unbounded_(lens), length_(length), paraxial_(paraxial)
+    {
+        // Chief rays and depth maps want a ray for every pixel: no clear aperture blocks.
+        for (LensSurface& surface : unbounded_.surfaces)
+            surface.aperture_mm = INFINITY;
+        unbounded_.blades = 0;
+    }
     MainLensType type() const override { return MainLensType::Prescription; }
     Vec3 exit_pupil_centre() const override { return paraxial_.exit_pupil_centre(); }
     double exit_pupil_radius() const override { return paraxial_.exit_pupil_radius(); }
@@ -136,23 +183,26 @@ public:
     SceneRay to_scene(Vec3 origin, Vec3 direction, bool check_apertures) const override
     {
         const LensRay in{Vec3{origin.x, origin.y, length_ - origin.z}, normalized(Vec3{direction.x, direction.y, -direction.z})};
-        Prescription traced = lens_;
-        if (!check_apertures) {
-            // Chief rays and depth maps want a ray for every pixel: no clear aperture blocks.
-            for (LensSurface& surface : traced.surfaces)
-                surface.aperture_mm = INFINITY;
-            traced.blades = 0;
-        }
-        const Traced out = trace_from_image(check_apertures ? lens_ : traced, in);
+        const Traced out = trace_from_image(check_apertures ? lens_ : unbounded_, in);
         if (out.result != TraceResult::Passed)
             return SceneRay{origin, direction, false};
         return scene_ray(Vec3{out.ray.origin.x, out.ray.origin.y, length_ - out.ray.origin.z},
+                         Vec3{out.ray.dir.x, out.ray.dir.y, -out.ray.dir.z});
+    }
+    ImageRay to_image(Vec3 origin, Vec3 direction, bool check_apertures) const override
+    {
+        const LensRay in{Vec3{origin.x, origin.y, length_ - origin.z}, normalized(Vec3{direction.x, direction.y, -direction.z})};
+        const Traced out = trace_from_object(check_apertures ? lens_ : unbounded_, in);
+        if (out.result != TraceResult::Passed)
+            return ImageRay{origin, direction, false};
+        return image_ray(Vec3{out.ray.origin.x, out.ray.origin.y, length_ - out.ray.origin.z},
                          Vec3{out.ray.dir.x, out.ray.dir.y, -out.ray.dir.z});
     }
     HomogeneousPoint paraxial_image(Vec3 point) const override { return paraxial_.paraxial_image(point); }
 
 private:
     Prescription lens_;
+    Prescription unbounded_;  // the same without clear apertures or iris
     double length_;
     ThickMainLens paraxial_;
 };
@@ -182,6 +232,13 @@ SceneRay scene_ray(Vec3 origin, Vec3 direction)
     const Vec3 unit = normalized(direction);
     const bool ok = is_finite(origin) && is_finite(unit) && unit.z > 0;
     return SceneRay{origin, unit, ok};
+}
+
+ImageRay image_ray(Vec3 origin, Vec3 direction)
+{
+    const Vec3 unit = normalized(direction);
+    const bool ok = is_finite(origin) && is_finite(unit) && unit.z < 0;
+    return ImageRay{origin, unit, ok};
 }
 
 std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& p)

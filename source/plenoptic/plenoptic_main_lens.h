@@ -20,6 +20,14 @@ struct SceneRay {
     bool passed;  // false: blocked by an aperture, or no such ray
 };
 
+// A ray leaving the main lens towards the image side (to_image): origin and unit direction (-z
+// component), mm.
+struct ImageRay {
+    Vec3 origin;
+    Vec3 dir;
+    bool passed;  // false: blocked by an aperture, or no such ray
+};
+
 // A point in homogeneous coordinates (xyz / w; w = 0: at infinity in the direction xyz).
 struct HomogeneousPoint {
     Vec3 xyz;
@@ -44,6 +52,11 @@ public:
     // an aperture (only if check_apertures) or cannot pass the lens at all.
     virtual SceneRay to_scene(Vec3 origin, Vec3 direction, bool check_apertures) const = 0;
 
+    // The reverse: the ray that leaves towards the image side when light from the scene travels
+    // along (origin, direction) (origin in front of the lens, direction towards -z, any length).
+    // Blocked as to_scene blocks. Forward projection traces points' light with it.
+    virtual ImageRay to_image(Vec3 origin, Vec3 direction, bool check_apertures) const = 0;
+
     // The paraxial image of a scene point (optics frame), homogeneous so that an image at
     // infinity is fine. A pinhole forms none: it returns the point itself with w = 1 (unused).
     virtual HomogeneousPoint paraxial_image(Vec3 point) const = 0;
@@ -66,6 +79,8 @@ std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& params);
 // The unit-direction ray (origin, direction); passed false when it is not finite or does not head
 // into the scene (a strong lens or a steep tilt can bend a ray back into the camera body).
 SceneRay scene_ray(Vec3 origin, Vec3 direction);
+// The same towards the image: passed false unless finite and heading towards -z.
+ImageRay image_ray(Vec3 origin, Vec3 direction);
 
 } // namespace plenoptic
 

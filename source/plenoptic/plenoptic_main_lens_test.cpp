@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "plenoptic_main_lens.h"
 #include "plenoptic_prescription.h"
@@ -99,6 +100,48 @@ TEST(MainLens, ExactLensBlocksAtTheStopAndAtTheRims)
     // Without apertures (chief rays, depth maps) they all pass.
     for (double h = 0.25; h < 19; h += 0.5)
         EXPECT_TRUE(exact->to_scene(Vec3{h, 0, -50}, Vec3{0, 0, 1}, false).passed) << h;
+}
+
+// Optical reversibility: light sent back along the ray that to_scene returns leaves the lens,
+// through to_image, along the ray it came from (the same line, travelling the other way); a ray
+// For every kind of lens with an aperture.
+TEST(MainLens, ToImageRetracesToScene)
+{
+    MainLensParams thin;
+    thin.given = true;
+    thin.type = MainLensType::ThinLens;
+    thin.focal_length_mm = 50;
+    thin.has_f_number = true;
+    thin.f_number = 2;
+    std::vector<std::shared_ptr<const MainLens>> lenses;
+    lenses.push_back(make_main_lens(thin));
+    lenses.push_back(make_prescription_lens(singlet(), 0, false));
+    lenses.push_back(make_prescription_lens(singlet(), 0, true));
+    for (size_t which = 0; which < lenses.size(); ++which) {
+        const MainLens& lens = *lenses[which];
+        int passed = 0, blocked = 0;
+        for (int i = -6; i <= 6; ++i) {
+            for (int j = -6; j <= 6; ++j) {
+                const Vec3 origin{0.3 * i, -0.2 * j, -60};
+                const Vec3 aim = lens.exit_pupil_centre() + Vec3{2.5 * i, 1.9 * j, 0};
+                const SceneRay out = lens.to_scene(origin, aim - origin, true);
+                const ImageRay back = lens.to_image(out.origin + 30.0 * out.dir, -out.dir, true);
+                if (!out.passed) {
+                    ++blocked;
+                    continue;
+                }
+                ++passed;
+                ASSERT_TRUE(back.passed) << "lens " << which << " ray " << i << ", " << j;
+                // The returning ray lies on the original line and travels back along it.
+                const Vec3 d = normalized(aim - origin);
+                const Vec3 rel = back.origin - origin;
+                EXPECT_LT(length(cross(rel, d)), 1e-9) << "lens " << which << " ray " << i << ", " << j;
+                EXPECT_LT(length(back.dir + d), 1e-12) << "lens " << which << " ray " << i << ", " << j;
+            }
+        }
+        EXPECT_GT(passed, 20) << "lens " << which;
+        EXPECT_GT(blocked, 10) << "lens " << which << ": its aperture blocks some of these rays";
+    }
 }
 
 } // namespace

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Forward projection of 3-D points through ideal thin lenses and pinholes.
+// Forward projection of 3-D points through ideal thin and thick lenses and pinholes, in closed
+// form; a traced (prescription) lens goes to plenoptic_traced_projection.cpp.
 
 #include "plenoptic_projection.h"
 
@@ -8,34 +9,14 @@
 #include <vector>
 
 #include "plenoptic_rays.h"
+#include "plenoptic_projection_internal.h"
 #include "plenoptic_rays_internal.h"
+#include "plenoptic_traced_projection.h"
 
 namespace plenoptic {
 
-namespace {
+namespace detail {
 
-using detail::microlens_focal;
-using detail::project_to_array;
-using detail::to_local;
-using detail::to_optics;
-
-// Homogeneous point (x, y, z, w): the point (x/w, y/w, z/w), or the direction (x, y, z) if w = 0.
-typedef HomogeneousPoint Homogeneous;
-
-// Candidate lenses are enumerated in a box of array-local coordinates.
-struct Box {
-    bool valid;
-    double x0, x1, y0, y1;
-};
-
-// Bound on the lenses forward_project examines for one point, so no input can make it hang: about
-// 4 million, ten times the lenses of the largest sensors in use, and about a second of work
-// (an array tilted almost edge-on to the sensor makes a few pixels see millions of lenses).
-const long long kMaxForwardLenses = 1LL << 22;
-
-// Sensor hit of a ray arriving at array point h (optics frame) with direction `towards_sensor`,
-// refracted by `lens` (the same rule w' = w - (h - c)/f with w normalised to unit travel along the
-// normal).
 bool sensor_hit_through_lens(const Model& m, LensIndex lens, Vec3 h, Vec3 towards_sensor, Vec3* hit)
 {
     Vec3 direction = towards_sensor;
@@ -57,6 +38,91 @@ bool sensor_hit_through_lens(const Model& m, LensIndex lens, Vec3 h, Vec3 toward
     *hit = h + travel * direction;
     return is_finite(*hit);
 }
+
+int receiving_rings(const Model& m) { return m.model_overlap ? m.overlap_rings : 0; }
+
+bool within_rings(const Model& m, LensIndex a, LensIndex b, int rings)
+{
+    const std::int64_t dk = skew_k(m.grid, a) - skew_k(m.grid, b);
+    const std::int64_t dl = a.l - b.l;
+    std::int64_t d = std::max(dk < 0 ? -dk : dk, dl < 0 ? -dl : dl);
+    if (m.grid == GridType::Hexagonal)
+        d = std::max(d, dk + dl < 0 ? -(dk + dl) : dk + dl);
+    return d <= rings;
+}
+
+std::vector<Vec2> picture_polygon(const Model& m, int W, int H)
+{
+    const Vec3 a = sensor_point(m, W, H, 0, 0), b = sensor_point(m, W, H, W, H);
+    return std::vector<Vec2>{Vec2{a.x, a.y}, Vec2{b.x, a.y}, Vec2{b.x, b.y}, Vec2{a.x, b.y}};
+}
+
+std::vector<Vec2> microimage_cell(const Model& m, LensIndex lens)
+{
+    Vec2 cell[6];
+    const int count = cell_polygon(m.grid, m.pitch_mm, cell);
+    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+    std::vector<Vec2> out;
+    for (int i = 0; i < count; ++i) {
+        const Vec3 q = to_optics(m, Vec3{c.x + cell[i].x, c.y + cell[i].y, 0});
+        double s = 1;
+        if (m.main_lens != MainLensType::None) {
+            if (!(q.z < 0))
+                return std::vector<Vec2>();
+            s = m.sensor_z_mm / q.z;
+        }
+        out.push_back(Vec2{q.x * s, q.y * s});
+    }
+    return out;
+}
+
+bool delivered_point(const Model& m, int W, int H, LensIndex lens, Vec2 s)
+{
+    double u, v;
+    if (!sensor_to_pixel(m, W, H, s.x, s.y, &u, &v))
+        return false;
+    LensIndex owner;
+    return own_lens(m, Vec3{s.x, s.y, m.sensor_z_mm}, &owner) && within_rings(m, owner, lens, receiving_rings(m));
+}
+
+void add_point_hit(const Model& m, int W, int H, LensIndex lens, Vec3 s, double fraction, std::vector<PixelHit>* hits)
+{
+    if (!delivered_point(m, W, H, lens, Vec2{s.x, s.y}))
+        return;
+    double u, v;
+    sensor_to_pixel(m, W, H, s.x, s.y, &u, &v);
+    hits->push_back(PixelHit{lens, u, v, fraction});
+}
+
+} // namespace detail
+
+namespace {
+
+using detail::microlens_focal;
+using detail::project_to_array;
+using detail::to_local;
+using detail::to_optics;
+using detail::add_point_hit;
+using detail::delivered_point;
+using detail::microimage_cell;
+using detail::picture_polygon;
+using detail::receiving_rings;
+using detail::sensor_hit_through_lens;
+using detail::within_rings;
+
+// Homogeneous point (x, y, z, w): the point (x/w, y/w, z/w), or the direction (x, y, z) if w = 0.
+typedef HomogeneousPoint Homogeneous;
+
+// Candidate lenses are enumerated in a box of array-local coordinates.
+struct Box {
+    bool valid;
+    double x0, x1, y0, y1;
+};
+
+// Bound on the lenses forward_project examines for one point, so no input can make it hang: about
+// 4 million, ten times the lenses of the largest sensors in use, and about a second of work
+// (an array tilted almost edge-on to the sensor makes a few pixels see millions of lenses).
+const long long kMaxForwardLenses = 1LL << 22;
 
 // Line through homogeneous point a and point b, met with the plane n . x = n . point.
 bool line_meets_plane(Homogeneous a, Vec3 b, Vec3 n, Vec3 point, Homogeneous* out)
@@ -294,63 +360,6 @@ double area_centroid(const std::vector<Vec2>& poly, Vec2* centroid)
     return 0.5 * std::fabs(area);
 }
 
-// Lenses whose microimage cells may receive light through a lens: the renderer gives a sensor
-// point light through lens L only if L is its own lens (no overlap modelling: the own lens of
-// each sample's sensor point), or, with overlap modelling, if L lies within model.overlap_rings
-// rings of the own lens of the pixel's centre (overlap_lenses; its reach test is conservative,
-// so it never refuses light that arrives). Rings in skew indices: max(|dk|, |dl|) rectangular,
-// max(|dk|, |dl|, |dk + dl|) hexagonal.
-int receiving_rings(const Model& m) { return m.model_overlap ? m.overlap_rings : 0; }
-
-bool within_rings(const Model& m, LensIndex a, LensIndex b, int rings)
-{
-    const std::int64_t dk = skew_k(m.grid, a) - skew_k(m.grid, b);
-    const std::int64_t dl = a.l - b.l;
-    std::int64_t d = std::max(dk < 0 ? -dk : dk, dl < 0 ? -dl : dl);
-    if (m.grid == GridType::Hexagonal)
-        d = std::max(d, dk + dl < 0 ? -(dk + dl) : dk + dl);
-    return d <= rings;
-}
-
-// The picture on the sensor plane (x, y, mm).
-std::vector<Vec2> picture_polygon(const Model& m, int W, int H)
-{
-    const Vec3 a = sensor_point(m, W, H, 0, 0), b = sensor_point(m, W, H, W, H);
-    return std::vector<Vec2>{Vec2{a.x, a.y}, Vec2{b.x, a.y}, Vec2{b.x, b.y}, Vec2{a.x, b.y}};
-}
-
-// Lens `lens`'s microimage cell on the sensor plane: its cell seen from the main-lens centre
-// (straight down without a main lens). Empty if a corner does not project.
-std::vector<Vec2> microimage_cell(const Model& m, LensIndex lens)
-{
-    Vec2 cell[6];
-    const int count = cell_polygon(m.grid, m.pitch_mm, cell);
-    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
-    std::vector<Vec2> out;
-    for (int i = 0; i < count; ++i) {
-        const Vec3 q = to_optics(m, Vec3{c.x + cell[i].x, c.y + cell[i].y, 0});
-        double s = 1;
-        if (m.main_lens != MainLensType::None) {
-            if (!(q.z < 0))
-                return std::vector<Vec2>();
-            s = m.sensor_z_mm / q.z;
-        }
-        out.push_back(Vec2{q.x * s, q.y * s});
-    }
-    return out;
-}
-
-// Whether the renderer delivers light through `lens` to sensor point s (x, y, mm): inside the
-// picture and in the microimage cell of a lens within the receiving rings of `lens`.
-bool delivered_point(const Model& m, int W, int H, LensIndex lens, Vec2 s)
-{
-    double u, v;
-    if (!sensor_to_pixel(m, W, H, s.x, s.y, &u, &v))
-        return false;
-    LensIndex owner;
-    return own_lens(m, Vec3{s.x, s.y, m.sensor_z_mm}, &owner) && within_rings(m, owner, lens, receiving_rings(m));
-}
-
 // The part of `light` (a convex polygon on the sensor plane, x, y, mm, uniformly lit) that the
 // renderer delivers through `lens`: inside the picture and inside the microimage cells of the
 // lenses within the receiving rings. Returns its area and centroid.
@@ -414,16 +423,6 @@ double delivered_area(const Model& m, int W, int H, LensIndex lens, const std::v
         return 0;
     *centroid = Vec2{cx / area, cy / area};
     return is_finite(*centroid) ? area : 0;
-}
-
-// Adds the image at sensor point s if the renderer delivers light there through `lens`.
-void add_point_hit(const Model& m, int W, int H, LensIndex lens, Vec3 s, double fraction, std::vector<PixelHit>* hits)
-{
-    if (!delivered_point(m, W, H, lens, Vec2{s.x, s.y}))
-        return;
-    double u, v;
-    sensor_to_pixel(m, W, H, s.x, s.y, &u, &v);
-    hits->push_back(PixelHit{lens, u, v, fraction});
 }
 
 // Adds the image of the light `light` (sensor plane, uniformly lit, carrying `fraction` of the
@@ -663,6 +662,8 @@ std::vector<PixelHit> forward_project(const Model& m, int W, int H, const double
     const Vec3 point{point_mm[0], point_mm[1], point_mm[2]};
     if (!is_finite(point))
         return hits;
+    if (m.main_lens == MainLensType::Prescription)
+        return forward_project_traced(m, W, H, point, default_traced_projection_options());
     if (m.grid == GridType::None) {
         if (!(point.z > 0))
             return hits;

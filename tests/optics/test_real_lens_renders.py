@@ -152,7 +152,7 @@ def test_point_images_without_array_match_reference(args):
 
     # f_number 8: the stop scaled so that the entrance pupil is EFL / 8 (the pupil scales with it).
     stopped = lt.Lens(lt.parse_lens_file(LENS_FILE_TEXT), stop_diameter=par.efl / 8 / (par.entrance_pupil_diameter / 10.0))
-    errors = []
+    errors, references = [], []
     for x, y in points:
         # The scene point in the optics frame: location <0,0,-3>, looking along +z.
         optics = lt.world_to_optics(np.array([x, y, 0.0]), np.array([0, 0, -3.0]), np.array([1.0, 0, 0]),
@@ -161,7 +161,20 @@ def test_point_images_without_array_match_reference(args):
         u, v = lt.sensor_to_pixel(spot.x, spot.y, W, H, pixel, pixel)
         nearest = min(centroids, key=lambda c: math.hypot(c[1] - u, c[0] - v))
         errors.append(math.hypot(nearest[1] - u, nearest[0] - v))
+        references.append((u, v))
     assert max(errors) <= 0.2, errors
+
+    # Forward projection through the traced lens (plenoptic-project): the centroid of each point's
+    # spot, against the reference's (the same quantity; both sample the light, so a few
+    # hundredths of a pixel) and against the render.
+    hits = pt.run_project(args.project, os.path.join(args.work, "real_lens_points.plenoptic.json"),
+                          [(x, y, 0.0) for x, y in points])
+    assert sorted(h[0] for h in hits) == list(range(len(points))), hits
+    to_reference = [math.hypot(u - references[i][0], v - references[i][1]) for i, _, _, u, v in hits]
+    print("plenoptic-project - reference spot centroid: max %.4f px" % max(to_reference))
+    assert max(to_reference) <= 0.03, to_reference
+    to_render = [min(math.hypot(c[1] - u, c[0] - v) for c in centroids) for _, _, _, u, v in hits]
+    assert max(to_render) <= 0.2, to_render
 
 
 def blob_centroids(image, expected_count):
