@@ -218,3 +218,94 @@ def test_thin_weak_lens_prescription_converges_to_the_thin_lens(args):
     b = blob_centroids(pt.read_linear(thin).mean(axis=2), len(points))
     errors = [min(math.hypot(p[0] - q[0], p[1] - q[1]) for q in b) for p in a]
     assert max(errors) <= 0.05, errors
+
+
+ARRAY_CASES = {
+    # Pinhole microlenses: one sharp image of the sphere per pinhole its light reaches (Newton's
+    # method in the projection). Thin microlenses at d = f (plenoptic 1.0): per lens, the patch of
+    # the sphere's light that crosses that lens's cell (the centroid of the delivered light).
+    "pinholes": "pinhole distance 0.5",
+    "plenoptic-1.0": "focal_length 0.5 distance 0.5",
+}
+
+
+def hexagonal_neighbours(k, l):
+    """The six neighbours of lens (k, l) in row form (odd rows shifted by half a pitch)."""
+    shift = 0 if l % 2 else -1
+    return [(k - 1, l), (k + 1, l), (k + shift, l - 1), (k + shift + 1, l - 1), (k + shift, l + 1), (k + shift + 1, l + 1)]
+
+
+@pytest.mark.parametrize("case", sorted(ARRAY_CASES))
+def test_forward_projection_with_array_matches_render(args, case):
+    """Small bright spheres seen through the test lens and a hexagonal array, 13 degrees off axis
+    (a sensor window offset from the axis, where the clear apertures start to clip the light):
+    every image plenoptic-project predicts with the sphere wholly seen lies within 0.25 px of a
+    rendered blob's centroid, and every rendered blob is a predicted image."""
+    W, H, pixel = 320, 240, 0.005
+    offset = (11.0, 7.0)  # mm: the window's centre, 13 mm off axis
+    lens = reference_lens()
+    par = lt.paraxial_data(lens)
+    D = lt.paraxial_image_distance(lens, 3000.0)
+    # Spheres 0.3 and 0.35 m in front of the lens, far from the focused plane (3 m): each point's
+    # light spreads over about five lenses across; placed by the paraxial magnification so that
+    # each lands in one half of the window. Small (0.25 mm), so that most lenses see all of one.
+    radius_mm = 0.25
+    centres = []
+    for (du, z_m) in ((-0.4, 0.3), (0.4, 0.35)):
+        image_x, image_y = -(offset[0] + du), -offset[1]  # the image is inverted
+        magnification = (D + lens.length - par.rear_principal_z) / (z_m * 1000.0 + par.front_principal_z)
+        centres.append((image_x / magnification / 1000.0, image_y / magnification / 1000.0, z_m - 3.0))
+    spheres = "".join("sphere { <%r, %r, %r>, %r pigment { rgb 1 } finish { ambient 1 diffuse 0 } }\n"
+                      % (c + (radius_mm / 1000.0,)) for c in centres)
+    scene = camera_scene(inline_prescription() + " f_number 8 distance %r" % D,
+                         "  microlens_array { hexagonal pitch 0.1 %s }\n"
+                         "  sensor { pixel_size <%r, %r> offset <%r, %r> } samples 36\n"
+                         % (ARRAY_CASES[case], pixel, pixel, offset[0], offset[1]),
+                         background="rgb 0", objects=spheres)
+    name = "real_lens_projection_" + case.replace(".", "_").replace("-", "_")
+    path = pt.render(args.povray, args.work, name, scene, W, H, timeout=600)
+    image = pt.read_linear(path)[..., :3].mean(axis=2)
+    found = pt.blobs(image, 0.02)
+    metadata = os.path.join(args.work, name + ".plenoptic.json")
+
+    # Each sphere's centre and four points on its rim (across the line of sight): an image of the
+    # centre is compared only when the lens and its six neighbours image all five, so that the
+    # lens lies inside the light of the whole sphere (not at its rim, where the sphere is cut).
+    probes = []
+    for c in centres:
+        r = radius_mm / 1000.0
+        probes += [c, (c[0] + r, c[1], c[2]), (c[0] - r, c[1], c[2]), (c[0], c[1] + r, c[2]), (c[0], c[1] - r, c[2])]
+    hits = pt.run_project(args.project, metadata, probes, fraction=True)
+    by_probe = {}
+    for index, k, l, u, v, fraction in hits:
+        by_probe.setdefault(index, {})[(k, l)] = (u, v, fraction)
+    compared, errors, missing = 0, [], []
+    predicted = []
+    for s in range(len(centres)):
+        own = by_probe.get(5 * s, {})
+        predicted += [(u, v) for (u, v, _) in own.values()]
+        for probe in range(5 * s + 1, 5 * s + 5):
+            predicted += [(u, v) for (u, v, _) in by_probe.get(probe, {}).values()]
+        for lens_kl, (u, v, fraction) in own.items():
+            whole = all(kl in by_probe.get(p, {}) for kl in [lens_kl] + hexagonal_neighbours(*lens_kl)
+                        for p in range(5 * s, 5 * s + 5))
+            if not whole or not (4 <= u <= W - 5 and 4 <= v <= H - 5):
+                continue
+            near = [b for b in found if math.hypot(b["u"] - u, b["v"] - v) <= 3]
+            if not near:
+                missing.append((s, lens_kl, round(u, 2), round(v, 2)))
+                continue
+            best = min(near, key=lambda b: math.hypot(b["u"] - u, b["v"] - v))
+            errors.append(math.hypot(best["u"] - u, best["v"] - v))
+            compared += 1
+    assert compared >= 10, "only %d images wholly seen (hits %d, blobs %d)" % (compared, len(hits), len(found))
+    assert not missing, missing[:5]
+    print("%s: %d images compared, blob centroid - plenoptic-project: mean %.3f px, worst %.3f px"
+          % (case, compared, sum(errors) / len(errors), max(errors)))
+    assert max(errors) <= 0.25, sorted(errors)[-5:]
+    # Every blob of some weight lies near a predicted image (of the centre or of a rim point).
+    fluxes = sorted(b["flux"] for b in found)
+    median = fluxes[len(fluxes) // 2]
+    unexplained = [(round(b["u"], 1), round(b["v"], 1)) for b in found
+                   if b["flux"] > 0.5 * median and not any(math.hypot(b["u"] - u, b["v"] - v) <= 4 for u, v in predicted)]
+    assert not unexplained, unexplained[:5]
