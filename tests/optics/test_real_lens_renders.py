@@ -309,3 +309,43 @@ def test_forward_projection_with_array_matches_render(args, case):
     unexplained = [(round(b["u"], 1), round(b["v"], 1)) for b in found
                    if b["flux"] > 0.5 * median and not any(math.hypot(b["u"] - u, b["v"] - v) <= 4 for u, v in predicted)]
     assert not unexplained, unexplained[:5]
+
+
+def test_depth_map_through_real_lens_matches_reference(args):
+    """The depth map through the test lens (no array): per pixel, the distance (scene units) along
+    its chief ray from where it leaves the front surface to a fronto-parallel wall, against the
+    reference: the ray from the pixel centre through the centre of the paraxial exit pupil, traced
+    through the lens by the reference tracer, met with the wall. Compared where the reference's ray
+    passes every aperture (the camera ignores them for chief rays; so does the formula)."""
+    W, H, pixel = 64, 48, 0.4  # a 25.6 x 19.2 mm sensor: about +-15 degrees
+    lens = reference_lens()
+    par = lt.paraxial_data(lens)
+    D = lt.paraxial_image_distance(lens, 3000.0)
+    wall_units = 1.0  # the wall at scene z = 1: 4 m in front of the front vertex
+    scene = camera_scene(inline_prescription() + " f_number 8 distance %r" % D,
+                         "  sensor { pixel_size <%r, %r> } samples 4 depth_map\n" % (pixel, pixel),
+                         background="rgb 0",
+                         objects="plane { z, %r pigment { rgb 1 } finish { ambient 1 diffuse 0 } }\n" % wall_units)
+    path = pt.render(args.povray, args.work, "real_lens_depth", scene, W, H, timeout=300)
+    depth = pt.read_pixels(os.path.join(args.work, "real_lens_depth.depth.exr"))[..., 0]
+    assert depth.shape == (H, W)
+
+    # Pixel centres on the sensor (optics frame: x right, y up, z = -D; pixel (i, j)'s centre at
+    # x = -(i + 0.5 - W/2) pixel, y = (j + 0.5 - H/2) pixel: the image is inverted).
+    i, j = np.meshgrid(np.arange(W), np.arange(H))
+    sensor = np.stack([-(i + 0.5 - W / 2.0) * pixel, (j + 0.5 - H / 2.0) * pixel, np.full(i.shape, -D)], axis=-1)
+    pupil = np.array([0.0, 0.0, lens.length - par.exit_pupil_z])
+    result = lt.trace_image_to_object(lens, lt.optics_lens_mirror(sensor, lens),
+                                      lt.optics_lens_mirror_directions(pupil - sensor))
+    leave = lt.optics_lens_mirror(result.points, lens)
+    towards = lt.optics_lens_mirror_directions(result.directions)
+    wall_mm = (wall_units + 3.0) * 1000.0 + lens.length  # optics-frame z of the wall
+    expected = (wall_mm - leave[..., 2]) / towards[..., 2] / 1000.0
+    compared = result.passed
+    assert compared.sum() >= 0.5 * W * H, compared.sum()
+    error = np.abs(depth[compared] - expected[compared])
+    print("depth through the real lens: %d pixels compared, largest difference %.2g scene units (of %.3f)"
+          % (compared.sum(), error.max(), float(expected[compared].mean())))
+    assert error.max() <= 1e-5 * expected[compared].max(), error.max()
+    # Pixels whose chief ray the reference blocks still have a depth (apertures are ignored).
+    assert np.all(np.isfinite(depth) & (depth > 0)), "every pixel has a depth"
