@@ -3,7 +3,8 @@
 
   tools/bench                 full run (about an hour on 2 cores); writes benchmarks/results/
   tools/bench --quick         tiny sizes, one run each: checks that the benchmark runs (CI)
-  tools/bench --only trade    one section (overhead, lenses, trade, dark, threads, fullsize, build)
+  tools/bench --only trade    one section (overhead, lenses, trade, dark, threads, fullsize,
+                              real_lens, fullsize_real_lens, build)
   tools/bench --out DIR --report DIR/BENCHMARKS.md
                               a full run that leaves the committed results and report alone
 
@@ -21,5 +22,7 @@ the machine is doing, unlike the wall clock (+-15 % between runs on a shared 2-c
 #   runner     Bench: renders with POV-Ray's trace time, CPU time and peak memory; scene worlds
 #   callgrind  instruction counts of a render (valgrind's callgrind)
 #   overhead, lenses, trade, dark, threads, fullsize, build   the sections (--only NAME)
+#   real_lens  sections real_lens and fullsize_real_lens: a prescription main lens (issue 13),
+#              with the pass-fraction counts of source/plenoptic/plenoptic_pass_fractions.cpp
 #   report     BENCHMARKS.md from results.json; plots
 #   cli        the command line (main)

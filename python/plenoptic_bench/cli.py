@@ -14,6 +14,7 @@ from .dark import section_dark
 from .fullsize import section_fullsize
 from .lenses import section_lenses
 from .overhead import section_overhead
+from .real_lens import section_fullsize_real_lens, section_real_lens
 from .report import plot, write_report
 from .runner import Bench
 from .threads import section_threads
@@ -45,7 +46,8 @@ def main():
         print("bench: %s not found: run tools/build first" % args.povray, file=sys.stderr)
         return 2
     runs = 1 if args.quick else args.runs
-    sections = args.only or ["overhead", "lenses", "trade", "dark", "threads", "fullsize"]
+    sections = args.only or ["overhead", "lenses", "trade", "dark", "threads", "fullsize", "real_lens",
+                             "fullsize_real_lens"]
     os.makedirs(args.out, exist_ok=True)
     work = tempfile.mkdtemp(prefix="plenoptic-bench-")
     b = Bench(os.path.abspath(args.povray), work, runs)
@@ -109,6 +111,17 @@ def main():
             else:
                 section_fullsize(b, 7728, 5368, results)
             done("fullsize")
+        if "real_lens" in sections:
+            section_real_lens(b, args.quick, 1 if args.quick else max(runs, 9), results)
+            save()
+            done("real_lens")
+        if "fullsize_real_lens" in sections:
+            if args.quick:
+                section_fullsize_real_lens(b, 193, 134, results)
+            else:
+                section_fullsize_real_lens(b, 7728, 5368, results)
+            save()
+            done("fullsize_real_lens")
         if "build" in sections:
             section_build(results)
             done("build")

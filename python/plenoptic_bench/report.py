@@ -36,6 +36,103 @@ def lens_table(L, o):
     L.append("")
 
 
+def real_lens_report(L, results):
+    """Section real_lens (and fullsize_real_lens): pass fractions, cost against the thin and thick lens."""
+    L.append("## Real main lens (`--only real_lens`, `--only fullsize_real_lens`)\n")
+    for e in (results.get("real_lens") or {}).get("lenses", []):
+        w, h, px = e["sensor"]
+        L.append("`lenses/%s` (issue 13, docs/real-lenses.md) at f/%g, focused at %g m: EFL %.3f mm, working"
+                 " f-number %.3f. Camera: %gx%g mm sensor (%dx%d pixels of %g um), without an array and with a"
+                 " plenoptic 1.0 array (hexagonal, pitch %g mm, thin microlenses f = d = %.4f mm, matched to the"
+                 " working f-number); the thin lens compared has the same EFL and f-number, `thick_lens` is the"
+                 " prescription's paraxial equivalent.\n" % (e["lens_file"], e["f_number"], e["focus_distance"],
+                 e["efl_mm"], e["working_f_number"], w * px, h * px, w, h, px * 1000, e["pitch_mm"], e["array_focal_mm"]))
+        L.append("**Pass fractions** (counts, not timings): of the camera rays `generate_ray` makes for a pixel"
+                 " (the camera's own samples, `make_sample`, %d per pixel), the fraction that passes the lens;"
+                 " for the pixel itself and for a patch of pixels there (16x16 without an array, two microlens"
+                 " pitches square with one: with an array a single pixel lies at a microimage's centre or"
+                 " between microimages, so the patch is the figure). *Without bounds*: the same aperture samples"
+                 " spread uniformly over the rear element's clear aperture (pbrt's RealisticCamera before its"
+                 " exit-pupil bounds) instead of over the pupil-bounds disc. The wasted fraction is 1 minus the"
+                 " pass fraction. From `source/plenoptic/plenoptic_pass_fractions.cpp`.\n" % e["count_samples"])
+        L.append("| camera | f-number | place | field radius, mm | pixel: passes | patch: passes | patch: wasted |"
+                 " patch without bounds: passes | patch without bounds: wasted |\n|---|---|---|---|---|---|---|---|---|")
+        for cam, d in e["counts"].items():
+            for p in d["places"]:
+                pc, bc = p["pixel_counts"], p["patch_counts"]
+                ub = "unbounded_pass_fraction" in bc
+                L.append("| %s | %g | %s | %.2f | %s | %s | %s | %s | %s |" % (
+                    cam, d["f_number"], p["place"], p["field_radius_mm"], pct(pc["pass_fraction"]),
+                    pct(bc["pass_fraction"]), pct(1 - bc["pass_fraction"]),
+                    pct(bc["unbounded_pass_fraction"]) if ub else "-",
+                    pct(1 - bc["unbounded_pass_fraction"]) if ub else "-"))
+        L.append("")
+        cams = [c for c in ("no array", "no array, smaller stop", "plenoptic 1.0", "plenoptic 1.0, thick_lens")
+                if c in e["counts"]]
+        if cams:
+            base = e["counts"][cams[0]]
+            L.append("Along the centre row (patches from the axis to the sensor's edge; light stops at %.2f mm,"
+                     " where the pupil bounds find none passing):\n" % base["light_field_radius_mm"])
+            head = ["field radius, mm"]
+            for c in cams:
+                head.append(c)
+                if c.startswith("no array"):
+                    head.append(c + ", without bounds")
+            L.append("| " + " | ".join(head) + " |\n|" + "---|" * len(head))
+            for k, p in enumerate(base["profile"]):
+                cells = ["%.2f" % p["field_radius_mm"]]
+                for c in cams:
+                    q = e["counts"][c]["profile"][k]["patch_counts"]
+                    cells.append(pct(q["pass_fraction"]))
+                    if c.startswith("no array"):
+                        cells.append(pct(q["unbounded_pass_fraction"]))
+                L.append("| " + " | ".join(cells) + " |")
+            L.append("")
+        L.append("Commands (the program is built with the optics core, `build/source/plenoptic/`):\n")
+        for cam, d in e["counts"].items():
+            L.append("- %s: `%s`" % (cam, d["command"]))
+        L.append("")
+        c = e.get("cost")
+        if c:
+            L.append("**Cost**: benchmark scene (`benchmarks/scene.inc`), %dx%d, %d samples for every camera,"
+                     " %d interleaved runs (the order rotating every round); ratios to the thin lens of the same"
+                     " array, ratio of medians and median of the ratios of each run to the thin-lens run of its"
+                     " round. CPU time: user + system, minus a 16x16 render of the same scene (start-up and"
+                     " parsing).\n" % (c["size"][0], c["size"][1], c["samples"], c["runs"]))
+            L.append("| camera | trace time, s (median) | ratio to thin | median paired ratio to thin |"
+                     " CPU time for the render, s | CPU ratio to thin | peak RSS, MiB |\n|---|---|---|---|---|---|---|")
+            for r in c["rows"]:
+                L.append("| %s | %.3f | %.3f | %.3f | %.3f | %.3f | %.1f |" % (
+                    r["camera"], r["median_s"], r["ratio_to_thin"], r["median_paired_ratio_to_thin"],
+                    r["cpu_render_s"], r["cpu_ratio_to_thin"], r["peak_rss_mib"]))
+            L.append("")
+        g = e.get("callgrind")
+        if g:
+            L.append("Instruction counts (callgrind, one thread, %dx%d, same field of view, %d samples): as in the"
+                     " overhead section, camera instructions per pixel = (inclusive `TracePixel::operator()` -"
+                     " inclusive outermost `Trace::TraceRay`) / pixels.\n" % (g["size"][0], g["size"][1], g["samples"]))
+            L.append("| camera | total, M instructions | per-pixel work, M instructions | per-pixel work ratio to thin"
+                     " | scene, M instructions | scene rays per pixel | camera instructions per pixel |"
+                     " camera instructions ratio to thin |\n|---|---|---|---|---|---|---|---|")
+            for r in g["rows"]:
+                L.append("| %s | %s | %s | %.3f | %s | %.2f | %.0f | %.2f |" % (
+                    r["camera"], mega(r["total_ir"]), mega(r["pixel_work_ir"]), r["pixel_work_ratio_to_thin"],
+                    mega(r["trace_ray_ir"]), r["trace_ray_calls"] / r["pixels"], r["camera_ir_per_pixel"],
+                    r["camera_ratio_to_thin"]))
+            L.append("")
+    f = results.get("fullsize_real_lens")
+    if f:
+        L.append("**Lytro-class raw through the real lens** (`--only fullsize_real_lens`): the full-size section's"
+                 " camera (%dx%d pixels of 1.4 um, hexagonal 20 um f/2 microlenses, benchmark scene) at %d samples,"
+                 " the main lens at f/2; one run each, interleaved.\n" % (f["size"][0], f["size"][1], f["samples"]))
+        L.append("| main lens | EFL, mm | trace time, s | ratio to thin | CPU time, s | peak RSS, MiB |\n|---|---|---|---|---|---|")
+        for r in f["rows"]:
+            L.append("| %s, `%s` | %.3f | %.1f | %.3f | %.1f | %.0f |" % (
+                r["camera"], r["lens_file"], r["efl_mm"], r["median_s"], r["ratio_to_thin"], r["cpu_s"],
+                r["peak_rss_mib"]))
+        L.append("")
+
+
 def write_report(results, path, plots, results_path):
     """BENCHMARKS.md from results.json: every figure with the command that reproduces it."""
     L = []
@@ -175,6 +272,8 @@ def write_report(results, path, plots, results_path):
         L.append("## Full-size raw (`--only fullsize`)\n")
         L.append("Lytro Illum-class sensor, %dx%d (%.1f Mpx), 1 sample, benchmark scene: trace time %.1f s (median of %d),"
                  " peak RSS %.0f MiB.\n" % (f["size"][0], f["size"][1], f["size"][0] * f["size"][1] / 1e6, f["median_s"], f["runs"], f["peak_rss_mib"]))
+    if results.get("real_lens") or results.get("fullsize_real_lens"):
+        real_lens_report(L, results)
     analysis = os.path.join(ROOT, "benchmarks", "analysis.md")
     if os.path.exists(analysis):
         with open(analysis) as fh:
