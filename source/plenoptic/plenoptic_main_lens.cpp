@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "plenoptic_distortion.h"
 #include "plenoptic_prescription.h"
 #include "plenoptic_sampling.h"
 
@@ -50,9 +51,18 @@ public:
 
 // Ideal thin lens of focal length F in the plane z = 0, aperture disc of diameter A: a ray meeting
 // the plane at m with direction w (unit z component) leaves with w' = w - m / F.
+//
+// With distortion (plenoptic_distortion.h), the image-side ray through m is bent about m so that
+// where the ideal lens's ray would cross the plane z = plane_z (the array, or the sensor) at
+// normalised point u = (x, y) / -plane_z, the real ray crosses it at distort(u): every ray stays
+// straight on both sides, and the object side is the ideal lens's.
 class ThinMainLens : public MainLens {
 public:
-    ThinMainLens(double focal_length_mm, double aperture_mm) : focal_(focal_length_mm), radius_(0.5 * aperture_mm) {}
+    ThinMainLens(double focal_length_mm, double aperture_mm) : focal_(focal_length_mm), radius_(0.5 * aperture_mm),
+        distorted_(false), distortion_(DistortionParams{{0, 0, 0}, {0, 0}}), plane_z_(0) {}
+    ThinMainLens(double focal_length_mm, double aperture_mm, const DistortionParams& distortion, double plane_z)
+        : focal_(focal_length_mm), radius_(0.5 * aperture_mm), distorted_(!is_identity(distortion) && plane_z < 0),
+          distortion_(distortion), plane_z_(plane_z) {}
     MainLensType type() const override { return MainLensType::ThinLens; }
     Vec3 exit_pupil_centre() const override { return Vec3{0, 0, 0}; }
     double exit_pupil_radius() const override { return radius_; }
@@ -70,8 +80,19 @@ public:
         const double my = origin.y + travel * direction.y;
         if (check_apertures && !inside_disc(mx, my, radius_))
             return SceneRay{Vec3{mx, my, 0}, direction, false};  // misses the aperture: carries no light
-        const double wx = direction.x / direction.z - mx / focal_;
-        const double wy = direction.y / direction.z - my / focal_;
+        double sx = direction.x / direction.z, sy = direction.y / direction.z;  // slopes per unit of z
+        if (distorted_) {
+            // The real ray crosses the plane at h; the ideal ray through m crosses it at h_u.
+            const double scale = -plane_z_;
+            const Vec2 h{mx - scale * sx, my - scale * sy};
+            Vec2 ideal;
+            if (!undistort(distortion_, Vec2{h.x / scale, h.y / scale}, &ideal))
+                return SceneRay{Vec3{mx, my, 0}, direction, false};  // beyond the distortion's reach
+            sx = (mx - scale * ideal.x) / scale;
+            sy = (my - scale * ideal.y) / scale;
+        }
+        const double wx = sx - mx / focal_;
+        const double wy = sy - my / focal_;
         return scene_ray(Vec3{mx, my, 0}, Vec3{wx, wy, 1});
     }
     // The reverse of to_scene: arriving with slope a = direction / |direction.z| at m, the ray
@@ -85,16 +106,25 @@ public:
         const double my = origin.y + travel * direction.y;
         if (check_apertures && !inside_disc(mx, my, radius_))
             return ImageRay{Vec3{mx, my, 0}, direction, false};
-        const double ax = direction.x / -direction.z - mx / focal_;
-        const double ay = direction.y / -direction.z - my / focal_;
+        double ax = direction.x / -direction.z - mx / focal_;
+        double ay = direction.y / -direction.z - my / focal_;
+        if (distorted_) {
+            const double scale = -plane_z_;
+            const Vec2 real = distort(distortion_, Vec2{(mx + scale * ax) / scale, (my + scale * ay) / scale});
+            ax = (scale * real.x - mx) / scale;
+            ay = (scale * real.y - my) / scale;
+        }
         return image_ray(Vec3{mx, my, 0}, Vec3{ax, ay, -1});
     }
-    // X' = X / (1 - z / F), written homogeneously.
+    // X' = X / (1 - z / F), written homogeneously (the ideal image: distortion moves it).
     HomogeneousPoint paraxial_image(Vec3 point) const override { return HomogeneousPoint{point, 1 - point.z / focal_}; }
 
 private:
     double focal_;
     double radius_;
+    bool distorted_;
+    DistortionParams distortion_;
+    double plane_z_;
 };
 
 // The paraxial equivalent of a prescription: principal planes at z = front_h and z = rear_h
@@ -241,7 +271,7 @@ ImageRay image_ray(Vec3 origin, Vec3 direction)
     return ImageRay{origin, unit, ok};
 }
 
-std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& p)
+std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& p, double distance_mm)
 {
     if (!p.given)
         return nullptr;
@@ -250,6 +280,8 @@ std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& p)
         return std::make_shared<PinholeMainLens>();
     case MainLensType::ThinLens: {
         const double aperture = p.has_aperture ? p.aperture_mm : p.focal_length_mm / p.f_number;
+        if (p.has_distortion)
+            return std::make_shared<ThinMainLens>(p.focal_length_mm, aperture, p.distortion, -distance_mm);
         return std::make_shared<ThinMainLens>(p.focal_length_mm, aperture);
     }
     case MainLensType::ThickLens:

@@ -72,9 +72,10 @@ struct Prescription;
 // nullptr when the prescription has no paraxial data (afocal, or a pupil at infinity).
 std::shared_ptr<const MainLens> make_prescription_lens(const Prescription& lens, double stop_mm, bool exact);
 
-// The main lens of checked parameters (nullptr for none). D and the rest of the camera are the
-// model's business; a lens knows only itself.
-std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& params);
+// The main lens of checked parameters (nullptr for none). A lens knows only itself, and D
+// (distance_mm: main lens to array, or sensor) only for a thin lens's distortion, which acts on
+// the plane z = -D.
+std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& params, double distance_mm);
 
 // The unit-direction ray (origin, direction); passed false when it is not finite or does not head
 // into the scene (a strong lens or a steep tilt can bend a ray back into the camera body).

@@ -32,7 +32,7 @@ TEST(MainLens, ThinLensRefractsByItsFocalLength)
     p.focal_length_mm = 50;
     p.has_f_number = true;
     p.f_number = 2;
-    const std::shared_ptr<const MainLens> lens = make_main_lens(p);
+    const std::shared_ptr<const MainLens> lens = make_main_lens(p, 100);
     ASSERT_TRUE(lens);
     EXPECT_DOUBLE_EQ(lens->exit_pupil_radius(), 12.5);
     // A ray from the axial point 100 mm behind a 50 mm lens leaves parallel (1/50 = 1/100 + 1/100
@@ -114,7 +114,7 @@ TEST(MainLens, ToImageRetracesToScene)
     thin.has_f_number = true;
     thin.f_number = 2;
     std::vector<std::shared_ptr<const MainLens>> lenses;
-    lenses.push_back(make_main_lens(thin));
+    lenses.push_back(make_main_lens(thin, 100));
     lenses.push_back(make_prescription_lens(singlet(), 0, false));
     lenses.push_back(make_prescription_lens(singlet(), 0, true));
     for (size_t which = 0; which < lenses.size(); ++which) {

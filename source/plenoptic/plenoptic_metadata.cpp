@@ -151,6 +151,14 @@ Json main_lens(const Model& m)
         json["prescription"] = prescription_json(m);
         json["paraxial"] = paraxial_json(m);
     }
+    if (m.has_distortion) {
+        // Radial-tangential polynomial on the plane z = -D, coordinates (x, y) / D.
+        Json distortion = Json::object();
+        distortion["radial"] = numbers(m.distortion.radial, 3);
+        distortion["tangential"] = numbers(m.distortion.tangential, 2);
+        distortion["plane_z_mm"] = number(-m.distance_mm);
+        json["distortion"] = distortion;
+    }
     return json;
 }
 

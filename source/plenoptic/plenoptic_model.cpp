@@ -95,7 +95,7 @@ Model make_model(const CameraParams& params)
 
     const MainLensParams& main = params.main;
     m.main_lens = main.given ? main.type : MainLensType::None;
-    m.lens = make_main_lens(main);
+    m.lens = make_main_lens(main, m.main_lens != MainLensType::None ? main_lens_distance_mm(main, params.mm_per_unit) : 0);
     m.focal_length_mm = 0;
     m.aperture_mm = 0;
     m.f_number = 0;
@@ -103,6 +103,8 @@ Model make_model(const CameraParams& params)
     m.has_focus_distance = false;
     m.focus_distance_units = 0;
     m.lens_length_mm = 0;
+    m.has_distortion = m.main_lens == MainLensType::ThinLens && main.has_distortion;
+    m.distortion = main.distortion;
     if (m.main_lens == MainLensType::ThinLens) {
         m.focal_length_mm = main.focal_length_mm;
         m.aperture_mm = main.has_aperture ? main.aperture_mm : main.focal_length_mm / main.f_number;

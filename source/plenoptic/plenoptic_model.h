@@ -43,6 +43,9 @@ struct Model {
     double aperture_mm;          // A (diameter; a real lens's stop); 0 for pinhole and none
     double f_number;             // F / A (a real lens's: F / entrance-pupil diameter); 0 for pinhole and none
     double distance_mm;          // D (from a real lens's rear vertex); 0 without main lens
+    // A thin lens's parametric distortion (plenoptic_distortion.h), on the plane z = -D.
+    bool has_distortion;
+    DistortionParams distortion;
     // A real lens (thick_lens or prescription): its surfaces as used (stop sized, iris applied),
     // their paraxial data, the file they came from ("" when inline), and its length from the
     // front vertex (where the scene's location puts it) to the rear vertex (the frame's origin).

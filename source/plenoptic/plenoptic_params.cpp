@@ -295,6 +295,16 @@ std::string check_main_lens(const MainLensParams& main, double mm_per_unit)
 
     if (main.has_focus_distance && main.has_distance)
         return "main_lens: give focus_distance or distance, not both";
+    if (main.has_distortion) {
+        if (main.type != MainLensType::ThinLens)
+            return std::string("main_lens distortion { } models a thin_lens's distortion; ") +
+                   (main.type == MainLensType::Pinhole ? "a pinhole has none"
+                                                       : "a real lens has the distortion of its surfaces");
+        // Rays are mapped out to 45 degrees from the lens centre on the image side (normalised
+        // radius 1), beyond any plenoptic camera's field.
+        if (!(message = check_distortion(main.distortion, 1.0)).empty())
+            return message;
+    }
 
     if (main.type == MainLensType::Pinhole) {
         // A pinhole has no focal length, so neither can it focus nor have an f-number.

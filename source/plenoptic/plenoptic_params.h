@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "plenoptic_distortion.h"
 #include "plenoptic_prescription.h"
 
 namespace plenoptic {
@@ -62,6 +63,9 @@ struct MainLensParams {
     double focus_distance_units = 0;        // scene units in front of the lens (its front vertex)
     bool has_distance = false;
     double distance_mm = 0;                 // D: main lens (rear vertex) -> array (-> sensor without array)
+    // distortion { radial <k1, k2, k3> tangential <p1, p2> } (thin lens only; plenoptic_distortion.h)
+    bool has_distortion = false;
+    DistortionParams distortion = {{0, 0, 0}, {0, 0}};
 };
 
 // Whether the main lens is given by a prescription (traced exactly, or as its thick lens).

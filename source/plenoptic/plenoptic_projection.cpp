@@ -662,7 +662,7 @@ std::vector<PixelHit> forward_project(const Model& m, int W, int H, const double
     const Vec3 point{point_mm[0], point_mm[1], point_mm[2]};
     if (!is_finite(point))
         return hits;
-    if (m.main_lens == MainLensType::Prescription)
+    if (m.main_lens == MainLensType::Prescription || m.has_distortion)
         return forward_project_traced(m, W, H, point, default_traced_projection_options());
     if (m.grid == GridType::None) {
         if (!(point.z > 0))

@@ -35,7 +35,8 @@ struct PixelHit {
 // lens: each lens images the point along the line through its centre (a camera array). No array:
 // the chief ray through the main-lens centre. Points at or behind the main-lens plane image nowhere.
 // A thick lens is the thin lens between its principal planes, its exit pupil the aperture. A traced
-// (prescription) lens has no closed form: forward_project_traced (plenoptic_traced_projection.h).
+// (prescription) lens and a distorted thin lens have no closed form: forward_project_traced
+// (plenoptic_traced_projection.h).
 std::vector<PixelHit> forward_project(const Model& model, int W, int H, const double point_mm[3]);
 
 } // namespace plenoptic

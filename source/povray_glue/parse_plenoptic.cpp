@@ -34,7 +34,8 @@ const char *kPlenopticKeywords =
 	"and the placement keywords of every camera (location, look_at, sky, right, up, direction, rotate, "
 	"translate, scale, matrix, transform)";
 const char *kMainLensKeywords = "thin_lens, pinhole, thick_lens, lens_file, prescription { }, focal_length, f_number, aperture, "
-	"focus_distance, distance, blades, blade_rotation";
+	"focus_distance, distance, blades, blade_rotation, distortion { }";
+const char *kDistortionKeywords = "radial <k1, k2, k3>, tangential <p1, p2>";
 const char *kPrescriptionKeywords = "surface { }, stop { }";
 const char *kSurfaceKeywords = "radius, thickness, ior, aperture";
 const char *kStopKeywords = "thickness, aperture";
@@ -50,10 +51,10 @@ enum class Word
 	// the camera's own words: identifiers everywhere else
 	MainLens, MicrolensArray, Sensor, ThinLens, Pinhole, FocalLength, FocalLengths, FNumber,
 	FocusDistance, Hexagonal, Rectangular, Pitch, PixelSize, DepthMap,
-	ThickLens, LensFile, Prescription, Surface, Stop, Blades, BladeRotation,
+	ThickLens, LensFile, Prescription, Surface, Stop, Blades, BladeRotation, Distortion, Tangential,
 	// stock reserved words
 	MmPerUnit, Aperture, Distance, Offset, Rotate, Translate, Samples, Confidence, Variance,
-	Radius, Thickness, Ior
+	Radius, Thickness, Ior, Radial
 };
 
 struct ContextWord { const char *text; Word word; };
@@ -64,7 +65,8 @@ const ContextWord kContextWords[] = {
 	{"hexagonal", Word::Hexagonal}, {"rectangular", Word::Rectangular}, {"pitch", Word::Pitch},
 	{"pixel_size", Word::PixelSize}, {"depth_map", Word::DepthMap}, {"thick_lens", Word::ThickLens},
 	{"lens_file", Word::LensFile}, {"prescription", Word::Prescription}, {"surface", Word::Surface},
-	{"stop", Word::Stop}, {"blades", Word::Blades}, {"blade_rotation", Word::BladeRotation}
+	{"stop", Word::Stop}, {"blades", Word::Blades}, {"blade_rotation", Word::BladeRotation},
+	{"distortion", Word::Distortion}, {"tangential", Word::Tangential}
 };
 
 struct StockWord { TOKEN token; Word word; };
@@ -73,7 +75,7 @@ const StockWord kStockWords[] = {
 	{DISTANCE_TOKEN, Word::Distance}, {OFFSET_TOKEN, Word::Offset}, {ROTATE_TOKEN, Word::Rotate},
 	{TRANSLATE_TOKEN, Word::Translate}, {SAMPLES_TOKEN, Word::Samples}, {CONFIDENCE_TOKEN, Word::Confidence},
 	{VARIANCE_TOKEN, Word::Variance}, {RADIUS_TOKEN, Word::Radius}, {THICKNESS_TOKEN, Word::Thickness},
-	{IOR_TOKEN, Word::Ior}
+	{IOR_TOKEN, Word::Ior}, {RADIAL_TOKEN, Word::Radial}
 };
 
 // The keyword the current token stands for. A camera word arrives as an undeclared
@@ -267,6 +269,24 @@ void Parser::Parse_Plenoptic_Main_Lens(plenoptic::CameraParams& params)
 			case Word::Distance:
 				lens.distance_mm = Plenoptic_Float("main_lens distance", plenoptic::check_positive_length);
 				lens.has_distance = true;
+				break;
+			case Word::Distortion:
+				// distortion { radial <k1, k2, k3> tangential <p1, p2> } (plenoptic_distortion.h); either may be left out.
+				if (lens.has_distortion)
+					Error("plenoptic camera: main_lens takes one distortion { }, not several.");
+				lens.has_distortion = true;
+				Parse_Begin();
+				for (Get_Token(); Word_Of(Token) != Word::CloseBlock; Get_Token())
+				{
+					if (Word_Of(Token) == Word::Radial)
+						Plenoptic_Values("distortion radial", lens.distortion.radial, 3, NULL);
+					else if (Word_Of(Token) == Word::Tangential)
+						Plenoptic_Values("distortion tangential", lens.distortion.tangential, 2, NULL);
+					else
+						Plenoptic_Unknown("distortion", kDistortionKeywords);
+				}
+				UNGET
+				Parse_End();
 				break;
 			default:
 				Plenoptic_Unknown("main_lens", kMainLensKeywords);

@@ -297,6 +297,16 @@ void read_main_lens(const Json& root, CameraParams* params)
         const double f_number = positive_number(n, parent + ".f_number");
         check_close(parent + ".f_number", f_number, m.focal_length_mm / m.aperture_mm, f_number,
                     "focal_length_mm / aperture_mm");
+        if (main.contains("distortion")) {
+            const std::string d = parent + ".distortion";
+            const Json& distortion = object_member(main, parent, "distortion");
+            numbers(distortion, d, "radial", 3, false, m.distortion.radial);
+            numbers(distortion, d, "tangential", 2, false, m.distortion.tangential);
+            m.has_distortion = true;
+            const double plane = finite_number(member(distortion, d, "plane_z_mm"), d + ".plane_z_mm");
+            const double D = positive_number(member(main, parent, "distance_mm"), parent + ".distance_mm");
+            check_close(d + ".plane_z_mm", plane, -D, D, "-main_lens.distance_mm");
+        }
     } else if (type == "thick_lens" || type == "prescription") {
         m.type = type == "thick_lens" ? MainLensType::ThickLens : MainLensType::Prescription;
         read_prescription(object_member(main, parent, "prescription"), parent + ".prescription", &m);
