@@ -48,21 +48,24 @@ def real_lens_report(L, results):
                  " prescription's paraxial equivalent.\n" % (e["lens_file"], e["f_number"], e["focus_distance"],
                  e["efl_mm"], e["working_f_number"], w * px, h * px, w, h, px * 1000, e["pitch_mm"], e["array_focal_mm"]))
         L.append("**Pass fractions** (counts, not timings): of the camera rays `generate_ray` makes for a pixel"
-                 " (the camera's own samples, `make_sample`, %d per pixel), the fraction that passes the lens;"
+                 " (the camera's own samples, `make_sample`, %d per pixel unless the table says otherwise), the"
+                 " fraction that passes the lens;"
                  " for the pixel itself and for a patch of pixels there (16x16 without an array, two microlens"
                  " pitches square with one: with an array a single pixel lies at a microimage's centre or"
                  " between microimages, so the patch is the figure). *Without bounds*: the same aperture samples"
                  " spread uniformly over the rear element's clear aperture (pbrt's RealisticCamera before its"
                  " exit-pupil bounds) instead of over the pupil-bounds disc. The wasted fraction is 1 minus the"
                  " pass fraction. From `source/plenoptic/plenoptic_pass_fractions.cpp`.\n" % e["count_samples"])
-        L.append("| camera | f-number | place | field radius, mm | pixel: passes | patch: passes | patch: wasted |"
-                 " patch without bounds: passes | patch without bounds: wasted |\n|---|---|---|---|---|---|---|---|---|")
+        L.append("| camera | f-number | samples per pixel | place | field radius, mm | pixel: passes | patch |"
+                 " patch: passes | patch: wasted | patch without bounds: passes | patch without bounds: wasted |"
+                 "\n|---|---|---|---|---|---|---|---|---|---|---|")
         for cam, d in e["counts"].items():
             for p in d["places"]:
                 pc, bc = p["pixel_counts"], p["patch_counts"]
                 ub = "unbounded_pass_fraction" in bc
-                L.append("| %s | %g | %s | %.2f | %s | %s | %s | %s | %s |" % (
-                    cam, d["f_number"], p["place"], p["field_radius_mm"], pct(pc["pass_fraction"]),
+                L.append("| %s | %g | %d | %s | %.2f | %s | %dx%d px | %s | %s | %s | %s |" % (
+                    cam, d["f_number"], d["samples"], p["place"], p["field_radius_mm"], pct(pc["pass_fraction"]),
+                    d["patch"], d["patch"],
                     pct(bc["pass_fraction"]), pct(1 - bc["pass_fraction"]),
                     pct(bc["unbounded_pass_fraction"]) if ub else "-",
                     pct(1 - bc["unbounded_pass_fraction"]) if ub else "-"))
@@ -75,9 +78,10 @@ def real_lens_report(L, results):
                      " where the pupil bounds find none passing):\n" % base["light_field_radius_mm"])
             head = ["field radius, mm"]
             for c in cams:
-                head.append(c)
+                label = "%s (f/%g)" % (c, e["counts"][c]["f_number"])
+                head.append(label)
                 if c.startswith("no array"):
-                    head.append(c + ", without bounds")
+                    head.append(label + ", without bounds")
             L.append("| " + " | ".join(head) + " |\n|" + "---|" * len(head))
             for k, p in enumerate(base["profile"]):
                 cells = ["%.2f" % p["field_radius_mm"]]
