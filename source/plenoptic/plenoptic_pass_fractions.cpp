@@ -269,7 +269,6 @@ int main(int argc, char** argv)
         std::printf(" \"array\": null,\n");
     std::printf(" \"sensor\": {\"width\": %d, \"height\": %d, \"pixel_size_mm\": %.9g}, \"samples\": %d, "
                 "\"patch\": %d,\n \"places\": [\n", W, H, o.pixel_mm, o.samples, patch);
-    Count whole_pixels, whole_patches;
     for (int k = 0; k < 3; ++k) {
         const Place& p = places[k];
         Count pixel, block;
