@@ -199,12 +199,8 @@ private:
 class ExactMainLens : public MainLens {
 public:
     ExactMainLens(const Prescription& lens, double length, const ThickMainLens& paraxial)
-        : lens_(lens), unbounded_(lens), length_(length), paraxial_(paraxial)
+        : lens_(lens), unbounded_(unbounded(lens)), length_(length), paraxial_(paraxial)
     {
-        // Chief rays and depth maps want a ray for every pixel: no clear aperture blocks.
-        for (LensSurface& surface : unbounded_.surfaces)
-            surface.aperture_mm = INFINITY;
-        unbounded_.blades = 0;
     }
     MainLensType type() const override { return MainLensType::Prescription; }
     Vec3 exit_pupil_centre() const override { return paraxial_.exit_pupil_centre(); }
@@ -213,7 +209,7 @@ public:
     SceneRay to_scene(Vec3 origin, Vec3 direction, bool check_apertures) const override
     {
         const LensRay in{Vec3{origin.x, origin.y, length_ - origin.z}, normalized(Vec3{direction.x, direction.y, -direction.z})};
-        const Traced out = trace_from_image(check_apertures ? lens_ : unbounded_, in);
+        const Traced out = (check_apertures ? lens_ : unbounded_).trace_from_image(in);
         if (out.result != TraceResult::Passed)
             return SceneRay{origin, direction, false};
         return scene_ray(Vec3{out.ray.origin.x, out.ray.origin.y, length_ - out.ray.origin.z},
@@ -222,7 +218,7 @@ public:
     ImageRay to_image(Vec3 origin, Vec3 direction, bool check_apertures) const override
     {
         const LensRay in{Vec3{origin.x, origin.y, length_ - origin.z}, normalized(Vec3{direction.x, direction.y, -direction.z})};
-        const Traced out = trace_from_object(check_apertures ? lens_ : unbounded_, in);
+        const Traced out = (check_apertures ? lens_ : unbounded_).trace_from_object(in);
         if (out.result != TraceResult::Passed)
             return ImageRay{origin, direction, false};
         return image_ray(Vec3{out.ray.origin.x, out.ray.origin.y, length_ - out.ray.origin.z},
@@ -231,8 +227,16 @@ public:
     HomogeneousPoint paraxial_image(Vec3 point) const override { return paraxial_.paraxial_image(point); }
 
 private:
-    Prescription lens_;
-    Prescription unbounded_;  // the same without clear apertures or iris
+    TracingLens lens_;
+    // Chief rays and depth maps want a ray for every pixel: no clear aperture blocks.
+    static Prescription unbounded(Prescription lens)
+    {
+        for (LensSurface& surface : lens.surfaces)
+            surface.aperture_mm = INFINITY;
+        lens.blades = 0;
+        return lens;
+    }
+    TracingLens unbounded_;  // the same without clear apertures or iris
     double length_;
     ThickMainLens paraxial_;
 };

@@ -162,9 +162,10 @@ bool meet_surface(const LensSurface& s, double z, const LensRay& ray, Vec3* hit,
     return true;
 }
 
-Traced trace(const Prescription& lens, const LensRay& in, bool from_image)
+// z[i]: vertex of surface i; before[i], after[i]: the indices on either side of it.
+Traced trace(const Prescription& lens, const double* z, const double* before, const double* after, const LensRay& in,
+             bool from_image)
 {
-    const std::vector<double> z = vertex_positions(lens);
     const int count = int(lens.surfaces.size());
     LensRay ray{in.origin, normalized(in.dir)};
     for (int step = 0; step < count; ++step) {
@@ -182,10 +183,8 @@ Traced trace(const Prescription& lens, const LensRay& in, bool from_image)
         const double r = 0.5 * s.aperture_mm;
         if (hit.x * hit.x + hit.y * hit.y > r * r)
             return Traced{TraceResult::ClearAperture, LensRay{hit, ray.dir}, i};
-        const double before = i == 0 ? 1.0 : medium_after(lens, i - 1);
-        const double after = s.ior;
         Vec3 dir;
-        if (!refract(ray.dir, normal, from_image ? after : before, from_image ? before : after, &dir))
+        if (!refract(ray.dir, normal, from_image ? after[i] : before[i], from_image ? before[i] : after[i], &dir))
             return Traced{TraceResult::TotalInternalReflection, LensRay{hit, ray.dir}, i};
         ray = LensRay{hit, dir};
     }
@@ -347,8 +346,30 @@ ImageDistance paraxial_image_distance(const Prescription& lens, double object_mm
     return ImageDistance{std::isfinite(s) && s > 0, s};
 }
 
-Traced trace_from_image(const Prescription& lens, const LensRay& in) { return trace(lens, in, true); }
-Traced trace_from_object(const Prescription& lens, const LensRay& in) { return trace(lens, in, false); }
+TracingLens::TracingLens(const Prescription& lens)
+    : lens_(lens), z_(vertex_positions(lens)), before_(lens.surfaces.size()), after_(lens.surfaces.size())
+{
+    double n = 1;
+    for (size_t i = 0; i < lens.surfaces.size(); ++i) {
+        before_[i] = n;
+        if (!lens.surfaces[i].stop)
+            n = lens.surfaces[i].ior;
+        after_[i] = lens.surfaces[i].stop ? before_[i] : lens.surfaces[i].ior;
+    }
+}
+
+Traced TracingLens::trace_from_image(const LensRay& in) const
+{
+    return trace(lens_, z_.data(), before_.data(), after_.data(), in, true);
+}
+
+Traced TracingLens::trace_from_object(const LensRay& in) const
+{
+    return trace(lens_, z_.data(), before_.data(), after_.data(), in, false);
+}
+
+Traced trace_from_image(const Prescription& lens, const LensRay& in) { return TracingLens(lens).trace_from_image(in); }
+Traced trace_from_object(const Prescription& lens, const LensRay& in) { return TracingLens(lens).trace_from_object(in); }
 
 double stop_diameter_for_f_number(const Prescription& lens, double f_number)
 {

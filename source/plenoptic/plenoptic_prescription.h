@@ -118,6 +118,21 @@ Traced trace_from_image(const Prescription& lens, const LensRay& in);
 // The same from the object side towards the image (dir.z > 0), first surface to last.
 Traced trace_from_object(const Prescription& lens, const LensRay& in);
 
+// A prescription with what tracing needs worked out once (each vertex's z, the index on either
+// side of each surface), so that a trace allocates nothing and costs linear time in the surfaces:
+// the per-ray form of the two functions above, which build one each call.
+class TracingLens {
+public:
+    explicit TracingLens(const Prescription& lens);
+    const Prescription& prescription() const { return lens_; }
+    Traced trace_from_image(const LensRay& in) const;
+    Traced trace_from_object(const LensRay& in) const;
+
+private:
+    Prescription lens_;
+    std::vector<double> z_, before_, after_;
+};
+
 // Stop diameter (mm) giving the paraxial f-number N (efl / entrance pupil diameter).
 double stop_diameter_for_f_number(const Prescription& lens, double f_number);
 
