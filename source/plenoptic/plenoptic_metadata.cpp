@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "plenoptic_distortion_profile.h"
 #include "plenoptic_optics.h"
 
 namespace plenoptic {
@@ -17,6 +18,9 @@ namespace plenoptic {
 namespace {
 
 using Json = nlohmann::ordered_json;
+
+// Field heights of the distortion profile, 0 to the picture's corner in sixteenths.
+const int kDistortionProfileSamples = 17;
 
 // A finite number, or null (JSON has no NaN or infinity). Whole numbers below 2^53 are stored as
 // integers so that they print without a fraction ("1000", not "1000.0"; -0 as 0); every other
@@ -137,7 +141,32 @@ Json paraxial_json(const Model& m)
     return json;
 }
 
-Json main_lens(const Model& m)
+// The chief ray's image height over the field against the paraxial one (null when the lens has
+// no profile).
+Json distortion_profile_json(const Model& m, int W, int H)
+{
+    const DistortionProfile profile = distortion_profile(m, W, H, kDistortionProfileSamples);
+    if (!profile.valid)
+        return nullptr;
+    Json json = Json::object();
+    json["object_plane_z_mm"] = profile.object_at_infinity ? Json(nullptr) : number(profile.object_plane_z_mm);
+    json["image_plane_z_mm"] = number(profile.image_plane_z_mm);
+    json["chief_ray"] = m.main_lens == MainLensType::Prescription
+                            ? "through the centre of the aperture stop (traced)"
+                            : (m.main_lens == MainLensType::ThickLens ? "through the centre of the entrance pupil (paraxial model)"
+                                                                      : "through the lens centre");
+    json["columns"] = Json::array({"relative_field", "field_angle_deg", "paraxial_height_mm", "real_height_mm", "distortion_percent"});
+    Json samples = Json::array();
+    for (const DistortionSample& s : profile.samples) {
+        const double percent = s.paraxial_height_mm > 0 ? 100 * (s.real_height_mm / s.paraxial_height_mm - 1) : NAN;
+        samples.push_back(Json::array({number(s.relative_field), number(s.field_angle_deg), number(s.paraxial_height_mm),
+                                       number(s.real_height_mm), number(percent)}));
+    }
+    json["samples"] = samples;
+    return json;
+}
+
+Json main_lens(const Model& m, int W, int H)
 {
     const bool has_focal = m.main_lens == MainLensType::ThinLens || is_prescription_type(m.main_lens);
     Json json = Json::object();
@@ -159,6 +188,7 @@ Json main_lens(const Model& m)
         distortion["plane_z_mm"] = number(-m.distance_mm);
         json["distortion"] = distortion;
     }
+    json["distortion_profile"] = distortion_profile_json(m, W, H);
     return json;
 }
 
@@ -219,10 +249,44 @@ Json lftoolbox(const MicroimageLattice& lattice)
     return json;
 }
 
+Json microimages_json(const MicroimageSummary* summary)
+{
+    if (summary == nullptr)
+        return nullptr;
+    Json json = Json::object();
+    json["file"] = summary->file;
+    json["columns"] = Json::array({"k", "l", "u", "v", "lit_fraction", "residual_u", "residual_v"});
+    json["lenses"] = summary->lenses;
+    json["lit_lenses"] = summary->lit_lenses;
+    Json integration = Json::object();
+    integration["azimuths"] = summary->options.azimuths;
+    integration["tolerance_px"] = number(summary->options.tolerance_px);
+    integration["aperture_points"] = summary->options.aperture_points;
+    json["integration"] = integration;
+    const LatticeFit& fit = summary->fit;
+    if (fit.valid) {
+        Json f = Json::object();
+        f["origin_px"] = numbers(fit.origin_px, 2);
+        f["basis_px"] = Json::array({numbers(fit.basis_a_px, 2), numbers(fit.basis_b_px, 2)});
+        f["lenses"] = fit.lenses;
+        f["rms_residual_px"] = number(fit.rms_residual_px);
+        f["max_residual_px"] = number(fit.max_residual_px);
+        f["max_residual_lens"] = Json::array({fit.worst.k, fit.worst.l});
+        json["lattice_fit"] = f;
+    } else {
+        json["lattice_fit"] = nullptr;
+    }
+    Json from = Json::object();
+    from["rms_px"] = number(summary->from_lattice_rms_px);
+    from["max_px"] = number(summary->from_lattice_max_px);
+    json["from_microimage_lattice"] = from;
+    return json;
+}
+
 } // namespace
 
 std::string metadata_json(const Model& m, const CameraParams& params, int W, int H, const CameraFrame& frame,
-                          const std::string& depth_map_file)
+                          const std::string& depth_map_file, const MicroimageSummary* microimages)
 {
     Json json = Json::object();
     json["format"] = "povray-plenoptic-metadata";
@@ -239,7 +303,7 @@ std::string metadata_json(const Model& m, const CameraParams& params, int W, int
     camera_frame["direction"] = numbers(frame.direction, 3);
     json["camera_frame"] = camera_frame;
 
-    json["main_lens"] = main_lens(m);
+    json["main_lens"] = main_lens(m, W, H);
     json["microlens_array"] = microlens_array(m, params);
 
     Json sensor = Json::object();
@@ -264,6 +328,7 @@ std::string metadata_json(const Model& m, const CameraParams& params, int W, int
     json["microimage_lattice"] = lattice_json(m, lattice);
     json["lftoolbox_lenslet_grid_model"] = lftoolbox(lattice);
     json["depth_map"] = depth_map_file.empty() ? Json(nullptr) : Json(depth_map_file);
+    json["microimages"] = microimages_json(microimages);
 
     std::string text;
     layout(json, 0, false, &text);

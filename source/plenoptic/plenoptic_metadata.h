@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "plenoptic_microimages.h"
 #include "plenoptic_model.h"
 
 namespace plenoptic {
@@ -22,9 +23,11 @@ struct CameraFrame {
 // documented order). `depth_map_file` empty writes null; a file name that is not UTF-8 has each
 // invalid byte replaced by U+FFFD. Numbers are written in the shortest form that reads back to
 // the same double (0.15), whole numbers below 2^53 without a fraction (1000); a number that is
-// not finite is written as null.
+// not finite is written as null. `microimages`: the summary of the microimages file written
+// beside the image, or nullptr (null in the JSON).
 std::string metadata_json(const Model& model, const CameraParams& params, int W, int H,
-                          const CameraFrame& frame, const std::string& depth_map_file);
+                          const CameraFrame& frame, const std::string& depth_map_file,
+                          const MicroimageSummary* microimages = nullptr);
 
 } // namespace plenoptic
 

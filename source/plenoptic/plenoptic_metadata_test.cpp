@@ -144,11 +144,12 @@ TEST(Metadata, KeysComeInTheDocumentedOrder)
     typedef std::vector<std::string> Names;
     EXPECT_EQ(keys(doc), (Names{"format", "version", "image", "mm_per_unit", "camera_frame", "main_lens",
                                 "microlens_array", "sensor", "samples", "principal_point_px", "microimage_lattice",
-                                "lftoolbox_lenslet_grid_model", "depth_map"}));
+                                "lftoolbox_lenslet_grid_model", "depth_map", "microimages"}));
     EXPECT_EQ(keys(doc["image"]), (Names{"width", "height"}));
     EXPECT_EQ(keys(doc["camera_frame"]), (Names{"location", "right", "up", "direction"}));
     EXPECT_EQ(keys(doc["main_lens"]),
-              (Names{"type", "focal_length_mm", "aperture_mm", "f_number", "distance_mm", "focus_distance"}));
+              (Names{"type", "focal_length_mm", "aperture_mm", "f_number", "distance_mm", "focus_distance",
+                     "distortion_profile"}));
     EXPECT_EQ(keys(doc["microlens_array"]), (Names{"grid", "lens", "pitch_mm", "focal_lengths_mm", "distance_mm",
                                                     "rotate_deg", "translate_mm"}));
     EXPECT_EQ(keys(doc["sensor"]), (Names{"pixel_size_mm", "offset_mm", "plane_z_mm"}));
@@ -280,7 +281,8 @@ TEST(Metadata, LayoutIsOneMemberPerLineWithArraysOnOneLine)
     EXPECT_TRUE(has(json, "\n  \"image\": {\n    \"width\": 640,\n    \"height\": 480\n  },\n")) << json;
     EXPECT_TRUE(has(json, "\n  \"samples\": {\"adaptive\": false, \"min\": ")) << json;
     EXPECT_TRUE(has(json, "\n    \"basis_px\": [[")) << json;
-    EXPECT_EQ(json.substr(json.size() - 22), "  \"depth_map\": null\n}\n") << json;
+    EXPECT_TRUE(has(json, "\n  \"depth_map\": null,\n")) << json;
+    EXPECT_EQ(json.substr(json.size() - 24), "  \"microimages\": null\n}\n") << json;
 }
 
 TEST(Metadata, LatticeFieldsMatchTheMicroimageLattice)
@@ -299,6 +301,68 @@ TEST(Metadata, LatticeFieldsMatchTheMicroimageLattice)
     EXPECT_EQ(origin[0].get<double>(), lattice.origin_px[0]);
     EXPECT_EQ(origin[1].get<double>(), lattice.origin_px[1]);
     EXPECT_NEAR(lattice.h_spacing, 0.5 * (1 + 2.0 / 52) / 0.01, 1e-9);
+}
+
+TEST(Metadata, MicroimagesSummaryIsWrittenAsGiven)
+{
+    const CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2.0, 2.0, 50, 4, 52);
+    const Model m = make_model(p);
+    MicroimageSummary summary = MicroimageSummary();
+    summary.file = "scene.microimages.csv";
+    summary.lenses = 12;
+    summary.lit_lenses = 11;
+    summary.options = default_microimage_options();
+    summary.fit.valid = true;
+    summary.fit.origin_px[0] = 319.5;
+    summary.fit.origin_px[1] = 239.25;
+    summary.fit.basis_a_px[0] = 52;
+    summary.fit.basis_b_px[1] = 45.5;
+    summary.fit.lenses = 11;
+    summary.fit.rms_residual_px = 0.125;
+    summary.fit.max_residual_px = 0.5;
+    summary.fit.worst = LensIndex{-3, 2};
+    summary.from_lattice_rms_px = 0.25;
+    summary.from_lattice_max_px = 1.5;
+    const Json doc = parsed(metadata_json(m, p, 640, 480, kFrame, "", &summary));
+    const Json& mi = doc["microimages"];
+    std::vector<std::string> names;
+    for (auto it = mi.begin(); it != mi.end(); ++it)
+        names.push_back(it.key());
+    EXPECT_EQ(names, (std::vector<std::string>{"file", "columns", "lenses", "lit_lenses", "integration", "lattice_fit",
+                                               "from_microimage_lattice"}));
+    EXPECT_EQ(mi["file"], "scene.microimages.csv");
+    EXPECT_EQ(mi["lenses"], 12);
+    EXPECT_EQ(mi["lit_lenses"], 11);
+    EXPECT_EQ(mi["integration"]["aperture_points"], summary.options.aperture_points);
+    EXPECT_EQ(mi["lattice_fit"]["origin_px"][1].get<double>(), 239.25);
+    EXPECT_EQ(mi["lattice_fit"]["basis_px"][1][1].get<double>(), 45.5);
+    EXPECT_EQ(mi["lattice_fit"]["max_residual_lens"], Json::parse("[-3, 2]"));
+    EXPECT_EQ(mi["from_microimage_lattice"]["max_px"].get<double>(), 1.5);
+    summary.fit.valid = false;
+    EXPECT_TRUE(parsed(metadata_json(m, p, 640, 480, kFrame, "", &summary))["microimages"]["lattice_fit"].is_null());
+}
+
+TEST(Metadata, DistortionProfileOfAThinLensWithDistortion)
+{
+    CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2.0, 2.0, 50, 4, 60);
+    p.main.has_distortion = true;
+    p.main.distortion = DistortionParams{{-0.1, 0, 0}, {0, 0}};
+    const Json doc = parsed(metadata_json(make_model(p), p, 640, 480, kFrame, ""));
+    const Json& profile = doc["main_lens"]["distortion_profile"];
+    ASSERT_TRUE(profile.is_object());
+    EXPECT_EQ(profile["samples"].size(), 17u);
+    EXPECT_EQ(profile["image_plane_z_mm"].get<double>(), -60);
+    EXPECT_NEAR(profile["object_plane_z_mm"].get<double>(), 300, 1e-9);
+    EXPECT_TRUE(profile["samples"][0][4].is_null());  // no percentage on the axis
+    const Json& last = profile["samples"][16];
+    const double h = last[2].get<double>(), r = h / 60;
+    EXPECT_NEAR(last[4].get<double>(), -10 * r * r, 1e-9);  // 100 * k1 r^2
+    // A pinhole main lens has no profile.
+    CameraParams pinhole = p;
+    pinhole.main.type = MainLensType::Pinhole;
+    pinhole.main.has_distortion = false;
+    pinhole.array.lens = MicrolensType::ThinLens;
+    EXPECT_TRUE(parsed(metadata_json(make_model(pinhole), pinhole, 640, 480, kFrame, ""))["main_lens"]["distortion_profile"].is_null());
 }
 
 } // namespace

@@ -31,6 +31,7 @@ namespace
 
 const char *kPlenopticKeywords =
 	"main_lens { }, microlens_array { }, sensor { }, mm_per_unit, samples, confidence, variance, depth_map, "
+	"microimage_centres, "
 	"and the placement keywords of every camera (location, look_at, sky, right, up, direction, rotate, "
 	"translate, scale, matrix, transform)";
 const char *kMainLensKeywords = "thin_lens, pinhole, thick_lens, lens_file, prescription { }, focal_length, f_number, aperture, "
@@ -52,6 +53,7 @@ enum class Word
 	MainLens, MicrolensArray, Sensor, ThinLens, Pinhole, FocalLength, FocalLengths, FNumber,
 	FocusDistance, Hexagonal, Rectangular, Pitch, PixelSize, DepthMap,
 	ThickLens, LensFile, Prescription, Surface, Stop, Blades, BladeRotation, Distortion, Tangential,
+	MicroimageCentres,
 	// stock reserved words
 	MmPerUnit, Aperture, Distance, Offset, Rotate, Translate, Samples, Confidence, Variance,
 	Radius, Thickness, Ior, Radial
@@ -66,7 +68,8 @@ const ContextWord kContextWords[] = {
 	{"pixel_size", Word::PixelSize}, {"depth_map", Word::DepthMap}, {"thick_lens", Word::ThickLens},
 	{"lens_file", Word::LensFile}, {"prescription", Word::Prescription}, {"surface", Word::Surface},
 	{"stop", Word::Stop}, {"blades", Word::Blades}, {"blade_rotation", Word::BladeRotation},
-	{"distortion", Word::Distortion}, {"tangential", Word::Tangential}
+	{"distortion", Word::Distortion}, {"tangential", Word::Tangential},
+	{"microimage_centres", Word::MicroimageCentres}
 };
 
 struct StockWord { TOKEN token; Word word; };
@@ -524,6 +527,7 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 	{
 		params = New.Plenoptic->params;
 		setup->depth_map = New.Plenoptic->depth_map;
+		setup->microimage_centres = New.Plenoptic->microimage_centres;
 	}
 
 	for (Get_Token(); Word_Of(Token) != Word::CloseBlock; Get_Token())
@@ -553,6 +557,10 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 				continue;
 			case Word::DepthMap:
 				setup->depth_map = Plenoptic_Keyword_Follows() || ((int)Allow_Float(1.0) != 0);
+				continue;
+			case Word::MicroimageCentres:
+				setup->microimage_centres = (Plenoptic_Keyword_Follows() || ((int)Allow_Float(1.0) != 0))
+					? plenoptic::CameraSetup::kWrite : plenoptic::CameraSetup::kDoNotWrite;
 				continue;
 			case Word::Aperture:
 				break;  // refused below with focal blur's other words

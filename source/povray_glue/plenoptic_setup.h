@@ -16,6 +16,10 @@ struct CameraSetup {
     CameraParams params;
     Model model;
     bool depth_map = false;  // write <output>.depth.exr beside the image
+    // <output>.microimages.csv: `microimage_centres` on or off; by default written only where the
+    // centres leave the metadata's lattice (a traced prescription, a thin lens with distortion).
+    enum MicroimageCentres { kDefault, kWrite, kDoNotWrite };
+    MicroimageCentres microimage_centres = kDefault;
 
     // Where the camera's last placement keyword (location, look_at, right, up, ...) stands in
     // the scene file: the parser names it when the placement POV-Ray resolves is degenerate.

@@ -3,15 +3,18 @@
 
 #include "povray_glue/plenoptic_sidecar.h"
 
+#include "povray_glue/plenoptic_cancel.h"
 #include "povray_glue/plenoptic_render.h"
 
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <vector>
 
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <ImfChannelList.h>
@@ -47,6 +50,11 @@ std::string temporary_beside(const std::string& path)
     const int fd = mkstemp(buffer.data());
     if (fd < 0)
         return "";
+    // mkstemp creates the file for its owner only; the files beside the image get the permissions
+    // the image gets (0666 less the umask), as any file the program writes.
+    const mode_t mask = umask(0);
+    umask(mask);
+    fchmod(fd, 0666 & ~mask);
     close(fd);
     return std::string(buffer.data());
 }
@@ -56,22 +64,22 @@ void report_failure(const char* what, const std::string& path, int error)
     std::fprintf(stderr, "plenoptic camera: cannot write %s %s: %s\n", what, path.c_str(), std::strerror(error));
 }
 
-bool write_text_atomically(const std::string& path, const std::string& text)
+bool write_text_atomically(const char* what, const std::string& path, const std::string& text)
 {
     const std::string tmp = temporary_beside(path);
     if (tmp.empty()) {
-        report_failure("metadata", path, errno);
+        report_failure(what, path, errno);
         return false;
     }
     FILE* f = std::fopen(tmp.c_str(), "wb");
     if (f == nullptr) {
-        report_failure("metadata", path, errno);
+        report_failure(what, path, errno);
         std::remove(tmp.c_str());
         return false;
     }
     const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
     if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
-        report_failure("metadata", path, errno);
+        report_failure(what, path, errno);
         std::remove(tmp.c_str());
         return false;
     }
@@ -124,6 +132,10 @@ std::string base_name(const std::string& path)
 
 std::string metadata_path_for(const std::string& image_path) { return replace_extension(image_path, ".plenoptic.json"); }
 std::string depth_path_for(const std::string& image_path) { return replace_extension(image_path, ".depth.exr"); }
+std::string microimages_path_for(const std::string& image_path)
+{
+    return replace_extension(image_path, ".microimages.csv");
+}
 
 bool sidecar_write(const std::string& image_path, int W, int H)
 {
@@ -151,8 +163,36 @@ bool sidecar_write(const std::string& image_path, int W, int H)
         else
             ok = false;
     }
-    const std::string json = metadata_json(render->model(), render->setup().params, W, H, render->frame(), depth_file);
-    if (!write_text_atomically(metadata_path_for(image_path), json))
+    // The microimages of a white scene through this camera (a main lens and an array): by default
+    // only where they leave the lattice the metadata gives (docs/real-lenses.md).
+    const Model& model = render->model();
+    const CameraSetup::MicroimageCentres asked = render->setup().microimage_centres;
+    const bool off_lattice = model.main_lens == MainLensType::Prescription || model.has_distortion;
+    std::unique_ptr<MicroimageSummary> microimages;
+    if (model.grid != GridType::None && model.lens &&
+        (asked == CameraSetup::kWrite || (asked == CameraSetup::kDefault && off_lattice))) {
+        const MicroimageOptions options = default_microimage_options();
+        // Seconds for large arrays (about 0.5 ms a lens and thread behind a real lens): say how far.
+        const MicroimageProgress progress = [](std::size_t done, std::size_t total) {
+            if (total >= 20000)
+                std::fprintf(stderr, "plenoptic camera: microimage centres: %zu of %zu lenses\n", done, total);
+        };
+        const std::vector<MicroimageTruth> truth = microimage_truth(model, W, H, options, progress, render_cancel_requested);
+        const std::string path = microimages_path_for(image_path);
+        if (render_cancel_requested()) {
+            std::fprintf(stderr, "plenoptic camera: cancelled: no microimage centres written (%s); the metadata says "
+                                 "\"microimages\": null.\n", path.c_str());
+        } else {
+            MicroimageSummary summary = summarise_microimages(model, W, H, truth, options, base_name(path));
+            if (write_text_atomically("microimage centres", path, microimages_csv(model, truth, summary.fit)))
+                microimages.reset(new MicroimageSummary(summary));
+            else
+                ok = false;
+        }
+    }
+    const std::string json =
+        metadata_json(model, render->setup().params, W, H, render->frame(), depth_file, microimages.get());
+    if (!write_text_atomically("metadata", metadata_path_for(image_path), json))
         ok = false;
     return ok;
 }

@@ -5,7 +5,8 @@ docs/specification.md, section 3. A textured scene through the most involved set
 (thin main lens, multi-focus hexagonal array, rotated and translated, overlapping
 microimages, adaptive sampling, a depth map) is rendered with one thread, with two
 threads, and with two threads and tiny render blocks (a different order of pixels
-across threads). The three images, depth maps and metadata files must be identical.
+across threads). The three images, depth maps, microimage-centre files and metadata files must be
+identical (apart from the files' own names in the metadata).
 """
 import os
 
@@ -22,13 +23,14 @@ camera { plenoptic location <0.15, 0.7, -3> look_at <0, 0.45, 0>
   sensor { pixel_size 0.008 }
   samples 4, 32 confidence 0.95 variance 1/256
   depth_map
+  microimage_centres
 }
 """
 
 
 def test_determinism_across_thread_counts(args):
     runs = [("wt1", ["+WT1"]), ("wt2", ["+WT2"]), ("wt2_bs4", ["+WT2", "+BS4"])]
-    images, depths, metas = {}, {}, {}
+    images, depths, metas, centres = {}, {}, {}, {}
     for name, extra in runs:
         path = pt.render(args.povray, args.work, name, pt.TEXTURED_SCENE + CAMERA, W, H, extra=extra)
         images[name] = pt.load(path)
@@ -36,6 +38,8 @@ def test_determinism_across_thread_counts(args):
         depth_file = meta.get("depth_map")
         depths[name] = pt.load(os.path.join(args.work, depth_file)) if depth_file else None
         meta.pop("depth_map", None)
+        with open(os.path.join(args.work, meta["microimages"].pop("file")), "rb") as f:
+            centres[name] = f.read()
         metas[name] = meta
     ref = "wt1"
     assert depths[ref] is not None, "depth map written" + ": " + ("metadata depth_map: %r" % (depths[ref] is not None))
@@ -47,7 +51,8 @@ def test_determinism_across_thread_counts(args):
             a, b = depths[ref], depths[name]
             same = np.array_equal(a, b) or np.array_equal(np.nan_to_num(a, posinf=-9), np.nan_to_num(b, posinf=-9))
             assert same, "depth map %s == %s" % (name, ref) + ": " + ("%d values differ" % int((np.nan_to_num(a, posinf=-9) != np.nan_to_num(b, posinf=-9)).sum()))
-        assert metas[name] == metas[ref], "metadata %s == %s" % (name, ref) + ": " + ("identical apart from the file name of the depth map: %s" % (metas[name] == metas[ref]))
+        assert metas[name] == metas[ref], "metadata %s == %s" % (name, ref) + ": " + ("identical apart from the names of the depth map and the microimage centres: %s" % (metas[name] == metas[ref]))
+        assert centres[name] == centres[ref], "microimage centres %s == %s: byte for byte" % (name, ref)
     # The image must hold a real picture, or identity would prove little.
     spread = float(images[ref][:, :, :3].std())
     assert spread > 0.05, "the render is not trivial" + ": " + ("standard deviation of the pixels %.3f" % spread)

@@ -28,7 +28,7 @@ import plenoptic_testing as pt
 
 KNOWN_WORDS = {"main_lens", "microlens_array", "sensor", "thin_lens", "pinhole", "focal_length",
                "focal_lengths", "f_number", "focus_distance", "hexagonal", "rectangular", "pitch",
-               "pixel_size", "depth_map"}
+               "pixel_size", "depth_map", "microimage_centres"}
 
 
 def camera_words(parser_source):
@@ -208,6 +208,9 @@ def test_identifiers_named_like_keywords_as_values(args, literal):
     assert named is not None, "the camera written with identifiers does not render:\n" + log_named[-1500:]
     problems = compare(literal, named, "camera with identifiers as values vs literal values")
     a, b = metadata(args.work, "camera-literal"), metadata(args.work, "camera-identifiers")
+    for doc in (a, b):  # the microimage centres' file is named after the image
+        if doc.get("microimages"):
+            doc["microimages"].pop("file")
     for key in sorted((set(a) | set(b)) - {"depth_map"}):  # depth_map names the file
         if a.get(key) != b.get(key):
             problems.append("metadata '%s' differs: %s vs %s" % (key, a.get(key), b.get(key)))

@@ -80,10 +80,13 @@ SCENES = {
 
 ORDER = {
     "": ["format", "version", "image", "mm_per_unit", "camera_frame", "main_lens", "microlens_array", "sensor",
-         "samples", "principal_point_px", "microimage_lattice", "lftoolbox_lenslet_grid_model", "depth_map"],
+         "samples", "principal_point_px", "microimage_lattice", "lftoolbox_lenslet_grid_model", "depth_map",
+         "microimages"],
     "image": ["width", "height"],
     "camera_frame": ["location", "right", "up", "direction"],
-    "main_lens": ["type", "focal_length_mm", "aperture_mm", "f_number", "distance_mm", "focus_distance"],
+    "main_lens": ["type", "focal_length_mm", "aperture_mm", "f_number", "distance_mm", "focus_distance",
+                  "distortion_profile"],
+    "main_lens.distortion_profile": ["object_plane_z_mm", "image_plane_z_mm", "chief_ray", "columns", "samples"],
     "microlens_array": ["grid", "lens", "pitch_mm", "focal_lengths_mm", "distance_mm", "rotate_deg", "translate_mm"],
     "sensor": ["pixel_size_mm", "offset_mm", "plane_z_mm"],
     "samples": ["adaptive", "min", "max", "confidence", "variance"],
@@ -91,6 +94,7 @@ ORDER = {
                            "microimage_diameter_px"],
     "lftoolbox_lenslet_grid_model": ["HSpacing", "VSpacing", "HOffset", "VOffset", "Rot", "Orientation",
                                      "FirstPosShiftRow", "UMax", "VMax"],
+    "microimages": ["file", "columns", "lenses", "lit_lenses", "integration", "lattice_fit", "from_microimage_lattice"],
 }
 
 NUMBER = re.compile(r'"(?:[^"\\]|\\.)*"|(-?\d+(?:\.\d+)?(?:[eE][+-]?\d+)?)')
