@@ -179,11 +179,11 @@ def section_fullsize_real_lens(b, w, h, results):
                     for k, (label, main) in enumerate(cams.items())}
         log("fullsize through %s: %dx%d, 16 samples" % (name, w, h))
         res = b.compare(variants, w, h, runs=1)
-        cpu = b.cpu_runs
+        cpu, wall = b.cpu_runs, b.wall_runs
         thin = res["thin lens, same EFL and f-number"][0]
         for label, (t, m, ts) in res.items():
             rows.append({"lens_file": name, "camera": label, "f_number": LYTRO_F_NUMBER, "efl_mm": efl,
-                         "median_s": t, "runs_s": ts, "cpu_s": cpu[label][0], "peak_rss_mib": m,
-                         "ratio_to_thin": t / thin})
+                         "median_s": t, "runs_s": ts, "cpu_s": cpu[label][0], "wall_s": wall[label][0],
+                         "peak_rss_mib": m, "ratio_to_thin": t / thin})
             log("  %s: %.1f s (%.3fx thin), CPU %.1f s" % (label, t, t / thin, cpu[label][0]))
     results["fullsize_real_lens"] = {"size": [w, h], "samples": 16, "rows": rows}

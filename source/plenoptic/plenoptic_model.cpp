@@ -167,6 +167,8 @@ Model make_model(const CameraParams& params)
         round.blades = 0;
         const std::shared_ptr<const MainLens> traced = make_prescription_lens(round, 0, true);
         m.pupil_bounds = std::make_shared<PupilBounds>(round, *traced, m.grid == GridType::None ? m.sensor_z_mm : m.pose.centre_mm.z);
+        if (m.grid == GridType::None && m.prescription.blades == 0)
+            m.lit_area = std::make_shared<LitAreaTable>(*traced, *m.pupil_bounds);
     }
 
     for (int a = 0; a < 2; ++a) {

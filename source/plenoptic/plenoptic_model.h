@@ -10,6 +10,7 @@
 
 #include "plenoptic_main_lens.h"
 #include "plenoptic_params.h"
+#include "plenoptic_lit_area.h"
 #include "plenoptic_pupil_bounds.h"
 #include "plenoptic_vec.h"
 
@@ -56,6 +57,9 @@ struct Model {
     // Where light passes a traced real lens, for points of the sensor (no array) or of the array
     // plane: what ray generation samples, and what the overlap bound reaches. nullptr otherwise.
     std::shared_ptr<const PupilBounds> pupil_bounds;
+    // Without an array, behind a traced lens with a round stop: the lit area of the exit pupil's
+    // plane per sensor radius, which replaces the per-pixel vignetting probes. nullptr otherwise.
+    std::shared_ptr<const LitAreaTable> lit_area;
     bool has_focus_distance;     // D came from focus_distance
     double focus_distance_units; // as given; 0 when D was given directly
 

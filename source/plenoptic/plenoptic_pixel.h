@@ -138,6 +138,47 @@ Rgbt vignetted_value(const Model& model, int i, int j, int W, int H, int n, int 
     return Rgbt{sum[0] * scale, sum[1] * scale, sum[2] * scale, sum[3] * scale};
 }
 
+// The mean lit area (LitAreaTable) over `points` points of pixel (i, j): those of its sample
+// sequence, so the first of them are its traced samples' sensor points. A table look-up each, no
+// trace.
+inline double mean_lit_area(const Model& model, int i, int j, int W, int H, int points)
+{
+    double total = 0;
+    for (int k = 0; k < points; ++k) {
+        const CameraSample s = make_sample(i, j, k, points);
+        total += model.lit_area->at(sensor_point(model, W, H, i + s.pixel_u, j + s.pixel_v));
+    }
+    return total / points;
+}
+
+// The pixel's value behind a real lens with a lit-area table (Model::lit_area: no array, round
+// stop), from its n > 1 samples: the mean colour of those that passed (`plain`: their colours
+// without the ray weight) times the pixel's lit area, averaged over kVignettingProbesPerSample
+// times as many points of the pixel as samples. The samples that pass are spread uniformly over
+// the pixel's lit (sensor point, pupil point) pairs, so their plain mean is the lit light's mean
+// colour; the table knows the lit area everywhere, so the pixel's vignetting costs look-ups, not
+// traces. With none passed, the first passing point of the same 4n is traced for the colour.
+template <class TraceFn>
+Rgbt lit_area_value(const Model& model, int i, int j, int W, int H, int n, int passed, const double plain[4], TraceFn& trace)
+{
+    const int points = n * kVignettingProbesPerSample;
+    const double lit = mean_lit_area(model, i, j, W, H, points);
+    if (!(lit > 0))
+        return Rgbt{0, 0, 0, 0};
+    if (passed > 0) {
+        const double scale = lit / passed;
+        return Rgbt{plain[0] * scale, plain[1] * scale, plain[2] * scale, plain[3] * scale};
+    }
+    for (int k = n; k < points; ++k) {
+        OpticsRay ray;
+        if (generate_ray(model, W, H, i, j, make_sample(i, j, k, points), nullptr, &ray)) {
+            const Rgbt c = trace(ray);
+            return Rgbt{c.r * lit, c.g * lit, c.b * lit, c.t * lit};
+        }
+    }
+    return Rgbt{0, 0, 0, 0};
+}
+
 } // namespace detail
 
 // Shades pixel (i, j) of a W x H image. For each sample it builds the sample, generates the ray
@@ -147,7 +188,10 @@ Rgbt vignetted_value(const Model& model, int i, int j, int W, int H, int n, int 
 // passed the apertures and the variance of the estimate is below thresholds[n-1] in every
 // channel (r, g, b, t), or samples_max is reached. When some of the n samples were blocked, the
 // value is detail::vignetted_value: the mean of the traced colours times the fraction of 4n
-// sample points that pass (no scene ray for those). With one sample, the chief ray alone.
+// sample points that pass (no scene ray for those). Behind a real lens with a lit-area table
+// (no array, round stop) every pixel of n > 1 samples is the mean colour of its passing samples
+// times its lit area from the table over 4n points (detail::lit_area_value). With one sample,
+// the chief ray alone (weighted by the lit area at the pixel's centre).
 // With overlap modelling, sample n goes through the pixel's lens n mod L (L lenses from
 // overlap_lenses) as sample n / L of that lens's own sample stream (detail::lens_sample), and
 // the value is the sum over lenses of each lens's mean; t is clamped to [0, 1]. A pixel that no
@@ -159,6 +203,22 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
     if (!model.adaptive && !model.model_overlap) {
         // Fixed count through the own lens: the plain mean, without the variance bookkeeping
         // (the common case, and the one whose cost is compared with the stock cameras).
+        if (model.lit_area && count > 1) {
+            double plain[4] = {0, 0, 0, 0};
+            int passed = 0;
+            for (int n = 0; n < count; ++n) {
+                OpticsRay ray;
+                if (generate_ray(model, W, H, i, j, make_sample(i, j, n, count), nullptr, &ray)) {
+                    const Rgbt c = trace(ray);
+                    plain[0] += c.r;
+                    plain[1] += c.g;
+                    plain[2] += c.b;
+                    plain[3] += c.t;
+                    ++passed;
+                }
+            }
+            return detail::lit_area_value(model, i, j, W, H, count, passed, plain, trace);
+        }
         double sum[4] = {0, 0, 0, 0};
         int passed = 0;
         for (int n = 0; n < count; ++n) {
@@ -192,6 +252,7 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
     double value[4], variance[4];
     int n = 0;
     int passed = 0;  // samples that passed the apertures so far
+    double plain[4] = {0, 0, 0, 0};  // their colours without the ray weight (for lit_area_value)
     for (;;) {
         const int stop = std::min(count, n + batch);
         for (; n < stop; ++n) {
@@ -200,7 +261,12 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
             OpticsRay ray;
             Rgbt colour{0, 0, 0, 0};
             if (generate_ray(model, W, H, i, j, sample, model.model_overlap ? &lenses[slot] : nullptr, &ray)) {
-                colour = detail::traced(trace, ray);
+                const Rgbt raw = trace(ray);
+                colour = Rgbt{raw.r * ray.weight, raw.g * ray.weight, raw.b * ray.weight, raw.t * ray.weight};
+                plain[0] += raw.r;
+                plain[1] += raw.g;
+                plain[2] += raw.b;
+                plain[3] += raw.t;
                 ++passed;
             }
             detail::add_sample(&sums[slot], colour);
@@ -222,6 +288,8 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
             std::fabs(variance[2]) < threshold && std::fabs(variance[3]) < threshold)
             break;
     }
+    if (lens_count == 1 && n > 1 && model.lit_area)
+        return detail::lit_area_value(model, i, j, W, H, n, passed, plain, trace);
     if (lens_count == 1 && n > 1 && passed < n)
         return detail::vignetted_value(model, i, j, W, H, n, passed, sums[0].sum, trace);
     detail::estimate(sums, lens_count, value, variance);

@@ -125,7 +125,7 @@ void enclose(double c1, double r1, double c2, double r2, double* c, double* r)
 } // namespace
 
 PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, double plane_z)
-    : pupil_z_(traced.exit_pupil_centre().z), step_mm_(0), field_radius_mm_(0), reach_mm_(0)
+    : plane_z_(plane_z), pupil_z_(traced.exit_pupil_centre().z), step_mm_(0), field_radius_mm_(0), reach_mm_(0)
 {
     const Probe probe{traced, plane_z, pupil_z_};
     // The edge of the field: double a radius until no light passes, then bins up to it.

@@ -38,6 +38,8 @@ public:
     double reach_mm() const { return reach_mm_; }
     // Beyond this distance from the axis, no light passes the lens.
     double field_radius_mm() const { return field_radius_mm_; }
+    // The plane of the points the bounds are for (optics frame, mm).
+    double plane_z() const { return plane_z_; }
 
 private:
     // Per bin i (field radius i * step): the disc for a point on +x, its centre on the x axis.
@@ -45,6 +47,7 @@ private:
         double centre_x;
         double radius;
     };
+    double plane_z_;
     double pupil_z_;
     double step_mm_;
     double field_radius_mm_;

@@ -97,7 +97,8 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
 {
     if (m.grid == GridType::None && m.pupil_bounds && check_apertures) {
         // A real lens: towards a point of the region of the exit pupil's plane where light from p
-        // can pass, weighted by that region's area (see OpticsRay::weight). Chief rays (no
+        // can pass, weighted by that region's area, or by the lit part's when the model has a
+        // lit-area table (see OpticsRay::weight). Chief rays (no
         // aperture check) aim at the exit pupil's centre, below.
         const PupilDisc disc = m.pupil_bounds->disc_for(p);
         if (!(disc.radius > 0))
@@ -106,8 +107,12 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
         const Vec3 on_pupil{disc.centre.x + disc.radius * d.x, disc.centre.y + disc.radius * d.y, disc.centre.z};
         if (!emit(m.lens->to_scene(p, on_pupil - p, true), out))
             return false;
-        const double ratio = disc.radius / m.lens->exit_pupil_radius();
-        out->weight = ratio * ratio;
+        if (m.lit_area) {
+            out->weight = m.lit_area->at(p);
+        } else {
+            const double ratio = disc.radius / m.lens->exit_pupil_radius();
+            out->weight = ratio * ratio;
+        }
         return true;
     }
     if (m.grid == GridType::None) {

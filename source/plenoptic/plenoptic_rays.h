@@ -19,7 +19,9 @@ struct OpticsRay {
     // What the ray's colour counts for in its pixel: 1, except for a real lens without an array,
     // whose samples cover a region of its exit pupil's plane (PupilBounds) rather than the paraxial
     // pupil: the region's area over the paraxial pupil's, so that a pixel's value does not depend
-    // on the region sampled.
+    // on the region sampled. With a lit-area table (Model::lit_area, a round stop): the area of
+    // the region's lit part over the paraxial pupil's, and the pixel averages its passing
+    // samples only (shade_pixel).
     double weight;
 };
 

@@ -545,3 +545,38 @@ def white_image_pinhole_array(lens, D, d, pitch, W, H, sx, sy, samples_per_axis)
             sums += np.bincount(row_points_column[start:start + block][point_index[passed]], minlength=W)
         image[j] = sums / (n * n)
     return image
+
+
+def relative_lit_area_no_array(lens, D, points_xy, samples_per_axis):
+    """For sensor points S = (x, y) on the plane D behind the rear vertex (no array), the area of
+    the exit pupil's plane through which a ray from S passes the whole lens (clear apertures,
+    stop, iris, total internal reflection), over the paraxial exit pupil's area: what a pixel
+    at S records in a uniformly white scene (radiance 1). Returns an array of len(points_xy).
+
+    The area is counted on a samples_per_axis^2 grid of cell centres over a square that holds
+    every ray that can pass: such a ray meets the last surface inside its opening, at a point X
+    with |X_xy| <= a and lens-frame z between the vertex and the opening's edge, so it crosses
+    the exit pupil's plane within a s_max + |S| (s_max - s_min) / 2 of S (1 - s_mid), where s is
+    the fraction of the way from S to X at which the plane lies."""
+    lens = as_lens(lens)
+    data = paraxial_data(lens)
+    last = len(lens.surfaces) - 1
+    a = lens.opening_radius(last)
+    sensor_z = lens.length + D
+    rim_z = [lens.length, lens.length + lens.edge_sag(last)]
+    fractions = [(sensor_z - data.exit_pupil_z) / (sensor_z - z) for z in rim_z]
+    s_min, s_max = min(fractions), max(fractions)
+    s_mid = 0.5 * (s_min + s_max)
+    n = int(samples_per_axis)
+    grid = (np.arange(n) + 0.5) / n * 2.0 - 1.0
+    gx, gy = (g.ravel() for g in np.meshgrid(grid, grid))
+    pupil_area = math.pi * (data.exit_pupil_diameter / 2.0) ** 2
+    out = []
+    for x, y in points_xy:
+        half = a * s_max + math.hypot(x, y) * (s_max - s_min) / 2.0 + 1e-6
+        cx, cy = x * (1.0 - s_mid), y * (1.0 - s_mid)
+        targets = np.stack([cx + half * gx, cy + half * gy, np.full(gx.shape, data.exit_pupil_z)], axis=1)
+        origins = np.tile([x, y, sensor_z], (len(gx), 1))
+        passed = trace_image_to_object(lens, origins, targets - origins).passed
+        out.append(passed.sum() * (2.0 * half / n) ** 2 / pupil_area)
+    return np.array(out)
