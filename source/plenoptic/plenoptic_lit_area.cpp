@@ -59,7 +59,8 @@ double LitAreaTable::at(Vec3 point) const
 {
     if (relative_area_.empty())
         return 0;
-    const double at = std::hypot(point.x, point.y) / step_mm_;
+    // Not hypot: radii of millimetres neither overflow nor underflow, and this runs per sample.
+    const double at = std::sqrt(point.x * point.x + point.y * point.y) / step_mm_;
     if (!(at < kIntervals))
         return 0;
     const size_t i = size_t(at);

@@ -138,37 +138,39 @@ Rgbt vignetted_value(const Model& model, int i, int j, int W, int H, int n, int 
     return Rgbt{sum[0] * scale, sum[1] * scale, sum[2] * scale, sum[3] * scale};
 }
 
-// The mean lit area (LitAreaTable) over `points` points of pixel (i, j): those of its sample
-// sequence, so the first of them are its traced samples' sensor points. A table look-up each, no
-// trace.
-inline double mean_lit_area(const Model& model, int i, int j, int W, int H, int points)
+// Points a side of the grid over which a pixel's lit area is averaged (lit_area_value).
+const int kLitAreaGrid = 4;
+
+// The mean lit area (LitAreaTable) of pixel (i, j): the midpoint rule on a kLitAreaGrid square
+// grid over the pixel. The lit area is smooth across a pixel (a kink where vignetting sets in at
+// most), so the rule's error is second order in the pixel's size; a table look-up each, no trace.
+inline double mean_lit_area(const Model& model, int i, int j, int W, int H)
 {
     double total = 0;
-    for (int k = 0; k < points; ++k) {
-        const CameraSample s = make_sample(i, j, k, points);
-        total += model.lit_area->at(sensor_point(model, W, H, i + s.pixel_u, j + s.pixel_v));
-    }
-    return total / points;
+    for (int b = 0; b < kLitAreaGrid; ++b)
+        for (int a = 0; a < kLitAreaGrid; ++a)
+            total += model.lit_area->at(sensor_point(model, W, H, i + (a + 0.5) / kLitAreaGrid, j + (b + 0.5) / kLitAreaGrid));
+    return total / (kLitAreaGrid * kLitAreaGrid);
 }
 
 // The pixel's value behind a real lens with a lit-area table (Model::lit_area: no array, round
 // stop), from its n > 1 samples: the mean colour of those that passed (`plain`: their colours
-// without the ray weight) times the pixel's lit area, averaged over kVignettingProbesPerSample
-// times as many points of the pixel as samples. The samples that pass are spread uniformly over
-// the pixel's lit (sensor point, pupil point) pairs, so their plain mean is the lit light's mean
-// colour; the table knows the lit area everywhere, so the pixel's vignetting costs look-ups, not
-// traces. With none passed, the first passing point of the same 4n is traced for the colour.
+// without the ray weight) times the pixel's mean lit area (mean_lit_area). The samples that pass
+// are spread uniformly over the pixel's lit (sensor point, pupil point) pairs, so their plain
+// mean is the lit light's mean colour; the table knows the lit area everywhere, so the pixel's
+// vignetting costs look-ups, not traces. With none passed, the first passing point of
+// kVignettingProbesPerSample n points of its sample sequence is traced for the colour.
 template <class TraceFn>
 Rgbt lit_area_value(const Model& model, int i, int j, int W, int H, int n, int passed, const double plain[4], TraceFn& trace)
 {
-    const int points = n * kVignettingProbesPerSample;
-    const double lit = mean_lit_area(model, i, j, W, H, points);
+    const double lit = mean_lit_area(model, i, j, W, H);
     if (!(lit > 0))
         return Rgbt{0, 0, 0, 0};
     if (passed > 0) {
         const double scale = lit / passed;
         return Rgbt{plain[0] * scale, plain[1] * scale, plain[2] * scale, plain[3] * scale};
     }
+    const int points = n * kVignettingProbesPerSample;
     for (int k = n; k < points; ++k) {
         OpticsRay ray;
         if (generate_ray(model, W, H, i, j, make_sample(i, j, k, points), nullptr, &ray)) {
@@ -190,7 +192,7 @@ Rgbt lit_area_value(const Model& model, int i, int j, int W, int H, int n, int p
 // value is detail::vignetted_value: the mean of the traced colours times the fraction of 4n
 // sample points that pass (no scene ray for those). Behind a real lens with a lit-area table
 // (no array, round stop) every pixel of n > 1 samples is the mean colour of its passing samples
-// times its lit area from the table over 4n points (detail::lit_area_value). With one sample,
+// times its lit area from the table, averaged over a 4 x 4 grid (detail::lit_area_value). With one sample,
 // the chief ray alone (weighted by the lit area at the pixel's centre).
 // With overlap modelling, sample n goes through the pixel's lens n mod L (L lenses from
 // overlap_lenses) as sample n / L of that lens's own sample stream (detail::lens_sample), and

@@ -159,7 +159,8 @@ PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, doubl
 
 PupilDisc PupilBounds::disc_for(Vec3 point) const
 {
-    const double r = std::hypot(point.x, point.y);
+    // Not hypot: radii of millimetres neither overflow nor underflow, and this runs per sample.
+    const double r = std::sqrt(point.x * point.x + point.y * point.y);
     const double at = r / step_mm_;
     if (!(at < kBins))
         return PupilDisc{Vec3{0, 0, pupil_z_}, 0};
