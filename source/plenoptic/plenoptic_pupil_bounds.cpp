@@ -171,4 +171,15 @@ PupilDisc PupilBounds::disc_for(Vec3 point) const
     return PupilDisc{Vec3{cx, cy, pupil_z_}, span.radius};
 }
 
+bool PupilBounds::may_pass(Vec3 point, Vec3 direction) const
+{
+    const double t = (pupil_z_ - point.z) / direction.z;
+    if (!(t > 0) || !std::isfinite(t))
+        return true;
+    const PupilDisc disc = disc_for(point);
+    const double x = point.x + t * direction.x - disc.centre.x;
+    const double y = point.y + t * direction.y - disc.centre.y;
+    return x * x + y * y <= disc.radius * disc.radius;
+}
+
 } // namespace plenoptic

@@ -33,6 +33,11 @@ public:
     // exit pupil's plane through which light from the point can pass.
     PupilDisc disc_for(Vec3 point) const;
 
+    // False when the ray from `point` (of the bounds' plane) along `direction` certainly misses the
+    // lens: it crosses the exit pupil's plane outside disc_for(point). True otherwise (the ray may
+    // pass; only the exact trace says), and for a ray that does not head for the pupil's plane.
+    bool may_pass(Vec3 point, Vec3 direction) const;
+
     // The farthest any passing ray crosses the exit pupil's plane from the axis point where the
     // line from a field point through the exit-pupil centre crosses it, over the whole field.
     double reach_mm() const { return reach_mm_; }

@@ -162,6 +162,13 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
     if (m.main_lens == MainLensType::Pinhole)
         return false;  // pinhole + pinhole: refused at parse time, no ray passes both points
 
+    // A real lens behind an array parallel to the sensor: a ray that crosses the exit pupil's plane
+    // outside the pupil-bounds disc of the point where it leaves the array cannot pass the lens
+    // (PupilBounds holds every point through which light from that point passes, and the bounds
+    // were made for points of this plane), so it is blocked without the surface-by-surface trace:
+    // most of the rays at the rims of microimages and their vignetting probes.
+    if (check_apertures && m.pupil_bounds && !m.pose.tilted && !m.pupil_bounds->may_pass(leave, direction))
+        return false;
     // On through the main lens (a ray that misses its apertures carries no light).
     return emit(m.lens->to_scene(leave, direction, check_apertures), out);
 }
