@@ -38,6 +38,7 @@
 #include "plenoptic_params.h"
 #include "plenoptic_pixel.h"
 #include "plenoptic_sampling.h"
+#include "plenoptic_sensor_chain.h"
 
 namespace {
 
@@ -112,6 +113,7 @@ struct Input {
     int pixels[4][2] = {};
     int samples = 1;
     double point[3] = {0, 0, 1};
+    double pixel_value = 0;  // a noise-free value for the sensor's read-out, anything a picture may hold
 };
 
 Input decode(const uint8_t* data, size_t size)
@@ -175,6 +177,23 @@ Input decode(const uint8_t* data, size_t size)
     in.samples = 1 + r.byte() % 8;
     for (double& v : in.point)
         v = r.real();
+
+    // The sensor's read-out (appended: inputs written before it decode as before, without one).
+    SensorChainParams& c = p.sensor.chain;
+    c.given = r.flag();
+    c.bayer = BayerPattern(r.byte() % 5);
+    c.bit_depth = r.integer();
+    c.full_well_e = r.real();
+    c.has_exposure = r.flag();
+    c.exposure_e = r.real();
+    c.read_noise_e = r.real();
+    c.dark_current_e_per_s = r.real();
+    c.exposure_time_s = r.real();
+    c.prnu = r.real();
+    c.dsnu_e = r.real();
+    c.black_level_dn = r.integer();
+    c.seed = std::uint64_t(r.integer());
+    in.pixel_value = r.real();
     return in;
 }
 
@@ -402,6 +421,26 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         return 0;
     }
     accepted_values_are_sane(p);
+    if (p.sensor.chain.given) {
+        // The parser's per-value checks let only these through; with them, every site's DN lies in
+        // range whatever the picture holds (NaN, infinities, negative or huge values).
+        const SensorChainParams& c = p.sensor.chain;
+        const bool values_ok = check_bit_depth("bit_depth", c.bit_depth).empty() &&
+                               check_electrons("full_well", c.full_well_e).empty() &&
+                               (!c.has_exposure || check_electrons("exposure", c.exposure_e).empty()) &&
+                               check_non_negative("read_noise", c.read_noise_e).empty() &&
+                               check_non_negative("dark_current", c.dark_current_e_per_s).empty() &&
+                               check_non_negative("exposure_time", c.exposure_time_s).empty() &&
+                               check_non_negative("prnu", c.prnu).empty() && check_non_negative("dsnu", c.dsnu_e).empty() &&
+                               check_dn("black_level", c.black_level_dn).empty();
+        if (values_ok) {
+            const double maximum = std::ldexp(1.0, c.bit_depth) - 1;
+            for (double v : {in.pixel_value, 0.0, 1.0, 1e300, -1.0, kNaN, kInf}) {
+                const int dn = sensor_dn(c, v, 12345, 1);
+                FUZZ_ASSERT(dn >= 0 && dn <= maximum, "sensor_dn(%g) = %d outside 0..%g", v, dn, maximum);
+            }
+        }
+    }
     const Model m = make_model(p);
     model_is_sane(m);
     const std::vector<std::string> warned = warnings(m);

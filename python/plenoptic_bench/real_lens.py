@@ -73,7 +73,9 @@ def thin_main_of(efl, f_number):
 
 
 def cameras(lens_path, f_number, efl, array_focal, px):
-    """{label: camera} without an array and with the matched plenoptic 1.0 array."""
+    """{label: camera} without an array and with the matched plenoptic 1.0 array. The microimage centres
+    (written by default behind a traced lens with an array) are off: the renders are compared, and
+    the full-size section measures the centres."""
     array = "microlens_array { hexagonal pitch %g focal_length %.9g distance %.9g }" % (PITCH, array_focal, array_focal)
     mains = {"prescription (traced)": prescription_main(lens_path, f_number),
              "thick_lens": prescription_main(lens_path, f_number, thick=True),
@@ -81,7 +83,7 @@ def cameras(lens_path, f_number, efl, array_focal, px):
     out = {}
     for where, arr in (("no array", ""), ("plenoptic 1.0", array + " ")):
         for label, main in mains.items():
-            out["%s, %s" % (label, where)] = "plenoptic %s %s %ssensor { pixel_size %g } samples %d" % (
+            out["%s, %s" % (label, where)] = "plenoptic %s %s %ssensor { pixel_size %g } samples %d microimage_centres off" % (
                 LOCATION, main, arr, px, SAMPLES)
     return out
 

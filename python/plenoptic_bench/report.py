@@ -102,7 +102,8 @@ def real_lens_report(L, results):
                      " %d interleaved runs (the order rotating every round); ratios to the thin lens of the same"
                      " array, ratio of medians and median of the ratios of each run to the thin-lens run of its"
                      " round. CPU time: user + system, minus a 16x16 render of the same scene (start-up and"
-                     " parsing).\n" % (c["size"][0], c["size"][1], c["samples"], c["runs"]))
+                     " parsing). `microimage_centres off` for every camera: the renders are compared (the"
+                     " full-size table below times the centres).\n" % (c["size"][0], c["size"][1], c["samples"], c["runs"]))
             L.append("| camera | trace time, s (median) | ratio to thin | median paired ratio to thin |"
                      " CPU time for the render, s | CPU ratio to thin | peak RSS, MiB |\n|---|---|---|---|---|---|---|")
             for r in c["rows"]:

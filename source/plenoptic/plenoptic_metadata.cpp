@@ -283,10 +283,39 @@ Json microimages_json(const MicroimageSummary* summary)
     return json;
 }
 
+// sensor.read_out: the chain from the noise-free picture to the raw (plenoptic_sensor_chain.h),
+// every parameter as used, or null without one.
+Json read_out_json(const SensorChainParams& c, const std::string& raw_file)
+{
+    if (!c.given)
+        return Json(nullptr);
+    Json out = Json::object();
+    out["raw_file"] = raw_file.empty() ? Json(nullptr) : Json(raw_file);
+    out["bayer"] = c.bayer == BayerPattern::None ? Json(nullptr) : Json(bayer_name(c.bayer));
+    out["bit_depth"] = c.bit_depth;
+    out["full_well_e"] = number(c.full_well_e);
+    out["exposure_e"] = number(exposure_electrons(c));
+    out["read_noise_e"] = number(c.read_noise_e);
+    out["dark_current_e_per_s"] = number(c.dark_current_e_per_s);
+    out["exposure_time_s"] = number(c.exposure_time_s);
+    out["prnu"] = number(c.prnu);
+    out["dsnu_e"] = number(c.dsnu_e);
+    out["black_level_dn"] = c.black_level_dn;
+    out["seed"] = c.seed;
+    const double maximum_dn = std::ldexp(1.0, c.bit_depth) - 1;
+    out["gain_dn_per_e"] = number((maximum_dn - c.black_level_dn) / c.full_well_e);
+    out["chain"] = "signal = Poisson(exposure_e * value + dark_current_e_per_s * exposure_time_s); "
+                   "e = min(signal * (1 + prnu * g) + dsnu_e * h + read_noise_e * n, full_well_e), g and h fixed per "
+                   "site for the seed, n new per frame, all N(0, 1); DN = clamp(black_level_dn + round(e * "
+                   "gain_dn_per_e), 0, 2^bit_depth - 1)";
+    return out;
+}
+
 } // namespace
 
 std::string metadata_json(const Model& m, const CameraParams& params, int W, int H, const CameraFrame& frame,
-                          const std::string& depth_map_file, const MicroimageSummary* microimages)
+                          const std::string& depth_map_file, const MicroimageSummary* microimages,
+                          const std::string& raw_file)
 {
     Json json = Json::object();
     json["format"] = "povray-plenoptic-metadata";
@@ -310,6 +339,7 @@ std::string metadata_json(const Model& m, const CameraParams& params, int W, int
     sensor["pixel_size_mm"] = numbers(m.pixel_size_mm, 2);
     sensor["offset_mm"] = numbers(m.sensor_offset_mm, 2);
     sensor["plane_z_mm"] = number(m.sensor_z_mm);
+    sensor["read_out"] = read_out_json(params.sensor.chain, raw_file);
     json["sensor"] = sensor;
 
     Json samples = Json::object();

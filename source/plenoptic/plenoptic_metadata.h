@@ -24,10 +24,11 @@ struct CameraFrame {
 // invalid byte replaced by U+FFFD. Numbers are written in the shortest form that reads back to
 // the same double (0.15), whole numbers below 2^53 without a fraction (1000); a number that is
 // not finite is written as null. `microimages`: the summary of the microimages file written
-// beside the image, or nullptr (null in the JSON).
+// beside the image, or nullptr (null in the JSON). `raw_file`: the sensor's raw written beside
+// the image (sensor.read_out.raw_file; "" gives null there: asked for but not written).
 std::string metadata_json(const Model& model, const CameraParams& params, int W, int H,
                           const CameraFrame& frame, const std::string& depth_map_file,
-                          const MicroimageSummary* microimages = nullptr);
+                          const MicroimageSummary* microimages = nullptr, const std::string& raw_file = "");
 
 } // namespace plenoptic
 

@@ -152,7 +152,7 @@ TEST(Metadata, KeysComeInTheDocumentedOrder)
                      "distortion_profile"}));
     EXPECT_EQ(keys(doc["microlens_array"]), (Names{"grid", "lens", "pitch_mm", "focal_lengths_mm", "distance_mm",
                                                     "rotate_deg", "translate_mm"}));
-    EXPECT_EQ(keys(doc["sensor"]), (Names{"pixel_size_mm", "offset_mm", "plane_z_mm"}));
+    EXPECT_EQ(keys(doc["sensor"]), (Names{"pixel_size_mm", "offset_mm", "plane_z_mm", "read_out"}));
     EXPECT_EQ(keys(doc["samples"]), (Names{"adaptive", "min", "max", "confidence", "variance"}));
     EXPECT_EQ(keys(doc["microimage_lattice"]), (Names{"origin_px", "basis_px", "index_rule", "exact", "lens_types",
                                                        "lens_type_rule", "microimage_diameter_px"}));
@@ -209,6 +209,35 @@ TEST(Metadata, ExtremeNumbersReadBackExactly)
     EXPECT_EQ(doc["sensor"]["offset_mm"][0].get<double>(), 1e300);
     EXPECT_EQ(doc["sensor"]["offset_mm"][1].get<double>(), 9007199254740994.0);
     EXPECT_EQ(doc["microlens_array"]["rotate_deg"][0].get<double>(), 4503599627370495.5);
+}
+
+TEST(Metadata, SensorReadOut)
+{
+    CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.1, 0.4, 0.4, 50, 4, 52);
+    const Model m = make_model(p);
+    EXPECT_TRUE(parsed(metadata_json(m, p, 64, 48, kFrame, ""))["sensor"]["read_out"].is_null());
+    SensorChainParams& c = p.sensor.chain;
+    c.given = true;
+    c.bayer = BayerPattern::GRBG;
+    c.bit_depth = 10;
+    c.full_well_e = 4500;
+    c.read_noise_e = 3;
+    c.black_level_dn = 64;
+    c.seed = 7;
+    Json out = parsed(metadata_json(m, p, 64, 48, kFrame, "", nullptr, "scene.raw.png"))["sensor"]["read_out"];
+    EXPECT_EQ(out["raw_file"], "scene.raw.png");
+    EXPECT_EQ(out["bayer"], "grbg");
+    EXPECT_EQ(out["bit_depth"], 10);
+    EXPECT_EQ(out["exposure_e"].get<double>(), 4500);  // without `exposure`: the full well
+    EXPECT_EQ(out["read_noise_e"].get<double>(), 3);
+    EXPECT_EQ(out["black_level_dn"], 64);
+    EXPECT_EQ(out["seed"], 7);
+    EXPECT_EQ(out["gain_dn_per_e"].get<double>(), (1023.0 - 64) / 4500);
+    // Asked for but not written (the file could not be written): the parameters, and no file.
+    c.bayer = BayerPattern::None;
+    out = parsed(metadata_json(m, p, 64, 48, kFrame, ""))["sensor"]["read_out"];
+    EXPECT_TRUE(out["raw_file"].is_null());
+    EXPECT_TRUE(out["bayer"].is_null());
 }
 
 TEST(Metadata, StringsAreEscapedAndValidUtf8)

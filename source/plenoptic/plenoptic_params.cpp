@@ -384,7 +384,7 @@ std::string check_sensor(const SensorParams& sensor)
         if (!(message = check_translation("offset", sensor.offset_mm[i])).empty())
             return message;
     }
-    return "";
+    return sensor.chain.given ? check_sensor_chain(sensor.chain) : "";
 }
 
 // The adaptive form tests the variance of the samples taken so far; one sample has none, so a

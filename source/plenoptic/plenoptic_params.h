@@ -8,6 +8,7 @@
 
 #include "plenoptic_distortion.h"
 #include "plenoptic_prescription.h"
+#include "plenoptic_sensor_chain.h"
 
 namespace plenoptic {
 
@@ -101,6 +102,7 @@ struct ArrayParams {
 struct SensorParams {
     double pixel_size_mm[2] = {kDefaultPixelSizeMm, kDefaultPixelSizeMm};
     double offset_mm[2] = {kDefaultSensorOffsetMm, kDefaultSensorOffsetMm};
+    SensorChainParams chain;  // the raw's read-out (plenoptic_sensor_chain.h); chain.given: write it
 };
 
 // `samples N` gives adaptive = false and samples = N.

@@ -41,7 +41,9 @@ const char *kPrescriptionKeywords = "surface { }, stop { }";
 const char *kSurfaceKeywords = "radius, thickness, ior, aperture";
 const char *kStopKeywords = "thickness, aperture";
 const char *kArrayKeywords = "hexagonal, rectangular, pitch, focal_length, focal_lengths, pinhole, distance, rotate, translate";
-const char *kSensorKeywords = "pixel_size, offset";
+const char *kSensorKeywords = "pixel_size, offset, and the read-out to the raw: bayer rggb|bggr|grbg|gbrg, bit_depth, "
+	"full_well, exposure, read_noise, dark_current, exposure_time, prnu, dsnu, black_level, seed";
+const char *kBayerPatterns = "rggb, bggr, grbg, gbrg";
 
 // A keyword as the camera's blocks see it, whether it is one of the camera's own words or a
 // stock reserved word that the blocks read too.
@@ -53,10 +55,11 @@ enum class Word
 	MainLens, MicrolensArray, Sensor, ThinLens, Pinhole, FocalLength, FocalLengths, FNumber,
 	FocusDistance, Hexagonal, Rectangular, Pitch, PixelSize, DepthMap,
 	ThickLens, LensFile, Prescription, Surface, Stop, Blades, BladeRotation, Distortion, Tangential,
-	MicroimageCentres,
+	MicroimageCentres, Bayer, BitDepth, FullWell, Exposure, ReadNoise, DarkCurrent, ExposureTime, Prnu,
+	Dsnu, BlackLevel,
 	// stock reserved words
 	MmPerUnit, Aperture, Distance, Offset, Rotate, Translate, Samples, Confidence, Variance,
-	Radius, Thickness, Ior, Radial
+	Radius, Thickness, Ior, Radial, Seed
 };
 
 struct ContextWord { const char *text; Word word; };
@@ -69,7 +72,10 @@ const ContextWord kContextWords[] = {
 	{"lens_file", Word::LensFile}, {"prescription", Word::Prescription}, {"surface", Word::Surface},
 	{"stop", Word::Stop}, {"blades", Word::Blades}, {"blade_rotation", Word::BladeRotation},
 	{"distortion", Word::Distortion}, {"tangential", Word::Tangential},
-	{"microimage_centres", Word::MicroimageCentres}
+	{"microimage_centres", Word::MicroimageCentres}, {"bayer", Word::Bayer}, {"bit_depth", Word::BitDepth},
+	{"full_well", Word::FullWell}, {"exposure", Word::Exposure}, {"read_noise", Word::ReadNoise},
+	{"dark_current", Word::DarkCurrent}, {"exposure_time", Word::ExposureTime}, {"prnu", Word::Prnu},
+	{"dsnu", Word::Dsnu}, {"black_level", Word::BlackLevel}
 };
 
 struct StockWord { TOKEN token; Word word; };
@@ -90,6 +96,10 @@ Word Word_Of(const Parser::Token_Struct& token)
 	for (size_t i = 0; i < sizeof(kStockWords) / sizeof(kStockWords[0]); i++)
 		if (token.Token_Id == kStockWords[i].token)
 			return kStockWords[i].word;
+	// Reserved words that name float functions (seed) arrive as FLOAT_FUNCT_TOKEN, the word in
+	// Function_Id.
+	if (token.Token_Id == FLOAT_FUNCT_TOKEN && token.Function_Id == SEED_TOKEN)
+		return Word::Seed;
 	if (token.End_Of_File || token.Token_Id == END_OF_FILE_TOKEN || token.Token_Id == STRING_LITERAL_TOKEN ||
 	    token.Token_String == NULL)
 		return Word::None;
@@ -469,6 +479,7 @@ void Parser::Parse_Plenoptic_Sensor(plenoptic::CameraParams& params)
 	// A second sensor { } replaces the first entirely, as the other blocks do.
 	plenoptic::SensorParams& sensor = params.sensor;
 	sensor = plenoptic::SensorParams();
+	plenoptic::SensorChainParams& chain = sensor.chain;
 
 	Parse_Begin();
 	for (Get_Token(); Word_Of(Token) != Word::CloseBlock; Get_Token())
@@ -480,6 +491,67 @@ void Parser::Parse_Plenoptic_Sensor(plenoptic::CameraParams& params)
 				break;
 			case Word::Offset:
 				Plenoptic_Values("sensor offset", sensor.offset_mm, 2, plenoptic::check_translation);
+				break;
+			case Word::Bayer:
+			{
+				// The pattern is a word of its own, read by its text as the camera's keywords are.
+				Get_Token();
+				const char *text = (Token.Token_Id != STRING_LITERAL_TOKEN && !Token.End_Of_File) ? Token.Token_String : NULL;
+				const plenoptic::BayerPattern patterns[] = {plenoptic::BayerPattern::RGGB, plenoptic::BayerPattern::BGGR,
+				                                            plenoptic::BayerPattern::GRBG, plenoptic::BayerPattern::GBRG};
+				bool known = false;
+				for (size_t i = 0; i < sizeof(patterns) / sizeof(patterns[0]) && text != NULL; i++)
+					if (std::strcmp(text, plenoptic::bayer_name(patterns[i])) == 0)
+					{
+						chain.bayer = patterns[i];
+						known = true;
+					}
+				if (!known)
+					Error("plenoptic camera: bayer takes one of %s, not '%s'.", kBayerPatterns,
+					      text != NULL ? text : Get_Token_String(Token.Token_Id));
+				chain.given = true;
+				break;
+			}
+			case Word::BitDepth:
+				chain.bit_depth = (int)Plenoptic_Float("bit_depth", plenoptic::check_bit_depth);
+				chain.given = true;
+				break;
+			case Word::FullWell:
+				chain.full_well_e = Plenoptic_Float("full_well", plenoptic::check_electrons);
+				chain.given = true;
+				break;
+			case Word::Exposure:
+				chain.exposure_e = Plenoptic_Float("exposure", plenoptic::check_electrons);
+				chain.has_exposure = true;
+				chain.given = true;
+				break;
+			case Word::ReadNoise:
+				chain.read_noise_e = Plenoptic_Float("read_noise", plenoptic::check_non_negative);
+				chain.given = true;
+				break;
+			case Word::DarkCurrent:
+				chain.dark_current_e_per_s = Plenoptic_Float("dark_current", plenoptic::check_non_negative);
+				chain.given = true;
+				break;
+			case Word::ExposureTime:
+				chain.exposure_time_s = Plenoptic_Float("exposure_time", plenoptic::check_non_negative);
+				chain.given = true;
+				break;
+			case Word::Prnu:
+				chain.prnu = Plenoptic_Float("prnu", plenoptic::check_non_negative);
+				chain.given = true;
+				break;
+			case Word::Dsnu:
+				chain.dsnu_e = Plenoptic_Float("dsnu", plenoptic::check_non_negative);
+				chain.given = true;
+				break;
+			case Word::BlackLevel:
+				chain.black_level_dn = (int)Plenoptic_Float("black_level", plenoptic::check_dn);
+				chain.given = true;
+				break;
+			case Word::Seed:
+				chain.seed = (std::uint64_t)Plenoptic_Float("seed", plenoptic::check_whole_number);
+				chain.given = true;
 				break;
 			default:
 				Plenoptic_Unknown("sensor", kSensorKeywords);

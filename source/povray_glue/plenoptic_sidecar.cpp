@@ -4,6 +4,7 @@
 #include "povray_glue/plenoptic_sidecar.h"
 
 #include "povray_glue/plenoptic_cancel.h"
+#include "povray_glue/plenoptic_raw_png.h"
 #include "povray_glue/plenoptic_render.h"
 
 #include <cerrno>
@@ -21,6 +22,9 @@
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
+
+#include "base/image/colourspace.h"
+#include "base/image/image.h"
 
 namespace plenoptic {
 
@@ -137,8 +141,11 @@ std::string microimages_path_for(const std::string& image_path)
     return replace_extension(image_path, ".microimages.csv");
 }
 
-bool sidecar_write(const std::string& image_path, int W, int H)
+std::string raw_path_for(const std::string& image_path) { return replace_extension(image_path, ".raw.png"); }
+
+bool sidecar_write(const std::string& image_path, const pov_base::Image& image, const pov_base::GammaCurve* working_gamma)
 {
+    const int W = int(image.GetWidth()), H = int(image.GetHeight());
     const std::shared_ptr<Render> render = take_published_render();
     if (!render)
         return true;
@@ -190,8 +197,33 @@ bool sidecar_write(const std::string& image_path, int W, int H)
                 ok = false;
         }
     }
+    // The sensor's raw: the rendered picture (linear) through the read-out chain.
+    std::string raw_file;
+    const SensorChainParams& chain = render->setup().params.sensor.chain;
+    if (chain.given) {
+        std::vector<float> linear(size_t(W) * H * 3);
+        for (int j = 0; j < H; ++j)
+            for (int i = 0; i < W; ++i) {
+                float* rgb = &linear[(size_t(j) * W + i) * 3];
+                image.GetRGBValue(unsigned(i), unsigned(j), rgb[0], rgb[1], rgb[2]);
+                if (working_gamma != nullptr)
+                    for (int c = 0; c < 3; ++c)
+                        rgb[c] = working_gamma->Decode(rgb[c]);
+            }
+        const bool mosaic = chain.bayer != BayerPattern::None;
+        const std::string png = raw_png(sensor_raw(chain, linear, W, H), W, H, mosaic ? 1 : 3, chain.bit_depth);
+        const std::string path = raw_path_for(image_path);
+        if (png.empty()) {
+            std::fprintf(stderr, "plenoptic camera: cannot encode the raw %s\n", path.c_str());
+            ok = false;
+        } else if (write_text_atomically("raw", path, png)) {
+            raw_file = base_name(path);
+        } else {
+            ok = false;
+        }
+    }
     const std::string json =
-        metadata_json(model, render->setup().params, W, H, render->frame(), depth_file, microimages.get());
+        metadata_json(model, render->setup().params, W, H, render->frame(), depth_file, microimages.get(), raw_file);
     if (!write_text_atomically("metadata", metadata_path_for(image_path), json))
         ok = false;
     return ok;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Ground truth written beside a plenoptic render: the metadata JSON, the microimage centres
-// (with a main lens and an array) and, on request, the depth map. The render publishes its state (plenoptic_render.h) and fills the depth map as it
+// (with a main lens and an array) and, on request, the depth map and the sensor's raw. The render publishes its state (plenoptic_render.h) and fills the depth map as it
 // renders; the front end calls sidecar_write() right after it has written the image, so a
 // render that never writes its image leaves no metadata behind.
 
@@ -9,6 +9,11 @@
 
 #include <string>
 
+namespace pov_base {
+class Image;
+class GammaCurve;
+}
+
 namespace plenoptic {
 
 // Names of the files beside an image `dir/name.ext`.
@@ -16,10 +21,14 @@ std::string metadata_path_for(const std::string& image_path);  // dir/name.pleno
 std::string depth_path_for(const std::string& image_path);     // dir/name.depth.exr
 std::string microimages_path_for(const std::string& image_path);// dir/name.microimages.csv
 
+std::string raw_path_for(const std::string& image_path);        // dir/name.raw.png
+
 // Writes the files for the image just written (if a plenoptic camera rendered it: the published
-// render, which this takes). Returns false, with a message on stderr, when a file could not be written;
-// files are written to a temporary name and renamed, never left half-written.
-bool sidecar_write(const std::string& image_path, int W, int H);
+// render, which this takes). `image`: the picture as rendered, in the working gamma
+// `working_gamma` (nullptr: linear), which the sensor's raw reads. Returns false, with a message
+// on stderr, when a file could not be written; files are written to a temporary name and renamed,
+// never left half-written.
+bool sidecar_write(const std::string& image_path, const pov_base::Image& image, const pov_base::GammaCurve* working_gamma);
 
 } // namespace plenoptic
 

@@ -88,7 +88,7 @@ ORDER = {
                   "distortion_profile"],
     "main_lens.distortion_profile": ["object_plane_z_mm", "image_plane_z_mm", "chief_ray", "columns", "samples"],
     "microlens_array": ["grid", "lens", "pitch_mm", "focal_lengths_mm", "distance_mm", "rotate_deg", "translate_mm"],
-    "sensor": ["pixel_size_mm", "offset_mm", "plane_z_mm"],
+    "sensor": ["pixel_size_mm", "offset_mm", "plane_z_mm", "read_out"],
     "samples": ["adaptive", "min", "max", "confidence", "variance"],
     "microimage_lattice": ["origin_px", "basis_px", "index_rule", "exact", "lens_types", "lens_type_rule",
                            "microimage_diameter_px"],
