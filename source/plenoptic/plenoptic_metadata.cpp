@@ -315,7 +315,7 @@ Json read_out_json(const SensorChainParams& c, const std::string& raw_file)
 
 std::string metadata_json(const Model& m, const CameraParams& params, int W, int H, const CameraFrame& frame,
                           const std::string& depth_map_file, const MicroimageSummary* microimages,
-                          const std::string& raw_file)
+                          const std::string& raw_file, const std::vector<WhiteImageFile>* white_images)
 {
     Json json = Json::object();
     json["format"] = "povray-plenoptic-metadata";
@@ -359,6 +359,19 @@ std::string metadata_json(const Model& m, const CameraParams& params, int W, int
     json["lftoolbox_lenslet_grid_model"] = lftoolbox(lattice);
     json["depth_map"] = depth_map_file.empty() ? Json(nullptr) : Json(depth_map_file);
     json["microimages"] = microimages_json(microimages);
+    if (white_images == nullptr) {
+        json["white_images"] = nullptr;
+    } else {
+        Json list = Json::array();
+        for (const WhiteImageFile& w : *white_images) {
+            Json entry = Json::object();
+            entry["file"] = w.file;
+            entry["f_number"] = w.f_number > 0 ? number(w.f_number) : Json(nullptr);
+            entry["values"] = w.raw ? "dn" : "linear";
+            list.push_back(entry);
+        }
+        json["white_images"] = list;
+    }
 
     std::string text;
     layout(json, 0, false, &text);

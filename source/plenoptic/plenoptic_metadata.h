@@ -5,6 +5,7 @@
 #define PLENOPTIC_METADATA_H
 
 #include <string>
+#include <vector>
 
 #include "plenoptic_microimages.h"
 #include "plenoptic_model.h"
@@ -26,9 +27,18 @@ struct CameraFrame {
 // not finite is written as null. `microimages`: the summary of the microimages file written
 // beside the image, or nullptr (null in the JSON). `raw_file`: the sensor's raw written beside
 // the image (sensor.read_out.raw_file; "" gives null there: asked for but not written).
+// A white image written beside the image (plenoptic_white_image.h).
+struct WhiteImageFile {
+    std::string file;
+    double f_number;   // the main lens's f-number it was computed at (0: no main lens aperture)
+    bool raw;          // true: DN through the sensor's read-out; false: the linear value x 65535
+};
+
+// `white_images`: the white images written (null in the JSON when none was asked for).
 std::string metadata_json(const Model& model, const CameraParams& params, int W, int H,
                           const CameraFrame& frame, const std::string& depth_map_file,
-                          const MicroimageSummary* microimages = nullptr, const std::string& raw_file = "");
+                          const MicroimageSummary* microimages = nullptr, const std::string& raw_file = "",
+                          const std::vector<WhiteImageFile>* white_images = nullptr);
 
 } // namespace plenoptic
 

@@ -144,7 +144,7 @@ TEST(Metadata, KeysComeInTheDocumentedOrder)
     typedef std::vector<std::string> Names;
     EXPECT_EQ(keys(doc), (Names{"format", "version", "image", "mm_per_unit", "camera_frame", "main_lens",
                                 "microlens_array", "sensor", "samples", "principal_point_px", "microimage_lattice",
-                                "lftoolbox_lenslet_grid_model", "depth_map", "microimages"}));
+                                "lftoolbox_lenslet_grid_model", "depth_map", "microimages", "white_images"}));
     EXPECT_EQ(keys(doc["image"]), (Names{"width", "height"}));
     EXPECT_EQ(keys(doc["camera_frame"]), (Names{"location", "right", "up", "direction"}));
     EXPECT_EQ(keys(doc["main_lens"]),
@@ -311,7 +311,8 @@ TEST(Metadata, LayoutIsOneMemberPerLineWithArraysOnOneLine)
     EXPECT_TRUE(has(json, "\n  \"samples\": {\"adaptive\": false, \"min\": ")) << json;
     EXPECT_TRUE(has(json, "\n    \"basis_px\": [[")) << json;
     EXPECT_TRUE(has(json, "\n  \"depth_map\": null,\n")) << json;
-    EXPECT_EQ(json.substr(json.size() - 24), "  \"microimages\": null\n}\n") << json;
+    EXPECT_TRUE(has(json, "\n  \"microimages\": null,\n")) << json;
+    EXPECT_EQ(json.substr(json.size() - 25), "  \"white_images\": null\n}\n") << json;
 }
 
 TEST(Metadata, LatticeFieldsMatchTheMicroimageLattice)

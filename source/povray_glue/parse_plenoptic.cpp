@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "backend/frame.h"
 #include "backend/parser/parse.h"
@@ -31,7 +32,7 @@ namespace
 
 const char *kPlenopticKeywords =
 	"main_lens { }, microlens_array { }, sensor { }, mm_per_unit, samples, confidence, variance, depth_map, "
-	"microimage_centres, "
+	"microimage_centres, white_image, "
 	"and the placement keywords of every camera (location, look_at, sky, right, up, direction, rotate, "
 	"translate, scale, matrix, transform)";
 const char *kMainLensKeywords = "thin_lens, pinhole, thick_lens, lens_file, prescription { }, focal_length, f_number, aperture, "
@@ -56,7 +57,7 @@ enum class Word
 	FocusDistance, Hexagonal, Rectangular, Pitch, PixelSize, DepthMap,
 	ThickLens, LensFile, Prescription, Surface, Stop, Blades, BladeRotation, Distortion, Tangential,
 	MicroimageCentres, Bayer, BitDepth, FullWell, Exposure, ReadNoise, DarkCurrent, ExposureTime, Prnu,
-	Dsnu, BlackLevel,
+	Dsnu, BlackLevel, WhiteImage, FNumbers, NoiseFree,
 	// stock reserved words
 	MmPerUnit, Aperture, Distance, Offset, Rotate, Translate, Samples, Confidence, Variance,
 	Radius, Thickness, Ior, Radial, Seed
@@ -75,7 +76,8 @@ const ContextWord kContextWords[] = {
 	{"microimage_centres", Word::MicroimageCentres}, {"bayer", Word::Bayer}, {"bit_depth", Word::BitDepth},
 	{"full_well", Word::FullWell}, {"exposure", Word::Exposure}, {"read_noise", Word::ReadNoise},
 	{"dark_current", Word::DarkCurrent}, {"exposure_time", Word::ExposureTime}, {"prnu", Word::Prnu},
-	{"dsnu", Word::Dsnu}, {"black_level", Word::BlackLevel}
+	{"dsnu", Word::Dsnu}, {"black_level", Word::BlackLevel}, {"white_image", Word::WhiteImage},
+	{"f_numbers", Word::FNumbers}, {"noise_free", Word::NoiseFree}
 };
 
 struct StockWord { TOKEN token; Word word; };
@@ -600,6 +602,7 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 		params = New.Plenoptic->params;
 		setup->depth_map = New.Plenoptic->depth_map;
 		setup->microimage_centres = New.Plenoptic->microimage_centres;
+		setup->white_image = New.Plenoptic->white_image;
 	}
 
 	for (Get_Token(); Word_Of(Token) != Word::CloseBlock; Get_Token())
@@ -634,6 +637,62 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 				setup->microimage_centres = (Plenoptic_Keyword_Follows() || ((int)Allow_Float(1.0) != 0))
 					? plenoptic::CameraSetup::kWrite : plenoptic::CameraSetup::kDoNotWrite;
 				continue;
+			case Word::WhiteImage:
+			{
+				// white_image [on | off] [f_numbers N | f_numbers <N1, ..., N5>] [noise_free]
+				plenoptic::WhiteImageRequest& white = setup->white_image;
+				white = plenoptic::WhiteImageRequest();
+				white.given = Plenoptic_Keyword_Follows() || ((int)Allow_Float(1.0) != 0);
+				for (;;)
+				{
+					Get_Token();
+					if (Word_Of(Token) == Word::FNumbers)
+					{
+						const pov_base::ITextStream::FilePos position = Token.Token_File_Pos;
+						const int column = Token.Token_Col_No;
+						// One f-number, or a list in angle brackets as a vector's components are read.
+						std::vector<DBL> values;
+						Get_Token();
+						if (Token.Token_Id == LEFT_ANGLE_TOKEN)
+						{
+							for (;;)
+							{
+								values.push_back(Parse_Float());
+								Parse_Comma();
+								Get_Token();
+								if (Token.Token_Id == RIGHT_ANGLE_TOKEN)
+									break;
+								UNGET
+								if ((int)values.size() >= plenoptic::kMaxWhiteImages)
+									Plenoptic_Check_At("white_image f_numbers lists at most " +
+									                   plenoptic::format_number(plenoptic::kMaxWhiteImages) +
+									                   " f-numbers, between '<' and '>'", position, column);
+							}
+						}
+						else
+						{
+							UNGET
+							values.push_back(Parse_Float());
+						}
+						white.f_numbers.clear();
+						for (size_t k = 0; k < values.size(); k++)
+						{
+							Plenoptic_Check_At(plenoptic::check_finite("white_image f_numbers", values[k]), position, column);
+							Plenoptic_Check_At(plenoptic::check_f_number(values[k]).empty() ? "" :
+							                   "white_image f_numbers: " + plenoptic::check_f_number(values[k]), position, column);
+							white.f_numbers.push_back(values[k]);
+						}
+					}
+					else if (Word_Of(Token) == Word::NoiseFree)
+						white.noise_free = true;
+					else
+					{
+						UNGET
+						break;
+					}
+				}
+				continue;
+			}
 			case Word::Aperture:
 				break;  // refused below with focal blur's other words
 			case Word::None:
@@ -699,6 +758,8 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 
 	// The camera's closing brace is current for the checks across blocks.
 	Plenoptic_Check(plenoptic::check_camera(params));
+	if (setup->white_image.given)
+		Plenoptic_Check(plenoptic::check_white_image(setup->white_image, params));
 	UNGET
 	setup->model = plenoptic::make_model(params);
 	std::vector<std::string> warnings = plenoptic::warnings(setup->model);

@@ -9,6 +9,7 @@
 
 #include "plenoptic/plenoptic_model.h"
 #include "plenoptic/plenoptic_params.h"
+#include "plenoptic/plenoptic_white_image.h"
 
 namespace plenoptic {
 
@@ -20,6 +21,8 @@ struct CameraSetup {
     // centres leave the metadata's lattice (a traced prescription, a thin lens with distortion).
     enum MicroimageCentres { kDefault, kWrite, kDoNotWrite };
     MicroimageCentres microimage_centres = kDefault;
+    // `white_image [f_numbers <N...>] [noise_free]`: <output>.white.png (one per f-number).
+    WhiteImageRequest white_image;
 
     // Where the camera's last placement keyword (location, look_at, right, up, ...) stands in
     // the scene file: the parser names it when the placement POV-Ray resolves is degenerate.

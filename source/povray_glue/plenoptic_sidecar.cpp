@@ -222,8 +222,48 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
             ok = false;
         }
     }
-    const std::string json =
-        metadata_json(model, render->setup().params, W, H, render->frame(), depth_file, microimages.get(), raw_file);
+    // White images: the camera alone in front of a white diffuser, at its own aperture or at each
+    // f-number asked for; through the read-out when there is one (its own frame of noise), unless
+    // noise_free.
+    std::unique_ptr<std::vector<WhiteImageFile>> whites;
+    const WhiteImageRequest& white = render->setup().white_image;
+    if (white.given) {
+        whites.reset(new std::vector<WhiteImageFile>());
+        const CameraParams& params = render->setup().params;
+        const int count = white.f_numbers.empty() ? 1 : int(white.f_numbers.size());
+        for (int k = 0; k < count && !render_cancel_requested(); ++k) {
+            const double f_number = white.f_numbers.empty() ? model.f_number : white.f_numbers[size_t(k)];
+            const Model at = white.f_numbers.empty() ? Model() : make_model(at_f_number(params, f_number));
+            const std::vector<float> values =
+                white_image(white.f_numbers.empty() ? model : at, W, H, render_cancel_requested);
+            if (values.empty())
+                break;  // cancelled
+            const bool raw = chain.given && !white.noise_free;
+            std::string png;
+            if (raw) {
+                std::vector<float> rgb(values.size() * 3);
+                for (size_t p = 0; p < values.size(); ++p)
+                    rgb[3 * p] = rgb[3 * p + 1] = rgb[3 * p + 2] = values[p];
+                SensorChainParams frame = chain;
+                frame.seed = chain.seed ^ (0x7768697465000000ULL + std::uint64_t(k + 1));  // "white": its own noise
+                png = raw_png(sensor_raw(frame, rgb, W, H), W, H, chain.bayer != BayerPattern::None ? 1 : 3, chain.bit_depth);
+            } else {
+                std::vector<std::uint16_t> linear(values.size());
+                for (size_t p = 0; p < values.size(); ++p)
+                    linear[p] = std::uint16_t(std::lround(std::min(1.0f, std::max(0.0f, values[p])) * 65535.0f));
+                png = raw_png(linear, W, H, 1, 16);
+            }
+            const std::string path = white_image_path_for(image_path, white, k);
+            if (!png.empty() && write_text_atomically("white image", path, png))
+                whites->push_back(WhiteImageFile{base_name(path), f_number, raw});
+            else
+                ok = false;
+        }
+        if (render_cancel_requested())
+            std::fprintf(stderr, "plenoptic camera: cancelled: white images not all written.\n");
+    }
+    const std::string json = metadata_json(model, render->setup().params, W, H, render->frame(), depth_file,
+                                           microimages.get(), raw_file, whites.get());
     if (!write_text_atomically("metadata", metadata_path_for(image_path), json))
         ok = false;
     return ok;

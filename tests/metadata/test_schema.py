@@ -81,7 +81,7 @@ SCENES = {
 ORDER = {
     "": ["format", "version", "image", "mm_per_unit", "camera_frame", "main_lens", "microlens_array", "sensor",
          "samples", "principal_point_px", "microimage_lattice", "lftoolbox_lenslet_grid_model", "depth_map",
-         "microimages"],
+         "microimages", "white_images"],
     "image": ["width", "height"],
     "camera_frame": ["location", "right", "up", "direction"],
     "main_lens": ["type", "focal_length_mm", "aperture_mm", "f_number", "distance_mm", "focus_distance",
