@@ -60,6 +60,10 @@ def count_passes(program, lens_file, f_number, sensor, samples, array=None, thic
     # As BENCHMARKS.md shows it: the program by name, the lens file relative to the repository.
     d["command"] = " ".join(["plenoptic_pass_fractions"] + [
         os.path.relpath(a, ROOT) if a == lens_file else a for a in cmd[1:]])
+    # The program echoes the lens file as given (an absolute path): results.json is committed and
+    # names no path outside the repository.
+    if d.get("lens_file") == lens_file:
+        d["lens_file"] = os.path.relpath(lens_file, ROOT)
     return d
 
 
