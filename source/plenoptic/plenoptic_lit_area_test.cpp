@@ -77,14 +77,7 @@ TEST(LitArea, IntersectionOfTheStopAndAnOpeningsShadow)
 // pupil bounds), for a triplet whose front and rear elements cut the field into cat's eyes.
 TEST(LitArea, MatchesABruteForceCountThroughATriplet)
 {
-    Prescription lens;
-    lens.surfaces.push_back(LensSurface{30, 6, 1.6, 24, false, 1});
-    lens.surfaces.push_back(LensSurface{-200, 4, 1, 24, false, 2});
-    lens.surfaces.push_back(LensSurface{0, 4, 1, 10, true, 3});
-    lens.surfaces.push_back(LensSurface{-40, 2, 1.6, 14, false, 4});
-    lens.surfaces.push_back(LensSurface{60, 4, 1, 14, false, 5});
-    lens.surfaces.push_back(LensSurface{100, 5, 1.6, 18, false, 6});
-    lens.surfaces.push_back(LensSurface{-40, 0, 1, 18, false, 7});
+    const Prescription lens = test::vignetting_triplet();
     const std::shared_ptr<const MainLens> traced = make_prescription_lens(lens, 0, true);
     const double D = 45;
     const PupilBounds bounds(lens, *traced, -D);

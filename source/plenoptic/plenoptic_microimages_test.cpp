@@ -78,20 +78,7 @@ TEST(MicroimageTruth, ThinLensMicroimagesAreThePupilDiscAboutTheLatticeCentres)
     }
 }
 
-// A made-up triplet of about 53 mm with large outer elements and a small stop: at full aperture
-// the clear apertures clip the off-axis microimages into cat's eyes.
-Prescription vignetting_triplet()
-{
-    Prescription lens;
-    lens.surfaces.push_back(LensSurface{30, 6, 1.6, 24, false, 1});
-    lens.surfaces.push_back(LensSurface{-200, 4, 1, 24, false, 2});
-    lens.surfaces.push_back(LensSurface{0, 4, 1, 10, true, 3});
-    lens.surfaces.push_back(LensSurface{-40, 2, 1.6, 14, false, 4});
-    lens.surfaces.push_back(LensSurface{60, 4, 1, 14, false, 5});
-    lens.surfaces.push_back(LensSurface{100, 5, 1.6, 18, false, 6});
-    lens.surfaces.push_back(LensSurface{-40, 0, 1, 18, false, 7});
-    return lens;
-}
+using test::vignetting_triplet;
 
 TEST(MicroimageTruth, CatsEyesAgreeWithABruteForceCount)
 {

@@ -205,28 +205,15 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
     if (!model.adaptive && !model.model_overlap) {
         // Fixed count through the own lens: the plain mean, without the variance bookkeeping
         // (the common case, and the one whose cost is compared with the stock cameras).
-        if (model.lit_area && count > 1) {
-            double plain[4] = {0, 0, 0, 0};
-            int passed = 0;
-            for (int n = 0; n < count; ++n) {
-                OpticsRay ray;
-                if (generate_ray(model, W, H, i, j, make_sample(i, j, n, count), nullptr, &ray)) {
-                    const Rgbt c = trace(ray);
-                    plain[0] += c.r;
-                    plain[1] += c.g;
-                    plain[2] += c.b;
-                    plain[3] += c.t;
-                    ++passed;
-                }
-            }
-            return detail::lit_area_value(model, i, j, W, H, count, passed, plain, trace);
-        }
+        const bool lit_area = model.lit_area && count > 1;
         double sum[4] = {0, 0, 0, 0};
         int passed = 0;
         for (int n = 0; n < count; ++n) {
             OpticsRay ray;
             if (generate_ray(model, W, H, i, j, make_sample(i, j, n, count), nullptr, &ray)) {
-                const Rgbt c = detail::traced(trace, ray);
+                // With a lit-area table the colours are summed without the ray weight: the
+                // pixel's lit area scales their mean (detail::lit_area_value).
+                const Rgbt c = lit_area ? trace(ray) : detail::traced(trace, ray);
                 sum[0] += c.r;
                 sum[1] += c.g;
                 sum[2] += c.b;
@@ -234,6 +221,8 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
                 ++passed;
             }
         }
+        if (lit_area)
+            return detail::lit_area_value(model, i, j, W, H, count, passed, sum, trace);
         if (count > 1 && passed < count)
             return detail::vignetted_value(model, i, j, W, H, count, passed, sum, trace);
         return Rgbt{sum[0] / count, sum[1] / count, sum[2] / count, sum[3] / count};

@@ -22,19 +22,7 @@
 namespace plenoptic {
 namespace {
 
-// The tests' vignetting triplet: large front and rear elements, a small stop.
-Prescription triplet()
-{
-    Prescription lens;
-    lens.surfaces.push_back(LensSurface{30, 6, 1.6, 24, false, 1});
-    lens.surfaces.push_back(LensSurface{-200, 4, 1, 24, false, 2});
-    lens.surfaces.push_back(LensSurface{0, 4, 1, 10, true, 3});
-    lens.surfaces.push_back(LensSurface{-40, 2, 1.6, 14, false, 4});
-    lens.surfaces.push_back(LensSurface{60, 4, 1, 14, false, 5});
-    lens.surfaces.push_back(LensSurface{100, 5, 1.6, 18, false, 6});
-    lens.surfaces.push_back(LensSurface{-40, 0, 1, 18, false, 7});
-    return lens;
-}
+using test::vignetting_triplet;
 
 Prescription laikin_wide_angle(double f_number)
 {
@@ -102,8 +90,8 @@ void expect_bounds_hold(const Case& c)
 
 TEST(PupilBounds, HoldEveryPassingRayOfTheTriplet)
 {
-    expect_bounds_hold(Case{"triplet, sensor 45 mm behind", triplet(), -45});
-    expect_bounds_hold(Case{"triplet, array 37 mm behind", triplet(), -37});
+    expect_bounds_hold(Case{"triplet, sensor 45 mm behind", vignetting_triplet(), -45});
+    expect_bounds_hold(Case{"triplet, array 37 mm behind", vignetting_triplet(), -37});
 }
 
 TEST(PupilBounds, HoldEveryPassingRayOfTheWideAngle)
@@ -114,7 +102,7 @@ TEST(PupilBounds, HoldEveryPassingRayOfTheWideAngle)
 
 TEST(PupilBounds, MayPassRefusesWhatMissesTheDisc)
 {
-    const Prescription lens = triplet();
+    const Prescription lens = vignetting_triplet();
     const std::shared_ptr<const MainLens> traced = make_prescription_lens(lens, 0, true);
     const PupilBounds bounds(lens, *traced, -45);
     const Vec3 p{2, 1, -45};

@@ -10,6 +10,7 @@
 
 #include "plenoptic_model.h"
 #include "plenoptic_optics.h"
+#include "plenoptic_prescription.h"
 
 namespace plenoptic {
 namespace test {
@@ -22,6 +23,22 @@ inline std::string str(Vec3 v)
     out.precision(17);
     out << "(" << v.x << ", " << v.y << ", " << v.z << ")";
     return out.str();
+}
+
+// A made-up triplet of about 53 mm with large outer elements and a small stop (the Python tests'
+// real_lens_scenes.LENS_ROWS): at full aperture the clear apertures cut the off-axis bundles into
+// cat's eyes.
+inline Prescription vignetting_triplet()
+{
+    Prescription lens;
+    lens.surfaces.push_back(LensSurface{30, 6, 1.6, 24, false, 1});
+    lens.surfaces.push_back(LensSurface{-200, 4, 1, 24, false, 2});
+    lens.surfaces.push_back(LensSurface{0, 4, 1, 10, true, 3});
+    lens.surfaces.push_back(LensSurface{-40, 2, 1.6, 14, false, 4});
+    lens.surfaces.push_back(LensSurface{60, 4, 1, 14, false, 5});
+    lens.surfaces.push_back(LensSurface{100, 5, 1.6, 18, false, 6});
+    lens.surfaces.push_back(LensSurface{-40, 0, 1, 18, false, 7});
+    return lens;
 }
 
 inline Vec3 origin_of(const OpticsRay& r) { return Vec3{r.origin_mm[0], r.origin_mm[1], r.origin_mm[2]}; }

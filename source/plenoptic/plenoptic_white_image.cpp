@@ -49,13 +49,14 @@ std::vector<float> white_image(const Model& model, int W, int H, const std::func
     std::vector<float> out(size_t(std::max(0, W)) * std::max(0, H), 0.0f);
     std::atomic<int> next_row(0);
     std::atomic<bool> stop(false);
+    auto shade_row = [&](int j) {
+        for (int i = 0; i < W; ++i)
+            out[size_t(j) * W + i] =
+                float(shade_pixel(model, i, j, W, H, [](const OpticsRay&) { return Rgbt{1, 1, 1, 1}; }).r);
+    };
     auto work = [&]() {
-        for (int j = next_row++; j < H && !stop; j = next_row++) {
-            for (int i = 0; i < W; ++i) {
-                const Rgbt v = shade_pixel(model, i, j, W, H, [](const OpticsRay&) { return Rgbt{1, 1, 1, 1}; });
-                out[size_t(j) * W + i] = float(v.r);
-            }
-        }
+        for (int j = next_row++; j < H && !stop; j = next_row++)
+            shade_row(j);
     };
     const unsigned hardware = std::thread::hardware_concurrency();
     const int count = threads > 0 ? threads : int(std::max(1u, hardware));
@@ -68,10 +69,7 @@ std::vector<float> white_image(const Model& model, int W, int H, const std::func
             stop = true;
             break;
         }
-        for (int i = 0; i < W; ++i) {
-            const Rgbt v = shade_pixel(model, i, j, W, H, [](const OpticsRay&) { return Rgbt{1, 1, 1, 1}; });
-            out[size_t(j) * W + i] = float(v.r);
-        }
+        shade_row(j);
     }
     for (std::thread& worker : workers)
         worker.join();
@@ -80,15 +78,11 @@ std::vector<float> white_image(const Model& model, int W, int H, const std::func
     return out;
 }
 
-std::string white_image_path_for(const std::string& image_path, const WhiteImageRequest& request, int k)
+std::string white_image_suffix(const WhiteImageRequest& request, int k)
 {
-    const size_t slash = image_path.find_last_of('/');
-    const size_t dot = image_path.find_last_of('.');
-    const bool has_ext = dot != std::string::npos && (slash == std::string::npos || dot > slash + 1);
-    const std::string stem = has_ext ? image_path.substr(0, dot) : image_path;
     if (request.f_numbers.empty())
-        return stem + ".white.png";
-    return stem + ".white.f" + format_number(request.f_numbers[size_t(k)]) + ".png";
+        return ".white.png";
+    return ".white.f" + format_number(request.f_numbers[size_t(k)]) + ".png";
 }
 
 } // namespace plenoptic

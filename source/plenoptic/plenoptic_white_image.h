@@ -38,9 +38,9 @@ CameraParams at_f_number(const CameraParams& params, double f_number);
 // result does not depend on their number. Returns an empty vector when `cancelled` says so.
 std::vector<float> white_image(const Model& model, int W, int H, const std::function<bool()>& cancelled, int threads = 0);
 
-// The file for f-number index k of a request beside `image_path`: dir/name.white.png for the
-// camera's own aperture, dir/name.white.f<N>.png for f_numbers (N shortest: f2, f5.6).
-std::string white_image_path_for(const std::string& image_path, const WhiteImageRequest& request, int k);
+// What replaces the image's extension for f-number index k of a request: ".white.png" for the
+// camera's own aperture, ".white.f<N>.png" for f_numbers (N shortest: f2, f5.6).
+std::string white_image_suffix(const WhiteImageRequest& request, int k);
 
 } // namespace plenoptic
 

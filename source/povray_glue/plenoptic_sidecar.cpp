@@ -232,10 +232,12 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
         const CameraParams& params = render->setup().params;
         const int count = white.f_numbers.empty() ? 1 : int(white.f_numbers.size());
         for (int k = 0; k < count && !render_cancel_requested(); ++k) {
-            const double f_number = white.f_numbers.empty() ? model.f_number : white.f_numbers[size_t(k)];
-            const Model at = white.f_numbers.empty() ? Model() : make_model(at_f_number(params, f_number));
-            const std::vector<float> values =
-                white_image(white.f_numbers.empty() ? model : at, W, H, render_cancel_requested);
+            const bool own = white.f_numbers.empty();
+            const double f_number = own ? model.f_number : white.f_numbers[size_t(k)];
+            std::unique_ptr<Model> other;
+            if (!own)
+                other.reset(new Model(make_model(at_f_number(params, f_number))));
+            const std::vector<float> values = white_image(own ? model : *other, W, H, render_cancel_requested);
             if (values.empty())
                 break;  // cancelled
             const bool raw = chain.given && !white.noise_free;
@@ -253,7 +255,7 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
                     linear[p] = std::uint16_t(std::lround(std::min(1.0f, std::max(0.0f, values[p])) * 65535.0f));
                 png = raw_png(linear, W, H, 1, 16);
             }
-            const std::string path = white_image_path_for(image_path, white, k);
+            const std::string path = replace_extension(image_path, white_image_suffix(white, k));
             if (!png.empty() && write_text_atomically("white image", path, png))
                 whites->push_back(WhiteImageFile{base_name(path), f_number, raw});
             else
