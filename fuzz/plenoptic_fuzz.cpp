@@ -33,6 +33,7 @@
 #include <limits>
 #include <string>
 
+#include "plenoptic_diffraction.h"
 #include "plenoptic_metadata.h"
 #include "plenoptic_optics.h"
 #include "plenoptic_params.h"
@@ -194,6 +195,11 @@ Input decode(const uint8_t* data, size_t size)
     c.black_level_dn = r.integer();
     c.seed = std::uint64_t(r.integer());
     in.pixel_value = r.real();
+    // Radiometry and diffraction (appended likewise).
+    p.radiometry = r.flag() ? Radiometry::Irradiance : Radiometry::Flat;
+    p.diffraction.given = r.flag();
+    for (double& v : p.diffraction.wavelengths_nm)
+        v = r.real();
     return in;
 }
 
@@ -421,6 +427,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         return 0;
     }
     accepted_values_are_sane(p);
+    // Diffraction's checks (wavelengths while parsed, the aperture at the camera's brace, the
+    // pattern's size once the model is built): refused inputs end here, as in the parser.
+    for (double v : p.diffraction.wavelengths_nm)
+        if (p.diffraction.given && !check_wavelength(v).empty()) {
+            g_input = nullptr;
+            return 0;
+        }
+    if (!check_diffraction(p.diffraction, p).empty()) {
+        g_input = nullptr;
+        return 0;
+    }
     if (p.sensor.chain.given) {
         // The parser's per-value checks let only these through; with them, every site's DN lies in
         // range whatever the picture holds (NaN, infinities, negative or huge values).
@@ -443,6 +460,20 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     }
     const Model m = make_model(p);
     model_is_sane(m);
+    if (check_diffraction_size(m, p.diffraction).empty()) {
+        // The picture keeps its light through the convolution and stays finite.
+        const Diffraction d = diffraction_of(m, p.diffraction);
+        if (d.applied && in.W * in.H <= 48 * 48) {
+            const std::vector<AiryKernel> kernels = channel_kernels(m, d);
+            std::vector<float> picture(size_t(in.W) * in.H * 3, 0.5f);
+            FUZZ_ASSERT(convolve_channels(picture, in.W, in.H, 3, kernels.data(), nullptr, 1), "convolution cancelled");
+            for (float v : picture)
+                FUZZ_ASSERT(std::isfinite(v) && v >= 0 && v <= 0.5f + 1e-5f, "convolved value %g", double(v));
+        }
+    } else {
+        g_input = nullptr;
+        return 0;
+    }
     const std::vector<std::string> warned = warnings(m);
     for (const std::string& w : warned)
         FUZZ_ASSERT(!w.empty(), "empty warning");
@@ -475,6 +506,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
             });
             FUZZ_ASSERT(std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b) && std::isfinite(v.t),
                         "shade_pixel (%d, %d) = (%g, %g, %g, %g)", i, j, v.r, v.g, v.b, v.t);
+            // A white world: no pixel is negative or NaN, under either radiometry.
+            const Rgbt white = shade_pixel(m, i, j, W, H, [](const OpticsRay&) { return Rgbt{1, 1, 1, 1}; });
+            FUZZ_ASSERT(std::isfinite(white.r) && white.r >= 0, "white pixel (%d, %d) = %g", i, j, white.r);
         }
     }
     // forward_project visits every lens that can image into the picture (bounded at 2^22 lenses);

@@ -15,6 +15,7 @@ from .fullsize import section_fullsize
 from .lenses import section_lenses
 from .overhead import section_overhead
 from .real_lens import section_fullsize_real_lens, section_real_lens
+from .realism import section_realism
 from .report import plot, write_report
 from .runner import Bench
 from .threads import section_threads
@@ -47,7 +48,7 @@ def main():
         return 2
     runs = 1 if args.quick else args.runs
     sections = args.only or ["overhead", "lenses", "trade", "dark", "threads", "fullsize", "real_lens",
-                             "fullsize_real_lens"]
+                             "fullsize_real_lens", "realism"]
     os.makedirs(args.out, exist_ok=True)
     work = tempfile.mkdtemp(prefix="plenoptic-bench-")
     b = Bench(os.path.abspath(args.povray), work, runs)
@@ -122,6 +123,10 @@ def main():
                 section_fullsize_real_lens(b, 7728, 5368, results)
             save()
             done("fullsize_real_lens")
+        if "realism" in sections:
+            section_realism(b, (64, 48) if args.quick else (1440, 960), runs, 24 if args.quick else 96, results)
+            save()
+            done("realism")
         if "build" in sections:
             section_build(results)
             done("build")

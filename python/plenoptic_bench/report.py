@@ -36,6 +36,30 @@ def lens_table(L, o):
     L.append("")
 
 
+def realism_report(L, results):
+    """Section realism: radiometry, diffraction and the read-out against the plain render."""
+    r = results["realism"]
+    L.append("## Radiometry, diffraction and the sensor's read-out (`--only realism`)\n")
+    L.append("Issue 14's costs, each against the plain render of the same camera: the benchmark scene through"
+             " Lytro-class optics (6.45 mm f/2 thin lens, hexagonal 14 um f/2 microlenses at d = f, 1.4 um pixels),"
+             " %dx%d, %d samples, %d interleaved runs each. Diffraction and the read-out run after the trace, so"
+             " the times are the whole process's (clock and CPU), not POV-Ray's trace time.\n"
+             % (r["size"][0], r["size"][1], r["samples"], r["runs"]))
+    L.append("| variant | whole process, s (median) | ratio | paired ratio (median) | CPU, s | CPU ratio | peak RSS, MiB |")
+    L.append("|---|---|---|---|---|---|---|")
+    for row in r["rows"]:
+        L.append("| %s | %.2f | %.3fx | %.3fx | %.2f | %.3fx | %.0f |" % (
+            row["variant"], row["median_wall_s"], row["ratio"], row["median_paired_ratio"], row["cpu_s"],
+            row["cpu_ratio"], row["peak_rss_mib"]))
+    cg = results.get("realism_callgrind")
+    if cg:
+        L.append("\nInstructions of the whole process (callgrind, one thread, %dx%d):\n" % (cg["size"], cg["size"]))
+        L.append("| variant | instructions | ratio |\n|---|---|---|")
+        for row in cg["rows"]:
+            L.append("| %s | %.4g | %.3fx |" % (row["variant"], row["total_ir"], row["total_ratio"]))
+    L.append("")
+
+
 def real_lens_report(L, results):
     """Section real_lens (and fullsize_real_lens): pass fractions, cost against the thin and thick lens."""
     L.append("## Real main lens (`--only real_lens`, `--only fullsize_real_lens`)\n")
@@ -283,6 +307,8 @@ def write_report(results, path, plots, results_path):
                  " peak RSS %.0f MiB.\n" % (f["size"][0], f["size"][1], f["size"][0] * f["size"][1] / 1e6, f["median_s"], f["runs"], f["peak_rss_mib"]))
     if results.get("real_lens") or results.get("fullsize_real_lens"):
         real_lens_report(L, results)
+    if results.get("realism"):
+        realism_report(L, results)
     analysis = os.path.join(ROOT, "benchmarks", "analysis.md")
     if os.path.exists(analysis):
         with open(analysis) as fh:

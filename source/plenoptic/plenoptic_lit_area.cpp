@@ -6,12 +6,15 @@
 // area-preserving polar map. The lens is symmetric about the plane y = 0 through P (centred
 // spherical surfaces, round stop), so the lower half passes where the upper half does, and the
 // half disc at kPoints points is the whole disc at twice as many. Lit area = disc area times
-// the passing share.
+// the passing share (each passing point counting with its irradiance weight under irradiance
+// radiometry).
 
 #include "plenoptic_lit_area.h"
 
 #include <cmath>
 #include <cstdint>
+
+#include "plenoptic_radiometry.h"
 
 namespace plenoptic {
 
@@ -22,13 +25,14 @@ const int kPoints = 987;        // lattice points on the half disc (a Fibonacci 
 const int kLatticeStep = 610;   // F15: the Fibonacci lattice's generator
 const double kPi = 3.14159265358979323846;
 
-double relative_lit_area(const MainLens& traced, const PupilBounds& bounds, double r, double paraxial_area)
+double relative_lit_area(const MainLens& traced, const PupilBounds& bounds, double r, double paraxial_area,
+                         double irradiance_k_mm2)
 {
     const Vec3 from{r, 0, bounds.plane_z()};
     const PupilDisc disc = bounds.disc_for(from);
     if (!(disc.radius > 0))
         return 0;
-    int passing = 0;
+    double passing = 0;
     for (int k = 0; k < kPoints; ++k) {
         const double u = (k + 0.5) / kPoints;
         const double v = double((std::int64_t(k) * kLatticeStep) % kPoints) / kPoints + 0.5 / kPoints;
@@ -36,7 +40,7 @@ double relative_lit_area(const MainLens& traced, const PupilBounds& bounds, doub
         const double angle = kPi * v;
         const Vec3 target{disc.centre.x + rho * std::cos(angle), disc.centre.y + rho * std::sin(angle), disc.centre.z};
         if (traced.to_scene(from, target - from, true).passed)
-            ++passing;
+            passing += irradiance_k_mm2 > 0 ? irradiance_weight(irradiance_k_mm2, from, target, Vec3{0, 0, 1}) : 1.0;
     }
     const double disc_area = kPi * disc.radius * disc.radius;
     return disc_area * passing / kPoints / paraxial_area;
@@ -44,7 +48,7 @@ double relative_lit_area(const MainLens& traced, const PupilBounds& bounds, doub
 
 } // namespace
 
-LitAreaTable::LitAreaTable(const MainLens& traced, const PupilBounds& bounds)
+LitAreaTable::LitAreaTable(const MainLens& traced, const PupilBounds& bounds, double irradiance_k_mm2)
     : step_mm_(bounds.field_radius_mm() / kIntervals)
 {
     const double pupil = traced.exit_pupil_radius();
@@ -52,7 +56,7 @@ LitAreaTable::LitAreaTable(const MainLens& traced, const PupilBounds& bounds)
     if (!(step_mm_ > 0) || !(paraxial_area > 0))
         return;  // no light passes anywhere: an empty table, at() is 0
     for (int i = 0; i <= kIntervals; ++i)
-        relative_area_.push_back(relative_lit_area(traced, bounds, i * step_mm_, paraxial_area));
+        relative_area_.push_back(relative_lit_area(traced, bounds, i * step_mm_, paraxial_area, irradiance_k_mm2));
 }
 
 double LitAreaTable::at(Vec3 point) const

@@ -25,12 +25,15 @@ class LitAreaTable {
 public:
     // For points of the sensor plane behind `traced`, an exact lens with a round stop (no iris
     // blades: the lit region of a point on the +x axis is then symmetric about that axis and
-    // turns with the point's azimuth), whose light falls within `bounds`' discs.
-    LitAreaTable(const MainLens& traced, const PupilBounds& bounds);
+    // turns with the point's azimuth), whose light falls within `bounds`' discs. With
+    // irradiance_k_mm2 > 0 (irradiance radiometry, plenoptic_radiometry.h) every lit point of the
+    // pupil's plane counts with its irradiance weight, so the table holds E / (L C).
+    LitAreaTable(const MainLens& traced, const PupilBounds& bounds, double irradiance_k_mm2);
 
     // The lit area of the exit pupil's plane for a sensor point (its z is not looked at), over
     // the paraxial exit pupil's area: 1 on the axis of an aberration-free lens, falling with
-    // mechanical vignetting; 0 beyond the field.
+    // mechanical vignetting; 0 beyond the field. Under irradiance radiometry, the lit area
+    // weighted by the cos^4 law, with the same normalisation.
     double at(Vec3 point) const;
 
     // Radii tabulated, from the axis to the edge of the field (for tests and reports).

@@ -5,13 +5,16 @@
 
 #include "plenoptic_metadata.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
 #include <nlohmann/json.hpp>
 
+#include "plenoptic_diffraction.h"
 #include "plenoptic_distortion_profile.h"
 #include "plenoptic_optics.h"
+#include "plenoptic_radiometry.h"
 
 namespace plenoptic {
 
@@ -285,6 +288,29 @@ Json microimages_json(const MicroimageSummary* summary)
 
 // sensor.read_out: the chain from the noise-free picture to the raw (plenoptic_sensor_chain.h),
 // every parameter as used, or null without one.
+Json diffraction_json(const Diffraction& d, const DiffractionParams& params, const Model& m)
+{
+    if (!d.applied)
+        return Json(nullptr);
+    Json json = Json::object();
+    json["model"] = "airy";
+    json["aperture"] = d.aperture;
+    json["aperture_diameter_mm"] = number(d.aperture_diameter_mm);
+    json["distance_mm"] = number(d.distance_mm);
+    json["wavelengths_nm"] = numbers(params.wavelengths_nm, 3);
+    double radius_um[3], radius_px[3], main_um[3];
+    for (int c = 0; c < 3; ++c) {
+        radius_um[c] = d.airy_radius_mm[c] * 1000;
+        radius_px[c] = d.airy_radius_mm[c] / m.pixel_size_mm[0];  // in pixel widths
+        main_um[c] = d.main_lens_airy_radius_at_array_mm[c] * 1000;
+    }
+    json["airy_radius_um"] = numbers(radius_um, 3);
+    json["airy_radius_px"] = numbers(radius_px, 3);
+    json["kernel_radius_airy_radii"] = number(kAiryKernelRadii);
+    json["main_lens_airy_radius_at_array_um"] = main_um[0] > 0 ? numbers(main_um, 3) : Json(nullptr);
+    return json;
+}
+
 Json read_out_json(const SensorChainParams& c, const std::string& raw_file)
 {
     if (!c.given)
@@ -339,6 +365,11 @@ std::string metadata_json(const Model& m, const CameraParams& params, int W, int
     sensor["pixel_size_mm"] = numbers(m.pixel_size_mm, 2);
     sensor["offset_mm"] = numbers(m.sensor_offset_mm, 2);
     sensor["plane_z_mm"] = number(m.sensor_z_mm);
+    Json radiometry = Json::object();
+    radiometry["model"] = radiometry_name(m.radiometry);
+    const double solid_angle = reference_projected_solid_angle_sr(m);
+    radiometry["projected_solid_angle_sr"] = number_or_null(solid_angle > 0, solid_angle);
+    sensor["radiometry"] = radiometry;
     sensor["read_out"] = read_out_json(params.sensor.chain, raw_file);
     json["sensor"] = sensor;
 
@@ -349,6 +380,7 @@ std::string metadata_json(const Model& m, const CameraParams& params, int W, int
     samples["confidence"] = number(m.confidence);
     samples["variance"] = number(m.variance);
     json["samples"] = samples;
+    json["diffraction"] = diffraction_json(diffraction_of(m, params.diffraction), params.diffraction, m);
 
     const Vec2 principal = principal_point_px(m, W, H);
     const double principal_px[2] = {principal.x, principal.y};

@@ -143,7 +143,7 @@ TEST(Metadata, KeysComeInTheDocumentedOrder)
     };
     typedef std::vector<std::string> Names;
     EXPECT_EQ(keys(doc), (Names{"format", "version", "image", "mm_per_unit", "camera_frame", "main_lens",
-                                "microlens_array", "sensor", "samples", "principal_point_px", "microimage_lattice",
+                                "microlens_array", "sensor", "samples", "diffraction", "principal_point_px", "microimage_lattice",
                                 "lftoolbox_lenslet_grid_model", "depth_map", "microimages", "white_images"}));
     EXPECT_EQ(keys(doc["image"]), (Names{"width", "height"}));
     EXPECT_EQ(keys(doc["camera_frame"]), (Names{"location", "right", "up", "direction"}));
@@ -152,7 +152,8 @@ TEST(Metadata, KeysComeInTheDocumentedOrder)
                      "distortion_profile"}));
     EXPECT_EQ(keys(doc["microlens_array"]), (Names{"grid", "lens", "pitch_mm", "focal_lengths_mm", "distance_mm",
                                                     "rotate_deg", "translate_mm"}));
-    EXPECT_EQ(keys(doc["sensor"]), (Names{"pixel_size_mm", "offset_mm", "plane_z_mm", "read_out"}));
+    EXPECT_EQ(keys(doc["sensor"]), (Names{"pixel_size_mm", "offset_mm", "plane_z_mm", "radiometry", "read_out"}));
+    EXPECT_EQ(keys(doc["sensor"]["radiometry"]), (Names{"model", "projected_solid_angle_sr"}));
     EXPECT_EQ(keys(doc["samples"]), (Names{"adaptive", "min", "max", "confidence", "variance"}));
     EXPECT_EQ(keys(doc["microimage_lattice"]), (Names{"origin_px", "basis_px", "index_rule", "exact", "lens_types",
                                                        "lens_type_rule", "microimage_diameter_px"}));

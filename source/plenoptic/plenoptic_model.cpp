@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "plenoptic_lattice.h"
+#include "plenoptic_radiometry.h"
 #include "plenoptic_sampling.h"
 
 namespace plenoptic {
@@ -92,6 +93,8 @@ Model make_model(const CameraParams& params)
 {
     Model m = Model();
     m.mm_per_unit = params.mm_per_unit;
+    m.radiometry = params.radiometry;
+    m.irradiance_k_mm2 = 0;  // set once the geometry is known, below
 
     const MainLensParams& main = params.main;
     m.main_lens = main.given ? main.type : MainLensType::None;
@@ -161,6 +164,8 @@ Model make_model(const CameraParams& params)
     else
         m.sensor_z_mm = array_z - m.array_distance_mm;
 
+    m.irradiance_k_mm2 = irradiance_constant_mm2(m);
+
     if (m.main_lens == MainLensType::Prescription) {
         // The round stop holds the iris: bounds from the lens without blades hold the lens with them.
         Prescription round = m.prescription;
@@ -168,7 +173,7 @@ Model make_model(const CameraParams& params)
         const std::shared_ptr<const MainLens> traced = make_prescription_lens(round, 0, true);
         m.pupil_bounds = std::make_shared<PupilBounds>(round, *traced, m.grid == GridType::None ? m.sensor_z_mm : m.pose.centre_mm.z);
         if (m.grid == GridType::None && m.prescription.blades == 0)
-            m.lit_area = std::make_shared<LitAreaTable>(*traced, *m.pupil_bounds);
+            m.lit_area = std::make_shared<LitAreaTable>(*traced, *m.pupil_bounds, m.irradiance_k_mm2);
     }
 
     for (int a = 0; a < 2; ++a) {

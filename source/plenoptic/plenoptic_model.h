@@ -37,6 +37,10 @@ const double kMaxPrunedTiltSine = 0.2;
 // there is no main lens), +z towards the scene, +x right, +y up; millimetres throughout.
 struct Model {
     double mm_per_unit;
+    // What a pixel measures (plenoptic_radiometry.h); under Irradiance each passing sample's colour
+    // is weighted by irradiance_weight with K = irradiance_k_mm2 (0 under Flat).
+    Radiometry radiometry;
+    double irradiance_k_mm2;
 
     MainLensType main_lens;
     std::shared_ptr<const MainLens> lens;  // the main lens's optics; nullptr without one
@@ -58,7 +62,8 @@ struct Model {
     // plane: what ray generation samples, and what the overlap bound reaches. nullptr otherwise.
     std::shared_ptr<const PupilBounds> pupil_bounds;
     // Without an array, behind a traced lens with a round stop: the lit area of the exit pupil's
-    // plane per sensor radius, which replaces the per-pixel vignetting probes. nullptr otherwise.
+    // plane per sensor radius (under irradiance radiometry weighted as the samples are), which
+    // replaces the per-pixel vignetting probes. nullptr otherwise.
     std::shared_ptr<const LitAreaTable> lit_area;
     bool has_focus_distance;     // D came from focus_distance
     double focus_distance_units; // as given; 0 when D was given directly

@@ -438,6 +438,12 @@ std::string check_camera(const CameraParams& camera)
         return "";
 
     const ArrayParams& array = camera.array;
+    if (camera.radiometry == Radiometry::Irradiance && has_main && camera.main.type == MainLensType::Pinhole &&
+        array.lens == MicrolensType::ThinLens)
+        return "radiometry irradiance needs a main lens with an area when the microlenses are lenses: behind a "
+               "pinhole main_lens each microlens focuses the pinhole's light onto a point, whose irradiance depends "
+               "on the pinhole's size, which the camera does not have; use a thin_lens main lens, pinhole "
+               "microlenses, or radiometry flat";
     if (has_main && camera.main.type == MainLensType::Pinhole && array.lens == MicrolensType::Pinhole)
         return "a pinhole main_lens with a pinhole microlens_array is degenerate: no light reaches the "
                "sensor (a ray would have to pass two points and the pixel at once); make one of them "

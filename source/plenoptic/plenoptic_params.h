@@ -17,6 +17,11 @@ namespace plenoptic {
 enum class MainLensType { None, Pinhole, ThinLens, ThickLens, Prescription };
 enum class GridType { None, Rectangular, Hexagonal };
 enum class MicrolensType { Pinhole, ThinLens };
+// What a pixel's value measures (plenoptic_radiometry.h): Flat, the radiance times the share of
+// the sampled aperture that passes (the first phase's camera, equal to the stock cameras); or
+// Irradiance, the sensor irradiance with its cos^4 law, normalised so that an on-axis pixel of
+// the camera without an array sees radiance L as L.
+enum class Radiometry { Flat, Irradiance };
 
 // Defaults for keywords the user may omit.
 const double kDefaultMmPerUnit = 1000.0;     // one scene unit is one metre
@@ -116,8 +121,17 @@ struct SamplingParams {
     double variance = kDefaultVariance;
 };
 
+// `diffraction [on | off] [wavelengths <r, g, b>]` (nanometres; plenoptic_diffraction.h).
+struct DiffractionParams {
+    bool given = false;
+    // Centres of common colour filters' pass bands: red 610, green 550, blue 465 nm.
+    double wavelengths_nm[3] = {610, 550, 465};
+};
+
 struct CameraParams {
     double mm_per_unit = kDefaultMmPerUnit;
+    Radiometry radiometry = Radiometry::Flat;  // `radiometry flat | irradiance`
+    DiffractionParams diffraction;
     MainLensParams main;
     ArrayParams array;
     SensorParams sensor;

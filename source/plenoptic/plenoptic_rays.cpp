@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "plenoptic_radiometry.h"
 #include "plenoptic_rays_internal.h"
 
 namespace plenoptic {
@@ -91,6 +92,15 @@ bool through_pinhole_main(const Model& m, Vec3 p, LensIndex lens, bool check_cel
     return finish(Vec3{0, 0, 0}, mul(m.pose.rotation, local_out), out);
 }
 
+// Under irradiance radiometry, weights a passing ray from sensor point s towards aperture point q
+// (on a plane of normal n) by the cos^4 law (plenoptic_radiometry.h); returns `passed`.
+bool weigh(const Model& m, bool passed, Vec3 s, Vec3 q, Vec3 n, OpticsRay* out)
+{
+    if (passed && m.radiometry == Radiometry::Irradiance)
+        out->weight *= irradiance_weight(m.irradiance_k_mm2, s, q, n);
+    return passed;
+}
+
 // The whole camera for one sensor point and one aperture sample (lens_u, lens_v).
 bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double lens_u, double lens_v,
                         bool check_apertures, OpticsRay* out)
@@ -108,19 +118,19 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
         if (!emit(m.lens->to_scene(p, on_pupil - p, true), out))
             return false;
         if (m.lit_area) {
-            out->weight = m.lit_area->at(p);
-        } else {
-            const double ratio = disc.radius / m.lens->exit_pupil_radius();
-            out->weight = ratio * ratio;
+            out->weight = m.lit_area->at(p);  // the table holds the irradiance weighting too
+            return true;
         }
-        return true;
+        const double ratio = disc.radius / m.lens->exit_pupil_radius();
+        out->weight = ratio * ratio;
+        return weigh(m, true, p, on_pupil, Vec3{0, 0, 1}, out);
     }
     if (m.grid == GridType::None) {
         // The sensor point towards a point of the exit pupil, through the lens.
         const Vec3 on_pupil = m.lens->exit_pupil_point(lens_u, lens_v);
         if (m.main_lens == MainLensType::Pinhole)
-            return finish(on_pupil, on_pupil - p, out);
-        return emit(m.lens->to_scene(p, on_pupil - p, false), out);
+            return weigh(m, finish(on_pupil, on_pupil - p, out), p, on_pupil, Vec3{0, 0, 1}, out);
+        return weigh(m, emit(m.lens->to_scene(p, on_pupil - p, false), out), p, on_pupil, Vec3{0, 0, 1}, out);
     }
 
     LensIndex lens;
@@ -158,7 +168,7 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
     }
 
     if (m.main_lens == MainLensType::None)
-        return finish(leave, direction, out);
+        return weigh(m, finish(leave, direction, out), p, leave, m.pose.normal, out);
     if (m.main_lens == MainLensType::Pinhole)
         return false;  // pinhole + pinhole: refused at parse time, no ray passes both points
 
@@ -170,7 +180,7 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
     if (check_apertures && m.pupil_bounds && !m.pose.tilted && !m.pupil_bounds->may_pass(leave, direction))
         return false;
     // On through the main lens (a ray that misses its apertures carries no light).
-    return emit(m.lens->to_scene(leave, direction, check_apertures), out);
+    return weigh(m, emit(m.lens->to_scene(leave, direction, check_apertures), out), p, leave, m.pose.normal, out);
 }
 
 // Whether light through `lens` can reach some point of the pixel centred at p. With k = D/d

@@ -19,7 +19,9 @@
 #include "backend/parser/parse.h"
 #include "backend/scene/camera.h"
 #include "backend/support/fileutil.h"
+#include "plenoptic/plenoptic_diffraction.h"
 #include "plenoptic/plenoptic_light_check.h"
+#include "plenoptic/plenoptic_radiometry.h"
 #include "povray_glue/plenoptic_setup.h"
 
 #include "base/povdebug.h"
@@ -32,7 +34,7 @@ namespace
 
 const char *kPlenopticKeywords =
 	"main_lens { }, microlens_array { }, sensor { }, mm_per_unit, samples, confidence, variance, depth_map, "
-	"microimage_centres, white_image, "
+	"microimage_centres, white_image, radiometry, diffraction, "
 	"and the placement keywords of every camera (location, look_at, sky, right, up, direction, rotate, "
 	"translate, scale, matrix, transform)";
 const char *kMainLensKeywords = "thin_lens, pinhole, thick_lens, lens_file, prescription { }, focal_length, f_number, aperture, "
@@ -45,6 +47,7 @@ const char *kArrayKeywords = "hexagonal, rectangular, pitch, focal_length, focal
 const char *kSensorKeywords = "pixel_size, offset, and the read-out to the raw: bayer rggb|bggr|grbg|gbrg, bit_depth, "
 	"full_well, exposure, read_noise, dark_current, exposure_time, prnu, dsnu, black_level, seed";
 const char *kBayerPatterns = "rggb, bggr, grbg, gbrg";
+const char *kRadiometries = "flat, irradiance";
 
 // A keyword as the camera's blocks see it, whether it is one of the camera's own words or a
 // stock reserved word that the blocks read too.
@@ -57,7 +60,7 @@ enum class Word
 	FocusDistance, Hexagonal, Rectangular, Pitch, PixelSize, DepthMap,
 	ThickLens, LensFile, Prescription, Surface, Stop, Blades, BladeRotation, Distortion, Tangential,
 	MicroimageCentres, Bayer, BitDepth, FullWell, Exposure, ReadNoise, DarkCurrent, ExposureTime, Prnu,
-	Dsnu, BlackLevel, WhiteImage, FNumbers, NoiseFree,
+	Dsnu, BlackLevel, WhiteImage, FNumbers, NoiseFree, Radiometry, Diffraction, Wavelengths,
 	// stock reserved words
 	MmPerUnit, Aperture, Distance, Offset, Rotate, Translate, Samples, Confidence, Variance,
 	Radius, Thickness, Ior, Radial, Seed
@@ -77,7 +80,8 @@ const ContextWord kContextWords[] = {
 	{"full_well", Word::FullWell}, {"exposure", Word::Exposure}, {"read_noise", Word::ReadNoise},
 	{"dark_current", Word::DarkCurrent}, {"exposure_time", Word::ExposureTime}, {"prnu", Word::Prnu},
 	{"dsnu", Word::Dsnu}, {"black_level", Word::BlackLevel}, {"white_image", Word::WhiteImage},
-	{"f_numbers", Word::FNumbers}, {"noise_free", Word::NoiseFree}
+	{"f_numbers", Word::FNumbers}, {"noise_free", Word::NoiseFree}, {"radiometry", Word::Radiometry},
+	{"diffraction", Word::Diffraction}, {"wavelengths", Word::Wavelengths}
 };
 
 struct StockWord { TOKEN token; Word word; };
@@ -118,6 +122,7 @@ std::string Check_Confidence(const char *, DBL value) { return plenoptic::check_
 std::string Check_Variance(const char *, DBL value) { return plenoptic::check_variance(value); }
 std::string Check_Blades(const char *, DBL value) { return plenoptic::check_blades(value); }
 std::string Check_Finite_Only(const char *, DBL) { return ""; }
+std::string Check_Wavelength(const char *, DBL value) { return plenoptic::check_wavelength(value); }
 
 // Most bytes read from a lens file: a prescription is a few hundred; this bounds a wrong file
 // (a device, an image) to a prompt refusal.
@@ -637,6 +642,34 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 				setup->microimage_centres = (Plenoptic_Keyword_Follows() || ((int)Allow_Float(1.0) != 0))
 					? plenoptic::CameraSetup::kWrite : plenoptic::CameraSetup::kDoNotWrite;
 				continue;
+			case Word::Radiometry:
+			{
+				// radiometry flat | irradiance: the word read by its text, as bayer's pattern.
+				Get_Token();
+				const char *text = (Token.Token_Id != STRING_LITERAL_TOKEN && !Token.End_Of_File) ? Token.Token_String : NULL;
+				const plenoptic::Radiometry kinds[] = {plenoptic::Radiometry::Flat, plenoptic::Radiometry::Irradiance};
+				bool known = false;
+				for (size_t i = 0; i < sizeof(kinds) / sizeof(kinds[0]) && text != NULL; i++)
+					if (std::strcmp(text, plenoptic::radiometry_name(kinds[i])) == 0)
+					{
+						params.radiometry = kinds[i];
+						known = true;
+					}
+				if (!known)
+					Error("plenoptic camera: radiometry takes one of %s, not '%s'.", kRadiometries,
+					      text != NULL ? text : Get_Token_String(Token.Token_Id));
+				continue;
+			}
+			case Word::Diffraction:
+				// diffraction [on | off] [wavelengths <r, g, b>] (nm)
+				params.diffraction = plenoptic::DiffractionParams();
+				params.diffraction.given = Plenoptic_Keyword_Follows() || ((int)Allow_Float(1.0) != 0);
+				Get_Token();
+				if (Word_Of(Token) == Word::Wavelengths)
+					Plenoptic_Values("diffraction wavelengths", params.diffraction.wavelengths_nm, 3, Check_Wavelength);
+				else
+					UNGET
+				continue;
 			case Word::WhiteImage:
 			{
 				// white_image [on | off] [f_numbers N | f_numbers <N1, ..., N5>] [noise_free]
@@ -760,8 +793,13 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 	Plenoptic_Check(plenoptic::check_camera(params));
 	if (setup->white_image.given)
 		Plenoptic_Check(plenoptic::check_white_image(setup->white_image, params));
-	UNGET
+	Plenoptic_Check(plenoptic::check_diffraction(params.diffraction, params));
 	setup->model = plenoptic::make_model(params);
+	Plenoptic_Check(plenoptic::check_diffraction_size(setup->model, params.diffraction));
+	for (size_t k = 0; k < setup->white_image.f_numbers.size() && params.diffraction.given; k++)
+		Plenoptic_Check(plenoptic::check_diffraction_size(
+			plenoptic::make_model(plenoptic::at_f_number(params, setup->white_image.f_numbers[k])), params.diffraction));
+	UNGET
 	std::vector<std::string> warnings = plenoptic::warnings(setup->model);
 	const std::string dark = plenoptic::dark_image_warning(setup->model);
 	if (!dark.empty())

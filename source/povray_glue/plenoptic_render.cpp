@@ -59,6 +59,12 @@ void publish_render(std::shared_ptr<Render> render)
     published = std::move(render);
 }
 
+std::shared_ptr<Render> published_render()
+{
+    std::lock_guard<std::mutex> lock(published_mutex);
+    return published;
+}
+
 std::shared_ptr<Render> take_published_render()
 {
     std::lock_guard<std::mutex> lock(published_mutex);

@@ -50,6 +50,8 @@ private:
 // animation's next frame, a render that was cancelled); taking empties the slot.
 void publish_render(std::shared_ptr<Render> render);
 std::shared_ptr<Render> take_published_render();
+// The published render without taking it (nullptr when there is none).
+std::shared_ptr<Render> published_render();
 
 } // namespace plenoptic
 

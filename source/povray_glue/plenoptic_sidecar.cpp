@@ -6,6 +6,7 @@
 #include "povray_glue/plenoptic_cancel.h"
 #include "povray_glue/plenoptic_raw_png.h"
 #include "povray_glue/plenoptic_render.h"
+#include "plenoptic/plenoptic_diffraction.h"
 
 #include <cerrno>
 #include <cmath>
@@ -126,6 +127,22 @@ bool write_depth_exr(const std::string& path, const DepthMap& depth)
     return true;
 }
 
+// The picture's R, G, B in linear light, interleaved, rows from the top.
+std::vector<float> linear_rgb(const pov_base::Image& image, const pov_base::GammaCurve* working_gamma)
+{
+    const int W = int(image.GetWidth()), H = int(image.GetHeight());
+    std::vector<float> linear(size_t(W) * H * 3);
+    for (int j = 0; j < H; ++j)
+        for (int i = 0; i < W; ++i) {
+            float* rgb = &linear[(size_t(j) * W + i) * 3];
+            image.GetRGBValue(unsigned(i), unsigned(j), rgb[0], rgb[1], rgb[2]);
+            if (working_gamma != nullptr)
+                for (int c = 0; c < 3; ++c)
+                    rgb[c] = working_gamma->Decode(rgb[c]);
+        }
+    return linear;
+}
+
 std::string base_name(const std::string& path)
 {
     const size_t slash = path.find_last_of('/');
@@ -142,6 +159,38 @@ std::string microimages_path_for(const std::string& image_path)
 }
 
 std::string raw_path_for(const std::string& image_path) { return replace_extension(image_path, ".raw.png"); }
+
+bool sidecar_prepare_image(pov_base::Image& image, const pov_base::GammaCurve* working_gamma)
+{
+    const std::shared_ptr<Render> render = published_render();
+    if (!render)
+        return true;
+    const int W = int(image.GetWidth()), H = int(image.GetHeight());
+    const Diffraction diffraction = diffraction_of(render->model(), render->setup().params.diffraction);
+    if (!diffraction.applied || W != render->width() || H != render->height())
+        return true;
+    std::vector<float> linear = linear_rgb(image, working_gamma);
+    const std::vector<AiryKernel> kernels = channel_kernels(render->model(), diffraction);
+    if (size_t(W) * H >= 4000000)
+        std::fprintf(stderr, "plenoptic camera: diffraction: convolving %d x %d pixels with Airy kernels of %d x %d "
+                             "pixels (red)\n", W, H, 2 * kernels[0].kx + 1, 2 * kernels[0].ky + 1);
+    if (!convolve_channels(linear, W, H, 3, kernels.data(), render_cancel_requested)) {
+        std::fprintf(stderr, "plenoptic camera: cancelled while applying diffraction: the image is not written "
+                             "(it would not be what the camera records).\n");
+        return false;
+    }
+    for (int j = 0; j < H; ++j)
+        for (int i = 0; i < W; ++i) {
+            float r, g, b, f, t;
+            image.GetRGBFTValue(unsigned(i), unsigned(j), r, g, b, f, t);
+            float* rgb = &linear[(size_t(j) * W + i) * 3];
+            if (working_gamma != nullptr)
+                for (int c = 0; c < 3; ++c)
+                    rgb[c] = working_gamma->Encode(rgb[c]);
+            image.SetRGBFTValue(unsigned(i), unsigned(j), rgb[0], rgb[1], rgb[2], f, t);
+        }
+    return true;
+}
 
 bool sidecar_write(const std::string& image_path, const pov_base::Image& image, const pov_base::GammaCurve* working_gamma)
 {
@@ -201,15 +250,7 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
     std::string raw_file;
     const SensorChainParams& chain = render->setup().params.sensor.chain;
     if (chain.given) {
-        std::vector<float> linear(size_t(W) * H * 3);
-        for (int j = 0; j < H; ++j)
-            for (int i = 0; i < W; ++i) {
-                float* rgb = &linear[(size_t(j) * W + i) * 3];
-                image.GetRGBValue(unsigned(i), unsigned(j), rgb[0], rgb[1], rgb[2]);
-                if (working_gamma != nullptr)
-                    for (int c = 0; c < 3; ++c)
-                        rgb[c] = working_gamma->Decode(rgb[c]);
-            }
+        const std::vector<float> linear = linear_rgb(image, working_gamma);
         const bool mosaic = chain.bayer != BayerPattern::None;
         const std::string png = raw_png(sensor_raw(chain, linear, W, H), W, H, mosaic ? 1 : 3, chain.bit_depth);
         const std::string path = raw_path_for(image_path);
@@ -237,23 +278,38 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
             std::unique_ptr<Model> other;
             if (!own)
                 other.reset(new Model(make_model(at_f_number(params, f_number))));
-            const std::vector<float> values = white_image(own ? model : *other, W, H, render_cancel_requested);
+            const Model& optics = own ? model : *other;
+            const std::vector<float> values = white_image(optics, W, H, render_cancel_requested);
             if (values.empty())
                 break;  // cancelled
+            // Diffraction differs by colour: the white image is then R, G and B.
+            const Diffraction diffraction = diffraction_of(optics, params.diffraction);
+            std::vector<float> rgb;
+            if (diffraction.applied) {
+                rgb.resize(values.size() * 3);
+                for (size_t p = 0; p < values.size(); ++p)
+                    rgb[3 * p] = rgb[3 * p + 1] = rgb[3 * p + 2] = values[p];
+                const std::vector<AiryKernel> kernels = channel_kernels(optics, diffraction);
+                if (!convolve_channels(rgb, W, H, 3, kernels.data(), render_cancel_requested))
+                    break;  // cancelled
+            }
             const bool raw = chain.given && !white.noise_free;
             std::string png;
             if (raw) {
-                std::vector<float> rgb(values.size() * 3);
-                for (size_t p = 0; p < values.size(); ++p)
-                    rgb[3 * p] = rgb[3 * p + 1] = rgb[3 * p + 2] = values[p];
+                if (!diffraction.applied) {
+                    rgb.resize(values.size() * 3);
+                    for (size_t p = 0; p < values.size(); ++p)
+                        rgb[3 * p] = rgb[3 * p + 1] = rgb[3 * p + 2] = values[p];
+                }
                 SensorChainParams frame = chain;
                 frame.seed = chain.seed ^ (0x7768697465000000ULL + std::uint64_t(k + 1));  // "white": its own noise
                 png = raw_png(sensor_raw(frame, rgb, W, H), W, H, chain.bayer != BayerPattern::None ? 1 : 3, chain.bit_depth);
             } else {
-                std::vector<std::uint16_t> linear(values.size());
-                for (size_t p = 0; p < values.size(); ++p)
-                    linear[p] = std::uint16_t(std::lround(std::min(1.0f, std::max(0.0f, values[p])) * 65535.0f));
-                png = raw_png(linear, W, H, 1, 16);
+                const std::vector<float>& source = diffraction.applied ? rgb : values;
+                std::vector<std::uint16_t> linear(source.size());
+                for (size_t p = 0; p < source.size(); ++p)
+                    linear[p] = std::uint16_t(std::lround(std::min(1.0f, std::max(0.0f, source[p])) * 65535.0f));
+                png = raw_png(linear, W, H, diffraction.applied ? 3 : 1, 16);
             }
             const std::string path = replace_extension(image_path, white_image_suffix(white, k));
             if (!png.empty() && write_text_atomically("white image", path, png))

@@ -23,6 +23,13 @@ std::string microimages_path_for(const std::string& image_path);// dir/name.micr
 
 std::string raw_path_for(const std::string& image_path);        // dir/name.raw.png
 
+// Before the front end writes the image of a plenoptic render: applies what the camera does to
+// the picture as a whole, diffraction (plenoptic_diffraction.h), in linear light (`working_gamma`:
+// the image's working gamma; nullptr: linear), so the image, its raw and everything read from it
+// carry it. Returns false, with a message on stderr, when it was cancelled (Ctrl-C): then no
+// image may be written, since it would not be what the metadata describes.
+bool sidecar_prepare_image(pov_base::Image& image, const pov_base::GammaCurve* working_gamma);
+
 // Writes the files for the image just written (if a plenoptic camera rendered it: the published
 // render, which this takes). `image`: the picture as rendered, in the working gamma
 // `working_gamma` (nullptr: linear), which the sensor's raw reads. Returns false, with a message

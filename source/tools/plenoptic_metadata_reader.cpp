@@ -421,7 +421,8 @@ void read_all(const Json& root, RenderMetadata* out)
     else if (!depth.is_null())
         refuse("depth_map", "a file name or null", depth);
 
-    // Sampling does not change where points image; any legal value will do.
+    // Sampling and radiometry (sensor.radiometry) do not change where points image; any legal
+    // value will do, and the defaults are.
     p.sampling = SamplingParams();
 
     const std::string problem = check_camera(p);

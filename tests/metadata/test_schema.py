@@ -80,7 +80,7 @@ SCENES = {
 
 ORDER = {
     "": ["format", "version", "image", "mm_per_unit", "camera_frame", "main_lens", "microlens_array", "sensor",
-         "samples", "principal_point_px", "microimage_lattice", "lftoolbox_lenslet_grid_model", "depth_map",
+         "samples", "diffraction", "principal_point_px", "microimage_lattice", "lftoolbox_lenslet_grid_model", "depth_map",
          "microimages", "white_images"],
     "image": ["width", "height"],
     "camera_frame": ["location", "right", "up", "direction"],
@@ -88,8 +88,11 @@ ORDER = {
                   "distortion_profile"],
     "main_lens.distortion_profile": ["object_plane_z_mm", "image_plane_z_mm", "chief_ray", "columns", "samples"],
     "microlens_array": ["grid", "lens", "pitch_mm", "focal_lengths_mm", "distance_mm", "rotate_deg", "translate_mm"],
-    "sensor": ["pixel_size_mm", "offset_mm", "plane_z_mm", "read_out"],
+    "sensor": ["pixel_size_mm", "offset_mm", "plane_z_mm", "radiometry", "read_out"],
+    "sensor.radiometry": ["model", "projected_solid_angle_sr"],
     "samples": ["adaptive", "min", "max", "confidence", "variance"],
+    "diffraction": ["model", "aperture", "aperture_diameter_mm", "distance_mm", "wavelengths_nm", "airy_radius_um",
+                    "airy_radius_px", "kernel_radius_airy_radii", "main_lens_airy_radius_at_array_um"],
     "microimage_lattice": ["origin_px", "basis_px", "index_rule", "exact", "lens_types", "lens_type_rule",
                            "microimage_diameter_px"],
     "lftoolbox_lenslet_grid_model": ["HSpacing", "VSpacing", "HOffset", "VOffset", "Rot", "Orientation",
