@@ -26,7 +26,7 @@ const int kLatticeStep = 610;   // F15: the Fibonacci lattice's generator
 const double kPi = 3.14159265358979323846;
 
 double relative_lit_area(const MainLens& traced, const PupilBounds& bounds, double r, double paraxial_area,
-                         double irradiance_k_mm2)
+                         double irradiance_k_mm2, double angular_exponent)
 {
     const Vec3 from{r, 0, bounds.plane_z()};
     const PupilDisc disc = bounds.disc_for(from);
@@ -40,7 +40,7 @@ double relative_lit_area(const MainLens& traced, const PupilBounds& bounds, doub
         const double angle = kPi * v;
         const Vec3 target{disc.centre.x + rho * std::cos(angle), disc.centre.y + rho * std::sin(angle), disc.centre.z};
         if (traced.to_scene(from, target - from, true).passed)
-            passing += irradiance_k_mm2 > 0 ? irradiance_weight(irradiance_k_mm2, from, target, Vec3{0, 0, 1}) : 1.0;
+            passing += irradiance_k_mm2 > 0 ? irradiance_weight(irradiance_k_mm2, angular_exponent, from, target, Vec3{0, 0, 1}) : 1.0;
     }
     const double disc_area = kPi * disc.radius * disc.radius;
     return disc_area * passing / kPoints / paraxial_area;
@@ -48,7 +48,8 @@ double relative_lit_area(const MainLens& traced, const PupilBounds& bounds, doub
 
 } // namespace
 
-LitAreaTable::LitAreaTable(const MainLens& traced, const PupilBounds& bounds, double irradiance_k_mm2)
+LitAreaTable::LitAreaTable(const MainLens& traced, const PupilBounds& bounds, double irradiance_k_mm2,
+                           double angular_exponent)
     : step_mm_(bounds.field_radius_mm() / kIntervals)
 {
     const double pupil = traced.exit_pupil_radius();
@@ -56,7 +57,7 @@ LitAreaTable::LitAreaTable(const MainLens& traced, const PupilBounds& bounds, do
     if (!(step_mm_ > 0) || !(paraxial_area > 0))
         return;  // no light passes anywhere: an empty table, at() is 0
     for (int i = 0; i <= kIntervals; ++i)
-        relative_area_.push_back(relative_lit_area(traced, bounds, i * step_mm_, paraxial_area, irradiance_k_mm2));
+        relative_area_.push_back(relative_lit_area(traced, bounds, i * step_mm_, paraxial_area, irradiance_k_mm2, angular_exponent));
 }
 
 double LitAreaTable::at(Vec3 point) const

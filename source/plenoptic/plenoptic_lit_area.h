@@ -28,7 +28,7 @@ public:
     // turns with the point's azimuth), whose light falls within `bounds`' discs. With
     // irradiance_k_mm2 > 0 (irradiance radiometry, plenoptic_radiometry.h) every lit point of the
     // pupil's plane counts with its irradiance weight, so the table holds E / (L C).
-    LitAreaTable(const MainLens& traced, const PupilBounds& bounds, double irradiance_k_mm2);
+    LitAreaTable(const MainLens& traced, const PupilBounds& bounds, double irradiance_k_mm2, double angular_exponent = 0);
 
     // The lit area of the exit pupil's plane for a sensor point (its z is not looked at), over
     // the paraxial exit pupil's area: 1 on the axis of an aberration-free lens, falling with

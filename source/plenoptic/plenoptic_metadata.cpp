@@ -369,6 +369,7 @@ std::string metadata_json(const Model& m, const CameraParams& params, int W, int
     radiometry["model"] = radiometry_name(m.radiometry);
     const double solid_angle = reference_projected_solid_angle_sr(m);
     radiometry["projected_solid_angle_sr"] = number_or_null(solid_angle > 0, solid_angle);
+    radiometry["angular_response"] = number(m.angular_exponent);
     sensor["radiometry"] = radiometry;
     sensor["read_out"] = read_out_json(params.sensor.chain, raw_file);
     json["sensor"] = sensor;

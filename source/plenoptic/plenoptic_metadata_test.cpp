@@ -153,7 +153,7 @@ TEST(Metadata, KeysComeInTheDocumentedOrder)
     EXPECT_EQ(keys(doc["microlens_array"]), (Names{"grid", "lens", "pitch_mm", "focal_lengths_mm", "distance_mm",
                                                     "rotate_deg", "translate_mm"}));
     EXPECT_EQ(keys(doc["sensor"]), (Names{"pixel_size_mm", "offset_mm", "plane_z_mm", "radiometry", "read_out"}));
-    EXPECT_EQ(keys(doc["sensor"]["radiometry"]), (Names{"model", "projected_solid_angle_sr"}));
+    EXPECT_EQ(keys(doc["sensor"]["radiometry"]), (Names{"model", "projected_solid_angle_sr", "angular_response"}));
     EXPECT_EQ(keys(doc["samples"]), (Names{"adaptive", "min", "max", "confidence", "variance"}));
     EXPECT_EQ(keys(doc["microimage_lattice"]), (Names{"origin_px", "basis_px", "index_rule", "exact", "lens_types",
                                                        "lens_type_rule", "microimage_diameter_px"}));

@@ -95,6 +95,7 @@ Model make_model(const CameraParams& params)
     m.mm_per_unit = params.mm_per_unit;
     m.radiometry = params.radiometry;
     m.irradiance_k_mm2 = 0;  // set once the geometry is known, below
+    m.angular_exponent = params.sensor.angular_exponent;
 
     const MainLensParams& main = params.main;
     m.main_lens = main.given ? main.type : MainLensType::None;
@@ -173,7 +174,7 @@ Model make_model(const CameraParams& params)
         const std::shared_ptr<const MainLens> traced = make_prescription_lens(round, 0, true);
         m.pupil_bounds = std::make_shared<PupilBounds>(round, *traced, m.grid == GridType::None ? m.sensor_z_mm : m.pose.centre_mm.z);
         if (m.grid == GridType::None && m.prescription.blades == 0)
-            m.lit_area = std::make_shared<LitAreaTable>(*traced, *m.pupil_bounds, m.irradiance_k_mm2);
+            m.lit_area = std::make_shared<LitAreaTable>(*traced, *m.pupil_bounds, m.irradiance_k_mm2, m.angular_exponent);
     }
 
     for (int a = 0; a < 2; ++a) {

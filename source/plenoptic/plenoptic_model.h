@@ -41,6 +41,7 @@ struct Model {
     // is weighted by irradiance_weight with K = irradiance_k_mm2 (0 under Flat).
     Radiometry radiometry;
     double irradiance_k_mm2;
+    double angular_exponent;     // sensor angular_response n: each sample also weighs cos^n(incidence)
 
     MainLensType main_lens;
     std::shared_ptr<const MainLens> lens;  // the main lens's optics; nullptr without one

@@ -375,6 +375,16 @@ std::string check_array(const ArrayParams& array)
     return "";
 }
 
+std::string check_angular_exponent(double value)
+{
+    if (!std::isfinite(value))
+        return "angular_response must be a finite number, got " + format_number(value);
+    if (!(value >= 0 && value <= kMaxAngularExponent))
+        return "angular_response is the exponent n of cos^n(incidence angle), from 0 to " +
+               format_number(kMaxAngularExponent) + ", got " + format_number(value);
+    return "";
+}
+
 std::string check_sensor(const SensorParams& sensor)
 {
     std::string message;
@@ -384,6 +394,8 @@ std::string check_sensor(const SensorParams& sensor)
         if (!(message = check_translation("offset", sensor.offset_mm[i])).empty())
             return message;
     }
+    if (!(message = check_angular_exponent(sensor.angular_exponent)).empty())
+        return message;
     return sensor.chain.given ? check_sensor_chain(sensor.chain) : "";
 }
 
@@ -430,6 +442,9 @@ std::string check_camera(const CameraParams& camera)
     if (!(message = check_sampling(camera.sampling)).empty())
         return message;
 
+    if (camera.sensor.angular_exponent > 0 && camera.radiometry != Radiometry::Irradiance)
+        return "sensor angular_response weights the light a pixel receives by its angle of incidence: it needs "
+               "radiometry irradiance (flat radiometry is the stock cameras' picture, which has no such response)";
     const bool has_main = camera.main.given;
     const bool has_array = camera.array.given;
     if (!has_main && !has_array)

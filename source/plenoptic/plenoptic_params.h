@@ -104,9 +104,15 @@ struct ArrayParams {
     double translate_mm[3] = {0, 0, 0};     // camera frame, after the rotation
 };
 
+// Largest exponent of `angular_response`: cos^64 of 10 degrees is 0.38, a pixel blind beyond 20.
+const double kMaxAngularExponent = 64;
+
 struct SensorParams {
     double pixel_size_mm[2] = {kDefaultPixelSizeMm, kDefaultPixelSizeMm};
     double offset_mm[2] = {kDefaultSensorOffsetMm, kDefaultSensorOffsetMm};
+    // `angular_response n`: a pixel's response to light arriving at angle t to the sensor's normal
+    // is cos^n(t), as on-chip microlenses make it (irradiance radiometry only; 0: none).
+    double angular_exponent = 0;
     SensorChainParams chain;  // the raw's read-out (plenoptic_sensor_chain.h); chain.given: write it
 };
 
@@ -154,6 +160,7 @@ std::string check_adaptive_minimum(double value);                           // s
 std::string check_confidence(double value);
 std::string check_blades(double value);                                     // a whole number 3..kMaxBlades
 std::string check_variance(double value);
+std::string check_angular_exponent(double value);                          // 0 .. kMaxAngularExponent
 
 // ---- Cross-field checks, run when a block's closing brace is read. ----
 std::string check_main_lens(const MainLensParams& main, double mm_per_unit);

@@ -21,9 +21,15 @@
 // world's microimages peak near 1 where their cell is wholly lit (the centre of a matched
 // plenoptic 1.0 microimage) and fall off with the cos^4 law within a microimage and across the
 // sensor. C is written to the metadata (sensor.radiometry), so E = value * C * L.
+//
+// A pixel's angular response (`sensor { angular_response e }`, on-chip microlenses) weighs each
+// ray by cos^e of its angle to the sensor's normal as well; C then holds the same factor (mean of
+// cos^(4+e) instead of cos^4 above), so the on-axis rule still holds.
 
 #ifndef PLENOPTIC_RADIOMETRY_H
 #define PLENOPTIC_RADIOMETRY_H
+
+#include <cmath>
 
 #include "plenoptic_model.h"
 #include "plenoptic_vec.h"
@@ -34,12 +40,14 @@ namespace plenoptic {
 double irradiance_constant_mm2(const Model& model);
 
 // The weight of a sample whose ray leaves sensor point s towards point q of an aperture plane
-// with unit normal n (towards the scene): K cos(t_s) cos(t_q) / |q - s|^2.
-inline double irradiance_weight(double k_mm2, Vec3 s, Vec3 q, Vec3 n)
+// with unit normal n (towards the scene): K cos(t_s) cos(t_q) / |q - s|^2, times cos^e(t_s) for
+// the pixel's angular response (sensor angular_response e; 0: none).
+inline double irradiance_weight(double k_mm2, double exponent, Vec3 s, Vec3 q, Vec3 n)
 {
     const Vec3 v = q - s;
     const double r2 = dot(v, v);
-    return k_mm2 * v.z * dot(v, n) / (r2 * r2);
+    const double weight = k_mm2 * v.z * dot(v, n) / (r2 * r2);
+    return exponent > 0 ? weight * std::pow(v.z * v.z / r2, 0.5 * exponent) : weight;
 }
 
 // C, the projected solid angle (sr) by which irradiance values are divided: E = value * C * L.

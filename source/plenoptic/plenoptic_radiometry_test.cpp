@@ -250,6 +250,66 @@ TEST(Radiometry, MicroimageCentresFallOffAcrossTheSensorAsTheirCellIsSeen)
     EXPECT_LT(worst, 2e-3) << worst;
 }
 
+// (1/h^2) integral over a disc of radius a of cos^m, seen from a point at distance r from the
+// disc's axis, h below it: a 600 x 600 polar midpoint sum.
+double disc_cos_power(double a, double h, double r, double m)
+{
+    const int nr = 600, nt = 600;
+    double total = 0;
+    for (int i = 0; i < nr; ++i) {
+        const double rho = (i + 0.5) / nr * a;
+        for (int j = 0; j < nt; ++j) {
+            const double t = (j + 0.5) / nt * 2 * kPi;
+            const double dx = rho * std::cos(t) - r, dy = rho * std::sin(t);
+            total += std::pow(h * h / (h * h + dx * dx + dy * dy), 0.5 * m) * rho * (a / nr) * (2 * kPi / nt);
+        }
+    }
+    return total / (h * h);
+}
+
+TEST(Radiometry, AngularResponseMultipliesTheCos4LawAndKeepsTheAxisAtOne)
+{
+    // A pinhole: cos^(4 + e) exactly.
+    CameraParams p;
+    p.main.given = true;
+    p.main.type = MainLensType::Pinhole;
+    p.main.has_distance = true;
+    p.main.distance_mm = 50;
+    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.5;
+    p.sensor.angular_exponent = 6;
+    p.radiometry = Radiometry::Irradiance;
+    ASSERT_EQ(check_camera(p), "");
+    const Model pinhole = make_model(p);
+    const double x = centre_x(170, 201, 0.5);
+    const double cos2 = 2500 / (2500 + x * x);
+    EXPECT_NEAR(shade_pixel(pinhole, 170, 0, 201, 1, white).r, std::pow(cos2, 5), 1e-12);
+
+    // A 50 mm f/2 thin lens: the pixel is the integral of cos^(4 + e) over the pupil, 1 on the axis.
+    CameraParams t = test::thin_lens_camera(50, 2, 52);
+    t.sensor.pixel_size_mm[0] = t.sensor.pixel_size_mm[1] = 0.25;
+    t.sampling.samples = 4096;
+    t.radiometry = Radiometry::Irradiance;
+    t.sensor.angular_exponent = 8;
+    const Model thin = make_model(t);
+    const int W = 241;
+    const double on_axis = disc_cos_power(12.5, 52, 0, 12);
+    double worst = 0;
+    for (int i = 120; i < W; i += 20) {
+        const double r = std::fabs(centre_x(i, W, 0.25));
+        const double expected = disc_cos_power(12.5, 52, r, 12) / on_axis;
+        worst = std::max(worst, std::fabs(shade_pixel(thin, i, 1, W, 3, white).r / expected - 1));
+    }
+    EXPECT_LT(worst, 2e-3) << worst;
+    // Without the response the same pixel 30 mm off axis is brighter: the test sees the exponent.
+    EXPECT_LT(disc_cos_power(12.5, 52, 30, 12) / on_axis, 0.9 * disc_cos_power(12.5, 52, 30, 4) / disc_cos_power(12.5, 52, 0, 4));
+
+    // Flat radiometry has no angular response: refused.
+    t.radiometry = Radiometry::Flat;
+    EXPECT_NE(check_camera(t).find("angular_response"), std::string::npos);
+    t.sensor.angular_exponent = 65;
+    EXPECT_NE(check_sensor(t.sensor).find("from 0 to 64"), std::string::npos);
+}
+
 TEST(Radiometry, RefusesIrradianceBehindAPinholeMainLensWithLensletMicrolenses)
 {
     CameraParams p = test::plenoptic_camera(GridType::Hexagonal, 0.16, 0.64, 0.64, 16, 4, 16.1);

@@ -97,7 +97,7 @@ bool through_pinhole_main(const Model& m, Vec3 p, LensIndex lens, bool check_cel
 bool weigh(const Model& m, bool passed, Vec3 s, Vec3 q, Vec3 n, OpticsRay* out)
 {
     if (passed && m.radiometry == Radiometry::Irradiance)
-        out->weight *= irradiance_weight(m.irradiance_k_mm2, s, q, n);
+        out->weight *= irradiance_weight(m.irradiance_k_mm2, m.angular_exponent, s, q, n);
     return passed;
 }
 

@@ -44,7 +44,7 @@ const char *kPrescriptionKeywords = "surface { }, stop { }";
 const char *kSurfaceKeywords = "radius, thickness, ior, aperture";
 const char *kStopKeywords = "thickness, aperture";
 const char *kArrayKeywords = "hexagonal, rectangular, pitch, focal_length, focal_lengths, pinhole, distance, rotate, translate";
-const char *kSensorKeywords = "pixel_size, offset, and the read-out to the raw: bayer rggb|bggr|grbg|gbrg, bit_depth, "
+const char *kSensorKeywords = "pixel_size, offset, angular_response, and the read-out to the raw: bayer rggb|bggr|grbg|gbrg, bit_depth, "
 	"full_well, exposure, read_noise, dark_current, exposure_time, prnu, dsnu, black_level, seed";
 const char *kBayerPatterns = "rggb, bggr, grbg, gbrg";
 const char *kRadiometries = "flat, irradiance";
@@ -60,7 +60,7 @@ enum class Word
 	FocusDistance, Hexagonal, Rectangular, Pitch, PixelSize, DepthMap,
 	ThickLens, LensFile, Prescription, Surface, Stop, Blades, BladeRotation, Distortion, Tangential,
 	MicroimageCentres, Bayer, BitDepth, FullWell, Exposure, ReadNoise, DarkCurrent, ExposureTime, Prnu,
-	Dsnu, BlackLevel, WhiteImage, FNumbers, NoiseFree, Radiometry, Diffraction, Wavelengths,
+	Dsnu, BlackLevel, WhiteImage, FNumbers, NoiseFree, Radiometry, Diffraction, Wavelengths, AngularResponse,
 	// stock reserved words
 	MmPerUnit, Aperture, Distance, Offset, Rotate, Translate, Samples, Confidence, Variance,
 	Radius, Thickness, Ior, Radial, Seed
@@ -81,7 +81,8 @@ const ContextWord kContextWords[] = {
 	{"dark_current", Word::DarkCurrent}, {"exposure_time", Word::ExposureTime}, {"prnu", Word::Prnu},
 	{"dsnu", Word::Dsnu}, {"black_level", Word::BlackLevel}, {"white_image", Word::WhiteImage},
 	{"f_numbers", Word::FNumbers}, {"noise_free", Word::NoiseFree}, {"radiometry", Word::Radiometry},
-	{"diffraction", Word::Diffraction}, {"wavelengths", Word::Wavelengths}
+	{"diffraction", Word::Diffraction}, {"wavelengths", Word::Wavelengths},
+	{"angular_response", Word::AngularResponse}
 };
 
 struct StockWord { TOKEN token; Word word; };
@@ -123,6 +124,7 @@ std::string Check_Variance(const char *, DBL value) { return plenoptic::check_va
 std::string Check_Blades(const char *, DBL value) { return plenoptic::check_blades(value); }
 std::string Check_Finite_Only(const char *, DBL) { return ""; }
 std::string Check_Wavelength(const char *, DBL value) { return plenoptic::check_wavelength(value); }
+std::string Check_Angular_Exponent(const char *, DBL value) { return plenoptic::check_angular_exponent(value); }
 
 // Most bytes read from a lens file: a prescription is a few hundred; this bounds a wrong file
 // (a device, an image) to a prompt refusal.
@@ -498,6 +500,9 @@ void Parser::Parse_Plenoptic_Sensor(plenoptic::CameraParams& params)
 				break;
 			case Word::Offset:
 				Plenoptic_Values("sensor offset", sensor.offset_mm, 2, plenoptic::check_translation);
+				break;
+			case Word::AngularResponse:
+				sensor.angular_exponent = Plenoptic_Float("angular_response", Check_Angular_Exponent);
 				break;
 			case Word::Bayer:
 			{

@@ -89,7 +89,7 @@ ORDER = {
     "main_lens.distortion_profile": ["object_plane_z_mm", "image_plane_z_mm", "chief_ray", "columns", "samples"],
     "microlens_array": ["grid", "lens", "pitch_mm", "focal_lengths_mm", "distance_mm", "rotate_deg", "translate_mm"],
     "sensor": ["pixel_size_mm", "offset_mm", "plane_z_mm", "radiometry", "read_out"],
-    "sensor.radiometry": ["model", "projected_solid_angle_sr"],
+    "sensor.radiometry": ["model", "projected_solid_angle_sr", "angular_response"],
     "samples": ["adaptive", "min", "max", "confidence", "variance"],
     "diffraction": ["model", "aperture", "aperture_diameter_mm", "distance_mm", "wavelengths_nm", "airy_radius_um",
                     "airy_radius_px", "kernel_radius_airy_radii", "main_lens_airy_radius_at_array_um"],
