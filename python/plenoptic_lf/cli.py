@@ -22,6 +22,7 @@ from .lightfield import decode, plan_decode
 from .metadata import load_metadata, metadata_path_for
 from .outputs import write_outputs
 from .progress import Progress
+from .sensor import demosaic_bilinear, devignette, dn_to_linear, read_out_of, white_image_of
 
 
 SLOPES_FORM = "START:STOP:COUNT (two numbers and a whole number >= 2, e.g. -0.8:0.8:17)"
@@ -67,6 +68,40 @@ def _attach_slopes_values(argv):
     return out
 
 
+def _stored_pixels(path):
+    """The image's values as stored (OpenImageIO's 0..1 for integers), (H, W, C) float, no decoding."""
+    oiio = require_openimageio()
+    buf = oiio.ImageBuf(path)
+    pixels = None if buf.has_error else buf.get_pixels(oiio.FLOAT)
+    if pixels is None or buf.has_error:
+        raise DecodeError("cannot read %s: %s" % (path, buf.geterror().strip() or "unknown format"))
+    pixels = np.asarray(pixels, dtype=np.float32)
+    return pixels[:, :, None] if pixels.ndim == 2 else pixels
+
+
+def read_picture(path, meta, encoding, progress, white=False):
+    """The picture (H, W, 3) linear: the render's image as its encoding says; the sensor's raw
+    (<stem>.raw.png, or a white image in DN) through dn_to_linear and, for a mosaic,
+    demosaic_bilinear; a linear white image as stored."""
+    read_out = meta.raw.get("sensor", {}).get("read_out")
+    entry = white_image_of(meta, path) if white else None
+    in_dn = (entry is not None and entry.get("values") == "dn") or (not white and read_out_of(meta, path) is not None)
+    if in_dn:
+        pixels = dn_to_linear(_stored_pixels(path), read_out)
+        if read_out.get("bayer"):
+            progress.stage("%s: the sensor's raw in DN, %s mosaic: demosaiced (bilinear)"
+                           % (os.path.basename(path), read_out["bayer"]))
+            return demosaic_bilinear(pixels[..., 0], read_out["bayer"])
+        progress.stage("%s: the sensor's raw in DN" % os.path.basename(path))
+        return np.ascontiguousarray(np.repeat(pixels[..., :1], 3, axis=2) if pixels.shape[2] == 1 else pixels[..., :3])
+    if white:
+        # A linear white image: value x 65535 / scale, grey or RGB (the metadata's white_images).
+        scale = float(entry.get("scale", 1)) if entry is not None else 1.0
+        pixels = _stored_pixels(path) * np.float32(scale)
+        return np.ascontiguousarray(np.repeat(pixels[..., :1], 3, axis=2) if pixels.shape[2] < 3 else pixels[..., :3])
+    return read_raw_image(path, encoding)[0]
+
+
 def _argument_parser():
     parser = argparse.ArgumentParser(
         prog="plenoptic-decode",
@@ -90,6 +125,9 @@ def _argument_parser():
                         help="how the raw image's values encode light: auto (default: the file's own "
                              "encoding, e.g. a PNG's gAMA/sRGB chunk; linear for EXR), or an override: "
                              "srgb, linear, or a gamma number")
+    parser.add_argument("--white", default=None, metavar="PNG",
+                        help="devignette: divide the raw by this white image of the camera (its <stem>.white.png, "
+                             "linear or in DN) where the white image carries light")
     parser.add_argument("--no-gif", action="store_true", help="do not write refocus.gif")
     parser.add_argument("--no-npy", action="store_true", help="do not write lightfield.npy")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
@@ -131,7 +169,13 @@ def main(argv=None):
         progress.stage("raw image %s: %s" % (os.path.basename(args.raw), info.describe()))
         meta = load_metadata(meta_path, (info.width, info.height))
         plan_decode(meta, args.angular, args.step)
-        raw, _ = read_raw_image(args.raw, encoding)
+        raw = read_picture(args.raw, meta, encoding, progress)
+        if args.white:
+            if not os.path.exists(args.white):
+                return fail("%s: the white image does not exist" % args.white)
+            white = read_picture(args.white, meta, encoding, progress, white=True)
+            raw = devignette(raw, white)
+            progress.stage("devignetted with %s" % os.path.basename(args.white))
         lf = decode(raw, meta, args.angular, args.step, progress)
         if slopes is None:
             slopes = slopes_from_depth_map(lf)

@@ -9,6 +9,7 @@ centre(k, l) = origin + k a + l b.
 import json
 import math
 import os
+import re
 
 import numpy as np
 
@@ -252,6 +253,7 @@ def load_metadata(path, image_size=None):
 
 
 def metadata_path_for(image_path):
-    """<dir>/<stem>.plenoptic.json for <dir>/<stem>.<ext>, as the renderer names it."""
+    """<dir>/<stem>.plenoptic.json for <dir>/<stem>.<ext>, as the renderer names it; also for the
+    files it writes beside the image, <stem>.raw.png and <stem>.white[.f<N>].png."""
     stem, _ = os.path.splitext(image_path)
-    return stem + ".plenoptic.json"
+    return re.sub(r"\.(raw|white(\.f[0-9.]+)?)$", "", stem) + ".plenoptic.json"

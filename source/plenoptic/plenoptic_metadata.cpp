@@ -401,6 +401,7 @@ std::string metadata_json(const Model& m, const CameraParams& params, int W, int
             entry["file"] = w.file;
             entry["f_number"] = w.f_number > 0 ? number(w.f_number) : Json(nullptr);
             entry["values"] = w.raw ? "dn" : "linear";
+            entry["scale"] = number(w.scale);
             list.push_back(entry);
         }
         json["white_images"] = list;

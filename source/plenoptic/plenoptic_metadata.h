@@ -31,7 +31,8 @@ struct CameraFrame {
 struct WhiteImageFile {
     std::string file;
     double f_number;   // the main lens's f-number it was computed at (0: no main lens aperture)
-    bool raw;          // true: DN through the sensor's read-out; false: the linear value x 65535
+    bool raw;          // true: DN through the sensor's read-out; false: the linear value x 65535 / scale
+    double scale = 1;  // linear: a power of two >= the largest value, so that none clips (1: none above 1)
 };
 
 // `white_images`: the white images written (null in the JSON when none was asked for).

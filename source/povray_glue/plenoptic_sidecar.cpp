@@ -294,6 +294,7 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
                     break;  // cancelled
             }
             const bool raw = chain.given && !white.noise_free;
+            double scale = 1;
             std::string png;
             if (raw) {
                 if (!diffraction.applied) {
@@ -305,17 +306,30 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
                 frame.seed = chain.seed ^ (0x7768697465000000ULL + std::uint64_t(k + 1));  // "white": its own noise
                 png = raw_png(sensor_raw(frame, rgb, W, H), W, H, chain.bayer != BayerPattern::None ? 1 : 3, chain.bit_depth);
             } else {
+                // Irradiance can exceed 1 (overlap at a microimage's rim, a lens cell's corners):
+                // divided by a power of two so that nothing clips, recorded as the entry's scale.
                 const std::vector<float>& source = diffraction.applied ? rgb : values;
+                float largest = 0;
+                for (float v : source)
+                    largest = std::max(largest, v);
+                while (scale < largest && scale < 65536)
+                    scale *= 2;
                 std::vector<std::uint16_t> linear(source.size());
                 for (size_t p = 0; p < source.size(); ++p)
-                    linear[p] = std::uint16_t(std::lround(std::min(1.0f, std::max(0.0f, source[p])) * 65535.0f));
+                    linear[p] = std::uint16_t(std::lround(std::min(1.0, std::max(0.0, source[p] / scale)) * 65535.0));
                 png = raw_png(linear, W, H, diffraction.applied ? 3 : 1, 16);
             }
             const std::string path = replace_extension(image_path, white_image_suffix(white, k));
-            if (!png.empty() && write_text_atomically("white image", path, png))
-                whites->push_back(WhiteImageFile{base_name(path), f_number, raw});
-            else
+            if (!png.empty() && write_text_atomically("white image", path, png)) {
+                WhiteImageFile file;
+                file.file = base_name(path);
+                file.f_number = f_number;
+                file.raw = raw;
+                file.scale = scale;
+                whites->push_back(file);
+            } else {
                 ok = false;
+            }
         }
         if (render_cancel_requested())
             std::fprintf(stderr, "plenoptic camera: cancelled: white images not all written.\n");
