@@ -31,6 +31,7 @@ LAYOUT = [
     "bin/povray-plenoptic",
     "bin/plenoptic-project",
     "bin/plenoptic-decode",
+    "bin/plenoptic-targets",
     "lib/python3/dist-packages/plenoptic_lf/__init__.py",
     "lib/python3/dist-packages/plenoptic_lf/cli.py",
     "share/povray-plenoptic/include/colors.inc",
@@ -42,6 +43,8 @@ LAYOUT = [
     "share/man/man1/povray-plenoptic.1",
     "share/man/man1/plenoptic-project.1",
     "share/man/man1/plenoptic-decode.1",
+    "share/man/man1/plenoptic-targets.1",
+    "share/povray-plenoptic/scenes/calibration_targets.inc",
     "share/doc/povray-plenoptic/copyright",
     "etc/povray-plenoptic/povray.ini",
     "etc/povray-plenoptic/povray.conf",
@@ -220,6 +223,13 @@ def test_install_relocatable(args):
     assert (r.returncode == 0 and os.path.isfile(os.path.join(run_dir, "sheet.png"))), "installed plenoptic-decode failed:\n" + r.stdout[-1500:] + r.stderr[-1500:]
     r = run([os.path.join(moved, "bin", "plenoptic-decode"), "--help"], cwd=run_dir, env=env)
     assert (r.returncode == 0 and "usage" in r.stdout), "plenoptic-decode --help failed:\n" + r.stderr
+    # plenoptic-targets finds the moved renderer, projection tool and target include by itself.
+    with open(os.path.join(run_dir, "targets_camera.inc"), "w") as f:
+        f.write("camera { plenoptic main_lens { pinhole distance 20 } sensor { pixel_size 0.04 } }\n")
+    r = run([os.path.join(moved, "bin", "plenoptic-targets"), "targets_camera.inc", "--out", "targets", "--count", "1",
+             "--width", "40", "--height", "30", "--target", "checkerboard:3x3:0.02"], cwd=run_dir, env=env, timeout=300)
+    assert (r.returncode == 0 and os.path.isfile(os.path.join(run_dir, "targets", "target_000.points.csv"))), \
+        "installed plenoptic-targets failed:\n" + r.stdout[-1500:] + r.stderr[-1500:]
     # The launcher's imports without its main(): where plenoptic_lf came from.
     probe = ("import runpy, sys; runpy.run_path(%r, run_name='probe'); "
              "print(sys.modules['plenoptic_lf'].__file__)" % os.path.join(moved, "bin", "plenoptic-decode"))

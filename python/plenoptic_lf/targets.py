@@ -1,0 +1,225 @@
+# SPDX-License-Identifier: AGPL-3.0-or-later
+"""plenoptic-targets: calibration data sets with ground truth (issue 14, item 5; docs/ground-truth.md,
+"Calibration targets").
+
+Renders N views of a calibration target (scenes/calibration_targets.inc: a checkerboard or a
+circle grid) at seeded random poses in front of a camera, and writes for each view every feature
+point's 3-D position and every raw pixel where it images (the forward projection,
+plenoptic-project):
+
+    plenoptic-targets CAMERA.inc --out DIR [--count N] [--seed S] [--distance MIN MAX]
+                      [--tilt DEG] [--target checkerboard:ROWSxCOLS:SQUARE | circles:ROWSxCOLS:SPACING:RADIUS]
+                      [--width W --height H] [--povray PATH] [--project PATH] [-- POVRAY OPTIONS]
+
+CAMERA.inc holds the camera, `camera { plenoptic ... }`, at POV-Ray's default placement: at the
+origin, looking along +z with +y up (no location, look_at or rotate). A pose is: a distance z
+drawn uniformly from [MIN, MAX] (scene units) along +z, an offset across of up to --lateral
+times z, tilts about x and y drawn uniformly from [-DEG, DEG] and a roll about z from
+[-180, 180); the target is rotated (x, then y, then z, POV-Ray's order) and then moved.
+
+For view k, DIR holds target_<k>.png (and what the camera writes beside it: the metadata, white
+image, raw...), target_<k>.pov, and target_<k>.points.csv: one line per image of a feature point,
+    point, row, col, x, y, z, lens_k, lens_l, u, v
+(point index, its row and column on the target, its world position in scene units, the lens of
+the image in row form and its pixel position, pixel centres at integers). DIR/targets.json lists
+the views with their poses and the command line.
+"""
+
+import argparse
+import json
+import math
+import os
+import random
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+
+
+def rotation_xyz(degrees):
+    """POV-Ray's `rotate <rx, ry, rz>` as a matrix acting on column vectors: x first, then y, then
+    z, each the textbook rotation matrix (POV-Ray's Compute_Rotation_Transform, which applies their
+    transposes to row vectors)."""
+    ax, ay, az = (math.radians(d) for d in degrees)
+    rx = np.array([[1, 0, 0], [0, math.cos(ax), -math.sin(ax)], [0, math.sin(ax), math.cos(ax)]])
+    ry = np.array([[math.cos(ay), 0, math.sin(ay)], [0, 1, 0], [-math.sin(ay), 0, math.cos(ay)]])
+    rz = np.array([[math.cos(az), -math.sin(az), 0], [math.sin(az), math.cos(az), 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
+def parse_target(text):
+    """'checkerboard:7x10:0.03' or 'circles:4x11:0.02:0.006' -> dict."""
+    parts = text.split(":")
+    try:
+        rows, cols = (int(v) for v in parts[1].lower().split("x"))
+        numbers = [float(v) for v in parts[2:]]
+    except (IndexError, ValueError):
+        raise ValueError("--target: checkerboard:ROWSxCOLS:SQUARE or circles:ROWSxCOLS:SPACING:RADIUS, not %r" % text)
+    if parts[0] == "checkerboard" and len(numbers) == 1 and rows >= 2 and cols >= 2 and numbers[0] > 0:
+        return {"kind": "checkerboard", "rows": rows, "cols": cols, "square": numbers[0]}
+    if parts[0] == "circles" and len(numbers) == 2 and rows >= 1 and cols >= 1 and numbers[0] > 0 and \
+            0 < numbers[1] < numbers[0] / 2:
+        return {"kind": "circles", "rows": rows, "cols": cols, "spacing": numbers[0], "radius": numbers[1]}
+    raise ValueError("--target: checkerboard:ROWSxCOLS:SQUARE (rows, cols >= 2, square > 0) or "
+                     "circles:ROWSxCOLS:SPACING:RADIUS (0 < radius < spacing / 2), not %r" % text)
+
+
+def feature_points(target):
+    """[(row, col, (x, y, 0))] in the target's frame, as calibration_targets.inc documents them."""
+    out = []
+    if target["kind"] == "checkerboard":
+        rows, cols, s = target["rows"], target["cols"], target["square"]
+        for j in range(1, rows):
+            for i in range(1, cols):
+                out.append((j - 1, i - 1, ((i - cols / 2.0) * s, (j - rows / 2.0) * s, 0.0)))
+    else:
+        rows, cols, s = target["rows"], target["cols"], target["spacing"]
+        for j in range(rows):
+            for i in range(cols):
+                out.append((j, i, ((i - (cols - 1) / 2.0) * s, (j - (rows - 1) / 2.0) * s, 0.0)))
+    return out
+
+
+def target_object(target):
+    if target["kind"] == "checkerboard":
+        return "Plenoptic_Checkerboard(%d, %d, %.17g, rgb 0.9, rgb 0.05)" % (target["rows"], target["cols"], target["square"])
+    return "Plenoptic_Circle_Grid(%d, %d, %.17g, %.17g, rgb 0.9, rgb 0.05)" % (
+        target["rows"], target["cols"], target["spacing"], target["radius"])
+
+
+def draw_pose(rng, distance, tilt, lateral):
+    z = rng.uniform(distance[0], distance[1])
+    return {"rotate_deg": [rng.uniform(-tilt, tilt), rng.uniform(-tilt, tilt), rng.uniform(-180.0, 180.0)],
+            "translate": [rng.uniform(-lateral, lateral) * z, rng.uniform(-lateral, lateral) * z, z]}
+
+
+def world_points(target, pose):
+    r = rotation_xyz(pose["rotate_deg"])
+    t = np.array(pose["translate"])
+    return [(row, col, r @ np.array(p) + t) for row, col, p in feature_points(target)]
+
+
+def scene_text(camera_path, target, pose):
+    return ("// SPDX-License-Identifier: AGPL-3.0-or-later\n// Written by plenoptic-targets.\n#version 3.7;\n"
+            "global_settings { assumed_gamma 1.0 }\nbackground { rgb 0.2 }\n#include \"calibration_targets.inc\"\n"
+            "#include \"%s\"\nobject { %s rotate <%.17g, %.17g, %.17g> translate <%.17g, %.17g, %.17g> }\n"
+            % (os.path.abspath(camera_path), target_object(target), *pose["rotate_deg"], *pose["translate"]))
+
+
+def _find(name, given, candidates):
+    """`given`, else the first candidate that exists, else `name` on PATH (never Debian's povray:
+    the renderer is looked for as povray-plenoptic)."""
+    if given:
+        return given
+    for c in candidates:
+        if os.path.exists(c):
+            return os.path.abspath(c)
+    found = shutil.which(name)
+    if not found:
+        raise FileNotFoundError("cannot find %s: give its path with --%s" % (name, "povray" if "povray" in name else "project"))
+    return found
+
+
+# This file is <repository>/python/plenoptic_lf/targets.py in the source tree, and
+# P/lib/python3/dist-packages/plenoptic_lf/targets.py when installed under the prefix P.
+_HERE = os.path.dirname(os.path.abspath(__file__))
+_REPOSITORY = os.path.dirname(os.path.dirname(_HERE))
+_PREFIX = os.path.normpath(os.path.join(_HERE, "..", "..", "..", ".."))
+
+
+def _include_dir():
+    """The folder holding calibration_targets.inc: the source tree's scenes/ or the install's."""
+    for c in (os.path.join(_REPOSITORY, "scenes"), os.path.join(_PREFIX, "share", "povray-plenoptic", "scenes")):
+        if os.path.exists(os.path.join(c, "calibration_targets.inc")):
+            return os.path.abspath(c)
+    raise FileNotFoundError("calibration_targets.inc not found beside the plenoptic_lf package")
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(prog="plenoptic-targets", description=__doc__.split("\n\n")[0])
+    p.add_argument("camera", help="a file holding camera { plenoptic ... } at POV-Ray's default placement")
+    p.add_argument("--out", required=True, help="output folder")
+    p.add_argument("--count", type=int, default=10)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--distance", type=float, nargs=2, default=[0.8, 1.5], metavar=("MIN", "MAX"),
+                   help="distance range along the optical axis, scene units (default 0.8 1.5)")
+    p.add_argument("--tilt", type=float, default=30.0, help="largest tilt about x and y, degrees (default 30)")
+    p.add_argument("--lateral", type=float, default=0.02,
+                   help="largest offset across the axis, as a fraction of the distance (default 0.02)")
+    p.add_argument("--target", default="checkerboard:7x10:0.03")
+    p.add_argument("--width", type=int, default=640)
+    p.add_argument("--height", type=int, default=480)
+    p.add_argument("--povray", default=None)
+    p.add_argument("--project", default=None)
+    p.add_argument("povray_options", nargs="*", help="after --: passed to POV-Ray (e.g. +WT2)")
+    args = p.parse_args(argv)
+
+    def fail(message):
+        print("plenoptic-targets: error: %s" % message, file=sys.stderr)
+        return 2
+
+    try:
+        target = parse_target(args.target)
+    except ValueError as e:
+        return fail(str(e))
+    if not os.path.isfile(args.camera):
+        return fail("%s: no such camera file" % args.camera)
+    if not (args.count >= 1 and 0 < args.distance[0] <= args.distance[1] and 0 <= args.tilt < 90 and
+            args.lateral >= 0 and args.width >= 1 and args.height >= 1):
+        return fail("need --count >= 1, 0 < MIN <= MAX, 0 <= --tilt < 90, --lateral >= 0 and a positive size")
+    try:
+        povray = _find("povray-plenoptic", args.povray, [os.path.join(_REPOSITORY, "build", "povray"),
+                                                         os.path.join(_PREFIX, "bin", "povray-plenoptic")])
+        project = _find("plenoptic-project", args.project, [os.path.join(_REPOSITORY, "build", "plenoptic-project"),
+                                                            os.path.join(_PREFIX, "bin", "plenoptic-project")])
+        include = _include_dir()
+    except FileNotFoundError as e:
+        return fail(str(e))
+    os.makedirs(args.out, exist_ok=True)
+    rng = random.Random(args.seed)
+    views = []
+    try:
+        for k in range(args.count):
+            pose = draw_pose(rng, args.distance, args.tilt, args.lateral)
+            name = "target_%03d" % k
+            pov = os.path.join(args.out, name + ".pov")
+            with open(pov, "w") as f:
+                f.write(scene_text(args.camera, target, pose))
+            png = os.path.join(args.out, name + ".png")
+            cmd = [povray, "+I" + pov, "+O" + png, "+W%d" % args.width, "+H%d" % args.height, "-D", "-P",
+                   "+L" + include, "+FN16", "File_Gamma=1.0"] + list(args.povray_options)
+            run = subprocess.run(cmd, capture_output=True, text=True)
+            if run.returncode != 0 or not os.path.exists(png):
+                return fail("the render of view %d failed (%s):\n%s" % (k, " ".join(cmd), run.stderr[-2000:]))
+            meta = os.path.join(args.out, name + ".plenoptic.json")
+            points = world_points(target, pose)
+            stdin = "".join("%.17g %.17g %.17g\n" % tuple(p) for _, _, p in points)
+            proj = subprocess.run([project, meta, "-"], input=stdin, capture_output=True, text=True)
+            if proj.returncode != 0:
+                return fail("plenoptic-project failed on view %d:\n%s" % (k, proj.stderr[-2000:]))
+            images = 0
+            with open(os.path.join(args.out, name + ".points.csv"), "w") as f:
+                f.write("point,row,col,x,y,z,lens_k,lens_l,u,v\n")
+                for line in proj.stdout.splitlines():
+                    index, lk, ll, u, v = line.split()[:5]
+                    row, col, p3 = points[int(index)]
+                    f.write("%s,%d,%d,%.17g,%.17g,%.17g,%s,%s,%s,%s\n" % (index, row, col, p3[0], p3[1], p3[2], lk, ll, u, v))
+                    images += 1
+            views.append({"view": k, "image": name + ".png", "points": name + ".points.csv", "pose": pose,
+                          "feature_points": len(points), "images_of_points": images})
+            print("plenoptic-targets: view %d of %d: %d feature points, %d images of them"
+                  % (k + 1, args.count, len(points), images), file=sys.stderr)
+    except KeyboardInterrupt:
+        print("plenoptic-targets: interrupted after %d views" % len(views), file=sys.stderr)
+        return 130
+    finally:
+        with open(os.path.join(args.out, "targets.json"), "w") as f:
+            json.dump({"target": target, "seed": args.seed, "distance": args.distance, "tilt_deg": args.tilt,
+                       "lateral": args.lateral, "size": [args.width, args.height], "camera": os.path.abspath(args.camera),
+                       "views": views}, f, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
