@@ -42,7 +42,7 @@ std::shared_ptr<Render> published;
 Render::Render(std::shared_ptr<const CameraSetup> setup, const CameraFrame& frame, int width, int height,
                PixelRect area, const std::vector<PixelRect>& untraced)
     : setup_(std::move(setup)), frame_(frame), frame_orthonormal_(is_orthonormal(frame)), width_(width),
-      height_(height)
+      height_(height), continued_(!untraced.empty())
 {
     if (setup_->depth_map) {
         depth_.reset(new DepthMap(width, height));

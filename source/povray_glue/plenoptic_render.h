@@ -36,12 +36,15 @@ public:
     const DepthMap* depth() const { return depth_.get(); }
     DepthBackfill* backfill() { return backfill_.get(); }
     const DepthBackfill* backfill() const { return backfill_.get(); }
+    // A continued render (+C): some of its pixels come from the image an earlier run wrote.
+    bool continued() const { return continued_; }
 
 private:
     std::shared_ptr<const CameraSetup> setup_;
     CameraFrame frame_;
     bool frame_orthonormal_;
     int width_, height_;
+    bool continued_;
     std::unique_ptr<DepthMap> depth_;
     std::unique_ptr<DepthBackfill> backfill_;
 };

@@ -169,6 +169,13 @@ bool sidecar_prepare_image(pov_base::Image& image, const pov_base::GammaCurve* w
     const Diffraction diffraction = diffraction_of(render->model(), render->setup().params.diffraction);
     if (!diffraction.applied || W != render->width() || H != render->height())
         return true;
+    if (render->continued()) {
+        // The rows the earlier run wrote were diffracted already: a second convolution would blur
+        // them twice. The image file stays as the earlier run left it.
+        std::fprintf(stderr, "plenoptic camera: diffraction cannot continue a render (+C): the part rendered "
+                             "before was diffracted already; render the image again without +C. No image written.\n");
+        return false;
+    }
     std::vector<float> linear = linear_rgb(image, working_gamma);
     const std::vector<AiryKernel> kernels = channel_kernels(render->model(), diffraction);
     if (size_t(W) * H >= 4000000)

@@ -26,8 +26,9 @@ std::string raw_path_for(const std::string& image_path);        // dir/name.raw.
 // Before the front end writes the image of a plenoptic render: applies what the camera does to
 // the picture as a whole, diffraction (plenoptic_diffraction.h), in linear light (`working_gamma`:
 // the image's working gamma; nullptr: linear), so the image, its raw and everything read from it
-// carry it. Returns false, with a message on stderr, when it was cancelled (Ctrl-C): then no
-// image may be written, since it would not be what the metadata describes.
+// carry it. Returns false, with a message on stderr, when it was cancelled (Ctrl-C) or the render
+// was continued (+C: the earlier part was diffracted already): then no image may be written,
+// since it would not be what the metadata describes.
 bool sidecar_prepare_image(pov_base::Image& image, const pov_base::GammaCurve* working_gamma);
 
 // Writes the files for the image just written (if a plenoptic camera rendered it: the published

@@ -185,3 +185,27 @@ def test_continue(args, part):
         assert not problems, "%s\n     %s" % (name, "\n     ".join(problems))
         print("ok   %s: continued image%s equal the uninterrupted render's" %
               (name, ", metadata and depth map" if part == "depth" else " and metadata"))
+
+
+def test_continue_refuses_diffraction(args):
+    """With `diffraction` the picture is convolved as a whole before it is written; a continued
+    render's earlier part was convolved already, so +C is refused: non-zero exit, a message that
+    says why, and no image, metadata or leftover written (docs/sensor.md, "Diffraction")."""
+    work = os.path.join(args.work, "diffraction")
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    pt.write_scene(os.path.join(work, "scene.pov"), CAMERA.replace("  depth_map\n", "  diffraction\n"))
+    for attempt in range(3):
+        status, output, fraction = interrupt(args.povray, work, 1, signal.SIGINT)
+        if fraction is not None and not os.path.exists(os.path.join(work, "image.png")):
+            break
+        for f in os.listdir(work):
+            if f != "scene.pov":
+                os.remove(os.path.join(work, f))
+    assert fraction is not None and os.path.exists(os.path.join(work, "image.pov-state")), pt.tail(output)
+    status, output = run(command(args.povray, 2, ["+C"]), work)
+    print("continued with diffraction: exit %d" % status)
+    assert status != 0, pt.tail(output)
+    assert "diffraction cannot continue a render (+C)" in output, pt.tail(output)
+    for f in ("image.png", "image.plenoptic.json"):
+        assert not os.path.exists(os.path.join(work, f)), f
