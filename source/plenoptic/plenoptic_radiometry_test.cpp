@@ -24,7 +24,8 @@ Rgbt white(const OpticsRay&) { return Rgbt{1, 1, 1, 1}; }
 double centre_x(int i, int W, double pixel) { return -(i + 0.5 - 0.5 * W) * pixel; }
 double centre_y(int j, int H, double pixel) { return (j + 0.5 - 0.5 * H) * pixel; }
 
-TEST(Radiometry, PinholeWithoutArrayFallsOffAsCos4AndIsOneOnAxis)
+// A pinhole 50 mm in front of a sensor of 0.5 mm pixels, no array, irradiance radiometry.
+CameraParams irradiance_pinhole()
 {
     CameraParams p;
     p.main.given = true;
@@ -33,6 +34,12 @@ TEST(Radiometry, PinholeWithoutArrayFallsOffAsCos4AndIsOneOnAxis)
     p.main.distance_mm = 50;
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.5;
     p.radiometry = Radiometry::Irradiance;
+    return p;
+}
+
+TEST(Radiometry, PinholeWithoutArrayFallsOffAsCos4AndIsOneOnAxis)
+{
+    CameraParams p = irradiance_pinhole();
     ASSERT_EQ(check_camera(p), "");
     const Model m = make_model(p);
     const int W = 201, H = 151;
@@ -270,14 +277,8 @@ double disc_cos_power(double a, double h, double r, double m)
 TEST(Radiometry, AngularResponseMultipliesTheCos4LawAndKeepsTheAxisAtOne)
 {
     // A pinhole: cos^(4 + e) exactly.
-    CameraParams p;
-    p.main.given = true;
-    p.main.type = MainLensType::Pinhole;
-    p.main.has_distance = true;
-    p.main.distance_mm = 50;
-    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.5;
+    CameraParams p = irradiance_pinhole();
     p.sensor.angular_exponent = 6;
-    p.radiometry = Radiometry::Irradiance;
     ASSERT_EQ(check_camera(p), "");
     const Model pinhole = make_model(p);
     const double x = centre_x(170, 201, 0.5);

@@ -289,26 +289,24 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
             const std::vector<float> values = white_image(optics, W, H, render_cancel_requested);
             if (values.empty())
                 break;  // cancelled
-            // Diffraction differs by colour: the white image is then R, G and B.
+            // R, G and B of the grey white image, where they are needed: diffraction differs by
+            // colour (the white image is then RGB), and the read-out reads three channels.
             const Diffraction diffraction = diffraction_of(optics, params.diffraction);
+            const bool raw = chain.given && !white.noise_free;
             std::vector<float> rgb;
-            if (diffraction.applied) {
+            if (diffraction.applied || raw) {
                 rgb.resize(values.size() * 3);
                 for (size_t p = 0; p < values.size(); ++p)
                     rgb[3 * p] = rgb[3 * p + 1] = rgb[3 * p + 2] = values[p];
+            }
+            if (diffraction.applied) {
                 const std::vector<AiryKernel> kernels = channel_kernels(optics, diffraction);
                 if (!convolve_channels(rgb, W, H, 3, kernels.data(), render_cancel_requested))
                     break;  // cancelled
             }
-            const bool raw = chain.given && !white.noise_free;
             double scale = 1;
             std::string png;
             if (raw) {
-                if (!diffraction.applied) {
-                    rgb.resize(values.size() * 3);
-                    for (size_t p = 0; p < values.size(); ++p)
-                        rgb[3 * p] = rgb[3 * p + 1] = rgb[3 * p + 2] = values[p];
-                }
                 SensorChainParams frame = chain;
                 frame.seed = chain.seed ^ (0x7768697465000000ULL + std::uint64_t(k + 1));  // "white": its own noise
                 png = raw_png(sensor_raw(frame, rgb, W, H), W, H, chain.bayer != BayerPattern::None ? 1 : 3, chain.bit_depth);

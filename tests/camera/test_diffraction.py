@@ -80,13 +80,12 @@ def test_white_image_with_diffraction_equals_a_white_world(args):
              "  sensor { pixel_size 0.0014 } samples 16 radiometry irradiance diffraction white_image }\n")
     path = pt.render(args.povray, args.work, "diffraction_white", scene, W, H)
     rendered = pt.read_linear(path)
-    scale = pt.metadata_of(path)["white_images"][0]["scale"]
-    white = pt.load(os.path.splitext(path)[0] + ".white.png") * scale
+    white, scale = pt.white_image_values(os.path.splitext(path)[0] + ".white.png")
     assert white.shape == rendered.shape  # R, G, B: diffraction differs by colour
-    unclipped = white <= 1 - (scale + 1) / 2.0 / 65535  # above 1 the render clips
+    unclipped = white <= 1 - pt.white_image_step(scale)  # above 1 the render clips
     diff = np.abs(white - rendered)[unclipped].max()
     print("white image with diffraction - render of a white world: max %.2g" % diff)
-    assert diff <= (scale + 1) / 2.0 / 65535 + 1e-12, diff
+    assert diff <= pt.white_image_step(scale), diff
     assert not np.array_equal(rendered[..., 0], rendered[..., 2])  # red spreads more than blue
     meta = pt.metadata_of(path)
     d = meta["diffraction"]

@@ -79,10 +79,10 @@ def test_white_image_under_irradiance(args):
              "  samples 64 radiometry irradiance white_image\n}\n")
     path = pt.render(args.povray, args.work, "irradiance_white", scene, W, H)
     rendered = pt.read_linear(path)[..., 0]
-    scale = pt.metadata_of(path)["white_images"][0]["scale"]
-    white = pt.load(os.path.splitext(path)[0] + ".white.png")[..., 0] * scale
-    unclipped = white <= 1 - (scale + 1) / 2.0 / 65535  # where neighbouring lenses' light adds above 1, the render clips
-    assert np.abs(white - rendered)[unclipped].max() <= (scale + 1) / 2.0 / 65535 + 1e-12
+    white, scale = pt.white_image_values(os.path.splitext(path)[0] + ".white.png")
+    white = white[..., 0]
+    unclipped = white <= 1 - pt.white_image_step(scale)  # where neighbouring lenses' light adds above 1, the render clips
+    assert np.abs(white - rendered)[unclipped].max() <= pt.white_image_step(scale)
     # f-number matched: the microimage centres see the whole cell, so they peak at L = 1; the
     # rims fall off (cos^4 within the microimage and the main pupil's edge).
     peak = rendered[30:60, 40:80].max()

@@ -10,7 +10,6 @@ f-number of `f_numbers` against a render at that f-number. With a sensor read-ou
 is a raw in DN (its own noise), and `noise_free` gives the linear one.
 """
 import os
-import re
 
 import numpy as np
 import pytest
@@ -34,12 +33,10 @@ def white_values(path):
 
 
 def white_linear(path):
-    """A linear white image's values: stored / 65535 x the scale its metadata entry gives (checked:
-    the smallest power of two at or above the largest value)."""
-    meta = pt.metadata_of(re.sub(r"\.white(\.f[0-9.]+)?\.png$", ".png", path))
-    entry = [w for w in meta["white_images"] if w["file"] == os.path.basename(path)][0]
-    values = white_values(path) * entry["scale"]
-    scale = entry["scale"]
+    """A linear white image's values (pt.white_image_values) and scale, the scale checked: the
+    smallest power of two at or above the largest value."""
+    values, scale = pt.white_image_values(path)
+    values = values[..., 0]
     assert values.max() <= scale + 1e-9 and (scale == 1 or values.max() > scale / 2), (values.max(), scale)
     return values, scale
 
@@ -47,7 +44,7 @@ def white_linear(path):
 def assert_equal_to_render(white, scale, rendered, what):
     """The white image against a 16-bit render of a white world, to both quantisations; where the
     render clipped at 1 (light of neighbouring lenses adding up), the white image holds more."""
-    step = (scale + 1) / 2.0 / 65535 + 1e-12
+    step = pt.white_image_step(scale)
     unclipped = white <= 1 - step
     diff = np.abs(white - rendered)[unclipped]
     print("%s: white image - render of a white world: max %.2g over %d of %d pixels below 1 (scale %g)"

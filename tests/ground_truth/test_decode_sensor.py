@@ -29,16 +29,6 @@ CAMERA = """camera { plenoptic location <0, 0, -2.5> look_at <0, 0, 0>
   samples 16 %s }
 """
 LOSSLESS = "bayer %s bit_depth 16 full_well 1e14 exposure 1e14"
-# Self-lit patches at the focus distance: the microimages of each are flat, their rims are not.
-PATCHES = """#version 3.7;
-global_settings { assumed_gamma 1.0 }
-background { rgb 0.05 }
-#declare Lit = finish { emission 1 diffuse 0 ambient 0 }
-box { <-0.03, 0, 0>, <0, 0.03, 0.001> pigment { rgb <0.8, 0.25, 0.2> } finish { Lit } }
-box { <0, 0, 0>, <0.03, 0.03, 0.001> pigment { rgb <0.25, 0.7, 0.3> } finish { Lit } }
-box { <-0.03, -0.03, 0>, <0, 0, 0.001> pigment { rgb <0.2, 0.3, 0.8> } finish { Lit } }
-box { <0, -0.03, 0>, <0.03, 0, 0.001> pigment { rgb <0.85, 0.8, 0.3> } finish { Lit } }
-"""
 
 
 def read_picture(path, meta_path, white=False):
@@ -52,7 +42,7 @@ def read_picture(path, meta_path, white=False):
 def test_bayer_raw_demosaics_to_the_picture(args):
     for pattern in ("rggb", "gbrg"):
         name = "sensor_raw_" + pattern
-        png = pt.render(args.povray, args.work, name, PATCHES + CAMERA % (LOSSLESS % pattern, ""), W, H)
+        png = pt.render(args.povray, args.work, name, pt.QUADRANT_CHART + CAMERA % (LOSSLESS % pattern, ""), W, H)
         raw = os.path.splitext(png)[0] + ".raw.png"
         truth = pt.read_linear(png)
         got = read_picture(raw, os.path.splitext(png)[0] + ".plenoptic.json")

@@ -35,15 +35,7 @@ F, N, FOCUS_M = 50.0, 2.0, 2.5
 
 # A chart at the focus distance that fills the field (44 x 33 mm at 2.5 m): four coloured
 # quadrants, a dark disc off centre and a bright bar, self-lit, so views can be compared.
-CHART = """\
-#version 3.7;
-global_settings { assumed_gamma 1.0 }
-background { rgb 0.05 }
-#declare Lit = finish { emission 1 diffuse 0 ambient 0 }
-box { <-0.03, 0, 0>, <0, 0.03, 0.001> pigment { rgb <0.8, 0.25, 0.2> } finish { Lit } }
-box { <0, 0, 0>, <0.03, 0.03, 0.001> pigment { rgb <0.25, 0.7, 0.3> } finish { Lit } }
-box { <-0.03, -0.03, 0>, <0, 0, 0.001> pigment { rgb <0.2, 0.3, 0.8> } finish { Lit } }
-box { <0, -0.03, 0>, <0.03, 0, 0.001> pigment { rgb <0.85, 0.8, 0.3> } finish { Lit } }
+CHART = pt.QUADRANT_CHART + """\
 cylinder { <0.006, 0.004, -0.001>, <0.006, 0.004, -0.0005>, 0.006 pigment { rgb 0.02 } finish { Lit } }
 box { <-0.018, -0.010, -0.001>, <-0.004, -0.006, -0.0005> pigment { rgb 1 } finish { Lit } }
 """

@@ -696,3 +696,31 @@ def render_golden(povray, name, s, out_dir, extra=()):
                           % (name, run.returncode, ", time limit" if run.timed_out else "", " ".join(cmd),
                              run.output[-3000:]))
     return run.output
+
+
+# Four self-lit coloured quadrants 6 cm wide at z = 0 on a dark background (a chart at the focus
+# distance of the decoder tests: flat microimages inside each quadrant, edges between them).
+QUADRANT_CHART = """\
+#version 3.7;
+global_settings { assumed_gamma 1.0 }
+background { rgb 0.05 }
+#declare Lit = finish { emission 1 diffuse 0 ambient 0 }
+box { <-0.03, 0, 0>, <0, 0.03, 0.001> pigment { rgb <0.8, 0.25, 0.2> } finish { Lit } }
+box { <0, 0, 0>, <0.03, 0.03, 0.001> pigment { rgb <0.25, 0.7, 0.3> } finish { Lit } }
+box { <-0.03, -0.03, 0>, <0, 0, 0.001> pigment { rgb <0.2, 0.3, 0.8> } finish { Lit } }
+box { <0, -0.03, 0>, <0.03, 0, 0.001> pigment { rgb <0.85, 0.8, 0.3> } finish { Lit } }
+"""
+
+
+def white_image_values(white_path):
+    """A linear white image's values (H, W, C): stored / 65535 times the scale its metadata entry
+    gives, and that scale. The metadata is the render's, found from the white image's name."""
+    image = re.sub(r"\.white(\.f[0-9.]+)?\.png$", ".png", white_path)
+    entry = [w for w in metadata_of(image)["white_images"] if w["file"] == os.path.basename(white_path)][0]
+    return load(white_path) * entry["scale"], entry["scale"]
+
+
+def white_image_step(scale):
+    """The largest difference between a white image of this scale and a 16-bit render of the same
+    values: both quantisations, half a step each."""
+    return (scale + 1) / 2.0 / 65535 + 1e-12
