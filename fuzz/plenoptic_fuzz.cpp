@@ -212,7 +212,7 @@ void dump(const Input& in)
     const MainLensParams& m = p.main;
     const ArrayParams& a = p.array;
     std::fprintf(stderr,
-                 "  mm_per_unit %.17g\n"
+                 "  mm_per_unit %.17g radiometry %s angular_response %.17g\n"
                  "  main_lens given %d type %s  focal_length %d:%.17g f_number %d:%.17g aperture %d:%.17g "
                  "focus_distance %d:%.17g distance %d:%.17g\n"
                  "  microlens_array given %d grid %s pitch %d:%.17g lens %s count %d f <%.17g, %.17g, %.17g> "
@@ -220,7 +220,8 @@ void dump(const Input& in)
                  "  sensor pixel_size <%.17g, %.17g> offset <%.17g, %.17g>\n"
                  "  samples %d adaptive %d min %d max %d confidence %.17g variance %.17g\n"
                  "  image %dx%d, %d samples, point <%.17g, %.17g, %.17g>\n",
-                 p.mm_per_unit, m.given, name(m.type), m.has_focal_length, m.focal_length_mm, m.has_f_number,
+                 p.mm_per_unit, p.radiometry == Radiometry::Irradiance ? "irradiance" : "flat",
+                 p.sensor.angular_exponent, m.given, name(m.type), m.has_focal_length, m.focal_length_mm, m.has_f_number,
                  m.f_number, m.has_aperture, m.aperture_mm, m.has_focus_distance, m.focus_distance_units,
                  m.has_distance, m.distance_mm, a.given, name(a.grid), a.has_pitch, a.pitch_mm,
                  a.lens == MicrolensType::Pinhole ? "pinhole" : "thin_lens", a.focal_length_count,

@@ -158,10 +158,11 @@ std::string check_thin_lens(const MainLensParams& main, double mm_per_unit)
         return "main_lens thin_lens needs focus_distance (scene units) or distance (D in mm)";
     if (main.has_f_number) {
         const double aperture = main.focal_length_mm / main.f_number;
-        if (!(std::isfinite(aperture) && aperture > 0))
+        // The same range as a given aperture: beyond it the aperture's area overflows.
+        if (!(aperture >= kMinLengthMm && aperture <= kMaxLengthMm))
             return "main_lens: focal_length " + format_number(main.focal_length_mm) + " mm / f_number " +
-                   format_number(main.f_number) + " gives an unusable aperture of " +
-                   format_number(aperture) + " mm";
+                   format_number(main.f_number) + " gives an aperture of " + format_number(aperture) +
+                   " mm, outside " + format_number(kMinLengthMm) + " to " + format_number(kMaxLengthMm) + " mm";
     }
     if (main.has_focus_distance) {
         std::string scale = check_mm_per_unit(mm_per_unit);

@@ -164,6 +164,25 @@ TEST(Params, MainLensCrossFieldRefusals)
     EXPECT_TRUE(contains(message, "thin_lens, pinhole, or a real lens")) << message;
 }
 
+// F / N must give an aperture in the range a given aperture has: a fuzzed f_number of 2e-230
+// passed the old finite-and-positive check, and under irradiance the aperture's area overflowed
+// to a NaN pixel.
+TEST(Params, ThinLensFNumberGivesAnApertureInRange)
+{
+    for (double n : {2.0611676062710827e-230, 50 / (2 * kMaxLengthMm), 50 / (0.5 * kMinLengthMm), 1e300}) {
+        MainLensParams m = thin_main();
+        m.f_number = n;
+        const std::string message = check_main_lens(m, 1000);
+        EXPECT_TRUE(contains(message, "f_number " + format_number(n)) && contains(message, "outside"))
+            << n << ": " << message;
+    }
+    for (double n : {50 / kMaxLengthMm, 50 / kMinLengthMm, 1.4, 64.0}) {
+        MainLensParams m = thin_main();
+        m.f_number = n;
+        EXPECT_EQ(check_main_lens(m, 1000), "") << n;
+    }
+}
+
 TEST(Params, PinholeMainLensTakesDistanceOnly)
 {
     MainLensParams m;
