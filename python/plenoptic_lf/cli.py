@@ -16,6 +16,7 @@ import sys
 import numpy as np
 
 from .errors import DecodeError, DependencyError, MetadataError
+from .hci import check_hci_camera, depth_map_path, export_hci
 from .focus import default_slopes, slopes_from_depth_map
 from .images import check_encoding, inspect_raw, read_raw_image, require_openimageio
 from .lightfield import decode, plan_decode
@@ -128,6 +129,15 @@ def _argument_parser():
     parser.add_argument("--white", default=None, metavar="PNG",
                         help="devignette: divide the raw by this white image of the camera (its <stem>.white.png, "
                              "linear or in DN) where the white image carries light")
+    parser.add_argument("--hci", default=None, metavar="DIR",
+                        help="write the HCI 4D light-field benchmark's layout to DIR instead of the usual outputs: "
+                             "N x N views input_CamNNN.png, parameters.cfg, and the centre view's ground-truth "
+                             "gt_depth_lowres.pfm and gt_disp_lowres.pfm from the render's depth map (plenoptic 1.0, "
+                             "thin main lens; docs/hci-export.md). --angular N sets N (default: the largest square "
+                             "that fits the microimage)")
+    parser.add_argument("--hci-all-views", action="store_true",
+                        help="with --hci: also write gt_depth_lowres_CamNNN.pfm and gt_disp_lowres_CamNNN.pfm for "
+                             "every view")
     parser.add_argument("--no-gif", action="store_true", help="do not write refocus.gif")
     parser.add_argument("--no-npy", action="store_true", help="do not write lightfield.npy")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
@@ -147,6 +157,8 @@ def main(argv=None):
         require_openimageio()
     except DependencyError as e:
         return fail(str(e), 1)
+    if args.hci_all_views and not args.hci:
+        return fail("--hci-all-views needs --hci DIR")
     if not (args.step > 0 and math.isfinite(args.step)):
         return fail("--step must be a positive number of pixels")
     try:
@@ -168,7 +180,11 @@ def main(argv=None):
         info = inspect_raw(args.raw, encoding)
         progress.stage("raw image %s: %s" % (os.path.basename(args.raw), info.describe()))
         meta = load_metadata(meta_path, (info.width, info.height))
-        plan_decode(meta, args.angular, args.step)
+        if args.hci:
+            check_hci_camera(meta)
+            depth_map_path(meta)
+        else:
+            plan_decode(meta, args.angular, args.step)
         raw = read_picture(args.raw, meta, encoding, progress)
         if args.white:
             if not os.path.exists(args.white):
@@ -176,6 +192,12 @@ def main(argv=None):
             white = read_picture(args.white, meta, encoding, progress, white=True)
             raw = devignette(raw, white)
             progress.stage("devignetted with %s" % os.path.basename(args.white))
+        if args.hci:
+            n = export_hci(raw, meta, args.hci, args.angular, args.step, args.hci_all_views, progress)
+            if not args.quiet:
+                print("plenoptic-decode: wrote %d x %d views and their ground truth to %s" % (n, n, args.hci),
+                      file=sys.stderr)
+            return 0
         lf = decode(raw, meta, args.angular, args.step, progress)
         if slopes is None:
             slopes = slopes_from_depth_map(lf)
