@@ -340,8 +340,7 @@ Json read_out_json(const SensorChainParams& c, const std::string& raw_file)
 } // namespace
 
 std::string metadata_json(const Model& m, const CameraParams& params, int W, int H, const CameraFrame& frame,
-                          const std::string& depth_map_file, const MicroimageSummary* microimages,
-                          const std::string& raw_file, const std::vector<WhiteImageFile>* white_images)
+                          const SidecarFiles& files)
 {
     Json json = Json::object();
     json["format"] = "povray-plenoptic-metadata";
@@ -371,7 +370,7 @@ std::string metadata_json(const Model& m, const CameraParams& params, int W, int
     radiometry["projected_solid_angle_sr"] = number_or_null(solid_angle > 0, solid_angle);
     radiometry["angular_response"] = number(m.angular_exponent);
     sensor["radiometry"] = radiometry;
-    sensor["read_out"] = read_out_json(params.sensor.chain, raw_file);
+    sensor["read_out"] = read_out_json(params.sensor.chain, files.raw);
     json["sensor"] = sensor;
 
     Json samples = Json::object();
@@ -390,13 +389,14 @@ std::string metadata_json(const Model& m, const CameraParams& params, int W, int
     const MicroimageLattice lattice = microimage_lattice(m, W, H);
     json["microimage_lattice"] = lattice_json(m, lattice);
     json["lftoolbox_lenslet_grid_model"] = lftoolbox(lattice);
-    json["depth_map"] = depth_map_file.empty() ? Json(nullptr) : Json(depth_map_file);
-    json["microimages"] = microimages_json(microimages);
-    if (white_images == nullptr) {
+    json["depth_map"] = files.depth_map.empty() ? Json(nullptr) : Json(files.depth_map);
+    json["virtual_depth_map"] = files.virtual_depth_map.empty() ? Json(nullptr) : Json(files.virtual_depth_map);
+    json["microimages"] = microimages_json(files.microimages);
+    if (files.white_images == nullptr) {
         json["white_images"] = nullptr;
     } else {
         Json list = Json::array();
-        for (const WhiteImageFile& w : *white_images) {
+        for (const WhiteImageFile& w : *files.white_images) {
             Json entry = Json::object();
             entry["file"] = w.file;
             entry["f_number"] = w.f_number > 0 ? number(w.f_number) : Json(nullptr);

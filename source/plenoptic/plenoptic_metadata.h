@@ -21,12 +21,9 @@ struct CameraFrame {
 };
 
 // The JSON of docs/metadata.md for a W x H render (written with nlohmann-json, members in the
-// documented order). `depth_map_file` empty writes null; a file name that is not UTF-8 has each
-// invalid byte replaced by U+FFFD. Numbers are written in the shortest form that reads back to
+// documented order). A file name that is not UTF-8 has each invalid byte replaced by U+FFFD. Numbers are written in the shortest form that reads back to
 // the same double (0.15), whole numbers below 2^53 without a fraction (1000); a number that is
-// not finite is written as null. `microimages`: the summary of the microimages file written
-// beside the image, or nullptr (null in the JSON). `raw_file`: the sensor's raw written beside
-// the image (sensor.read_out.raw_file; "" gives null there: asked for but not written).
+// not finite is written as null.
 // A white image written beside the image (plenoptic_white_image.h).
 struct WhiteImageFile {
     std::string file;
@@ -35,11 +32,26 @@ struct WhiteImageFile {
     double scale = 1;  // linear: a power of two >= the largest value, so that none clips (1: none above 1)
 };
 
-// `white_images`: the white images written (null in the JSON when none was asked for).
+// The files written beside the image, as the metadata names them (empty or nullptr: null).
+// `depth_map`: the depth EXR; `virtual_depth_map`: the virtual-depth EXR of a focused camera;
+// `microimages`: the summary of the microimages file; `raw`: the sensor's raw
+// (sensor.read_out.raw_file; "" gives null there: asked for but not written); `white_images`:
+// the white images written (null in the JSON when none was asked for). Built from a depth map's
+// name alone for the common case.
+struct SidecarFiles {
+    std::string depth_map;
+    std::string virtual_depth_map;
+    const MicroimageSummary* microimages = nullptr;
+    std::string raw;
+    const std::vector<WhiteImageFile>* white_images = nullptr;
+
+    SidecarFiles() {}
+    SidecarFiles(const std::string& depth_map_file) : depth_map(depth_map_file) {}
+    SidecarFiles(const char* depth_map_file) : depth_map(depth_map_file) {}
+};
+
 std::string metadata_json(const Model& model, const CameraParams& params, int W, int H,
-                          const CameraFrame& frame, const std::string& depth_map_file,
-                          const MicroimageSummary* microimages = nullptr, const std::string& raw_file = "",
-                          const std::vector<WhiteImageFile>* white_images = nullptr);
+                          const CameraFrame& frame, const SidecarFiles& files = SidecarFiles());
 
 } // namespace plenoptic
 

@@ -25,6 +25,20 @@ const CameraFrame kFrame = {{0, 0.5, -3}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 
 bool has(const std::string& json, const std::string& part) { return json.find(part) != std::string::npos; }
 
+SidecarFiles with_microimages(const MicroimageSummary* summary)
+{
+    SidecarFiles files;
+    files.microimages = summary;
+    return files;
+}
+
+SidecarFiles with_raw(const std::string& raw)
+{
+    SidecarFiles files;
+    files.raw = raw;
+    return files;
+}
+
 // The document, or a test failure when the text is not strict JSON (RFC 8259, valid UTF-8).
 Json parsed(const std::string& text)
 {
@@ -144,7 +158,7 @@ TEST(Metadata, KeysComeInTheDocumentedOrder)
     typedef std::vector<std::string> Names;
     EXPECT_EQ(keys(doc), (Names{"format", "version", "image", "mm_per_unit", "camera_frame", "main_lens",
                                 "microlens_array", "sensor", "samples", "diffraction", "principal_point_px", "microimage_lattice",
-                                "lftoolbox_lenslet_grid_model", "depth_map", "microimages", "white_images"}));
+                                "lftoolbox_lenslet_grid_model", "depth_map", "virtual_depth_map", "microimages", "white_images"}));
     EXPECT_EQ(keys(doc["image"]), (Names{"width", "height"}));
     EXPECT_EQ(keys(doc["camera_frame"]), (Names{"location", "right", "up", "direction"}));
     EXPECT_EQ(keys(doc["main_lens"]),
@@ -225,7 +239,7 @@ TEST(Metadata, SensorReadOut)
     c.read_noise_e = 3;
     c.black_level_dn = 64;
     c.seed = 7;
-    Json out = parsed(metadata_json(m, p, 64, 48, kFrame, "", nullptr, "scene.raw.png"))["sensor"]["read_out"];
+    Json out = parsed(metadata_json(m, p, 64, 48, kFrame, with_raw("scene.raw.png")))["sensor"]["read_out"];
     EXPECT_EQ(out["raw_file"], "scene.raw.png");
     EXPECT_EQ(out["bayer"], "grbg");
     EXPECT_EQ(out["bit_depth"], 10);
@@ -354,7 +368,7 @@ TEST(Metadata, MicroimagesSummaryIsWrittenAsGiven)
     summary.fit.worst = LensIndex{-3, 2};
     summary.from_lattice_rms_px = 0.25;
     summary.from_lattice_max_px = 1.5;
-    const Json doc = parsed(metadata_json(m, p, 640, 480, kFrame, "", &summary));
+    const Json doc = parsed(metadata_json(m, p, 640, 480, kFrame, with_microimages(&summary)));
     const Json& mi = doc["microimages"];
     std::vector<std::string> names;
     for (auto it = mi.begin(); it != mi.end(); ++it)
@@ -370,7 +384,7 @@ TEST(Metadata, MicroimagesSummaryIsWrittenAsGiven)
     EXPECT_EQ(mi["lattice_fit"]["max_residual_lens"], Json::parse("[-3, 2]"));
     EXPECT_EQ(mi["from_microimage_lattice"]["max_px"].get<double>(), 1.5);
     summary.fit.valid = false;
-    EXPECT_TRUE(parsed(metadata_json(m, p, 640, 480, kFrame, "", &summary))["microimages"]["lattice_fit"].is_null());
+    EXPECT_TRUE(parsed(metadata_json(m, p, 640, 480, kFrame, with_microimages(&summary)))["microimages"]["lattice_fit"].is_null());
 }
 
 TEST(Metadata, DistortionProfileOfAThinLensWithDistortion)

@@ -7,6 +7,7 @@
 #include "povray_glue/plenoptic_raw_png.h"
 #include "povray_glue/plenoptic_render.h"
 #include "plenoptic/plenoptic_diffraction.h"
+#include "plenoptic/plenoptic_virtual_depth.h"
 
 #include <cerrno>
 #include <cmath>
@@ -91,40 +92,76 @@ bool write_text_atomically(const char* what, const std::string& path, const std:
     return true;
 }
 
-// Writes the depth map row by row (memory: one row), -1 in rows never rendered.
-bool write_depth_exr(const std::string& path, const DepthMap& depth)
+// Writes a one-channel float EXR row by row (memory: one row): fill(j, row) fills row j and
+// returns false to stop (cancelled: nothing is written). `what` names the file in messages.
+template <class Fill>
+bool write_float_exr(const std::string& path, const char* what, const char* channel, int W, int H, Fill fill)
 {
     const std::string tmp = temporary_beside(path);
     if (tmp.empty()) {
-        report_failure("depth map", path, errno);
+        report_failure(what, path, errno);
         return false;
     }
-    const int W = depth.width(), H = depth.height();
+    bool complete = true;
     try {
         Imf::Header header(W, H);
-        header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+        header.channels().insert(channel, Imf::Channel(Imf::FLOAT));
         Imf::OutputFile file(tmp.c_str(), header);
-        const std::vector<float> unrendered(size_t(W), -1.0f);
-        for (int j = 0; j < H; ++j) {
-            const float* row = depth.row(j) != nullptr ? depth.row(j) : unrendered.data();
+        std::vector<float> row(size_t(W), 0.0f);
+        for (int j = 0; j < H && complete; ++j) {
+            complete = fill(j, row.data());
             // The slice's base is where pixel (0, 0) would be, so that row j starts at `row`.
             Imf::FrameBuffer buffer;
-            buffer.insert("Z", Imf::Slice(Imf::FLOAT, (char*)(row) - sizeof(float) * size_t(W) * j, sizeof(float),
-                                          sizeof(float) * W));
+            buffer.insert(channel, Imf::Slice(Imf::FLOAT, (char*)(row.data()) - sizeof(float) * size_t(W) * j,
+                                              sizeof(float), sizeof(float) * W));
             file.setFrameBuffer(buffer);
-            file.writePixels(1);
+            if (complete)
+                file.writePixels(1);
         }
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "plenoptic camera: cannot write depth map %s: %s\n", path.c_str(), e.what());
+        std::fprintf(stderr, "plenoptic camera: cannot write %s %s: %s\n", what, path.c_str(), e.what());
+        std::remove(tmp.c_str());
+        return false;
+    }
+    if (!complete) {
         std::remove(tmp.c_str());
         return false;
     }
     if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        report_failure("depth map", path, errno);
+        report_failure(what, path, errno);
         std::remove(tmp.c_str());
         return false;
     }
     return true;
+}
+
+// The depth map, -1 in rows never rendered.
+bool write_depth_exr(const std::string& path, const DepthMap& depth)
+{
+    const int W = depth.width();
+    return write_float_exr(path, "depth map", "Z", W, depth.height(), [&](int j, float* row) {
+        const float* rendered = depth.row(j);
+        for (int i = 0; i < W; ++i)
+            row[i] = rendered != nullptr ? rendered[i] : -1.0f;
+        return true;
+    });
+}
+
+// A focused camera's virtual depth per pixel, from the depth map (NaN where it is -1 or was not
+// rendered). Stops on Ctrl-C (no file).
+bool write_virtual_depth_exr(const std::string& path, const Model& model, const DepthMap& depth)
+{
+    const int W = depth.width(), H = depth.height();
+    if (size_t(W) * H >= 4000000)
+        std::fprintf(stderr, "plenoptic camera: virtual depth of %d x %d pixels\n", W, H);
+    return write_float_exr(path, "virtual depth map", "V", W, H, [&](int j, float* row) {
+        if (render_cancel_requested())
+            return false;
+        const float* rendered = depth.row(j);
+        for (int i = 0; i < W; ++i)
+            row[i] = pixel_virtual_depth(model, W, H, i, j, rendered != nullptr ? rendered[i] : -1.0f);
+        return true;
+    });
 }
 
 // The picture's R, G, B in linear light, interleaved, rows from the top.
@@ -153,6 +190,10 @@ std::string base_name(const std::string& path)
 
 std::string metadata_path_for(const std::string& image_path) { return replace_extension(image_path, ".plenoptic.json"); }
 std::string depth_path_for(const std::string& image_path) { return replace_extension(image_path, ".depth.exr"); }
+std::string virtual_depth_path_for(const std::string& image_path)
+{
+    return replace_extension(image_path, ".virtual_depth.exr");
+}
 std::string microimages_path_for(const std::string& image_path)
 {
     return replace_extension(image_path, ".microimages.csv");
@@ -213,7 +254,8 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
         return true;
     }
     bool ok = true;
-    std::string depth_file;
+    SidecarFiles files;
+    const Model& model = render->model();
     if (render->depth() != nullptr && W == render->width() && H == render->height()) {
         const long long unknown = render->backfill() ? render->backfill()->pixels_not_handed_out() : 0;
         if (unknown > 0)
@@ -222,13 +264,21 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
                                  "they read -1 in the depth map.\n", unknown);
         const std::string depth_path = depth_path_for(image_path);
         if (write_depth_exr(depth_path, *render->depth()))
-            depth_file = base_name(depth_path);
+            files.depth_map = base_name(depth_path);
         else
             ok = false;
+        if (is_focused_camera(model)) {
+            const std::string path = virtual_depth_path_for(image_path);
+            if (write_virtual_depth_exr(path, model, *render->depth()))
+                files.virtual_depth_map = base_name(path);
+            else if (render_cancel_requested())
+                std::fprintf(stderr, "plenoptic camera: cancelled: no virtual depth map written (%s).\n", path.c_str());
+            else
+                ok = false;
+        }
     }
     // The microimages of a white scene through this camera (a main lens and an array): by default
     // only where they leave the lattice the metadata gives (docs/real-lenses.md).
-    const Model& model = render->model();
     const CameraSetup::MicroimageCentres asked = render->setup().microimage_centres;
     const bool off_lattice = model.main_lens == MainLensType::Prescription || model.has_distortion;
     std::unique_ptr<MicroimageSummary> microimages;
@@ -339,8 +389,10 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
         if (render_cancel_requested())
             std::fprintf(stderr, "plenoptic camera: cancelled: white images not all written.\n");
     }
-    const std::string json = metadata_json(model, render->setup().params, W, H, render->frame(), depth_file,
-                                           microimages.get(), raw_file, whites.get());
+    files.microimages = microimages.get();
+    files.raw = raw_file;
+    files.white_images = whites.get();
+    const std::string json = metadata_json(model, render->setup().params, W, H, render->frame(), files);
     if (!write_text_atomically("metadata", metadata_path_for(image_path), json))
         ok = false;
     return ok;

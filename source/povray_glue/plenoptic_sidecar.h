@@ -19,6 +19,7 @@ namespace plenoptic {
 // Names of the files beside an image `dir/name.ext`.
 std::string metadata_path_for(const std::string& image_path);  // dir/name.plenoptic.json
 std::string depth_path_for(const std::string& image_path);     // dir/name.depth.exr
+std::string virtual_depth_path_for(const std::string& image_path);  // dir/name.virtual_depth.exr
 std::string microimages_path_for(const std::string& image_path);// dir/name.microimages.csv
 
 std::string raw_path_for(const std::string& image_path);        // dir/name.raw.png

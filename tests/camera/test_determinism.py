@@ -38,6 +38,9 @@ def test_determinism_across_thread_counts(args):
         depth_file = meta.get("depth_map")
         depths[name] = pt.load(os.path.join(args.work, depth_file)) if depth_file else None
         meta.pop("depth_map", None)
+        virtual_file = meta.pop("virtual_depth_map", None)
+        if virtual_file:
+            depths[name + " virtual depth"] = pt.load(os.path.join(args.work, virtual_file))
         with open(os.path.join(args.work, meta["microimages"].pop("file")), "rb") as f:
             centres[name] = f.read()
         metas[name] = meta
@@ -51,6 +54,11 @@ def test_determinism_across_thread_counts(args):
             a, b = depths[ref], depths[name]
             same = np.array_equal(a, b) or np.array_equal(np.nan_to_num(a, posinf=-9), np.nan_to_num(b, posinf=-9))
             assert same, "depth map %s == %s" % (name, ref) + ": " + ("%d values differ" % int((np.nan_to_num(a, posinf=-9) != np.nan_to_num(b, posinf=-9)).sum()))
+        key = " virtual depth"
+        assert (ref + key in depths) == (name + key in depths), "a virtual depth map in every run or in none"
+        if ref + key in depths:
+            assert np.array_equal(np.nan_to_num(depths[ref + key], nan=-9), np.nan_to_num(depths[name + key], nan=-9)), (
+                "virtual depth map %s == %s" % (name, ref))
         assert metas[name] == metas[ref], "metadata %s == %s" % (name, ref) + ": " + ("identical apart from the names of the depth map and the microimage centres: %s" % (metas[name] == metas[ref]))
         assert centres[name] == centres[ref], "microimage centres %s == %s: byte for byte" % (name, ref)
     # The image must hold a real picture, or identity would prove little.

@@ -71,7 +71,11 @@ SCENES = {
                      "microimage_lattice.exact": True}),
     "depth_map_on": (THIN + " microlens_array { hexagonal pitch 0.15 focal_length 0.6 distance 0.6 }"
                      " samples 4 depth_map",
-                     {"depth_map": "depth_map_on.depth.exr"}),
+                     {"depth_map": "depth_map_on.depth.exr", "virtual_depth_map": None}),
+    "virtual_depth_on": (THIN + " microlens_array { hexagonal pitch 0.15 focal_length 0.6 distance 0.75 }"
+                         " samples 4 depth_map",
+                         {"depth_map": "virtual_depth_on.depth.exr",
+                          "virtual_depth_map": "virtual_depth_on.virtual_depth.exr"}),
     "adaptive": (THIN + " microlens_array { hexagonal pitch 0.15 focal_length 0.6 distance 0.6 }"
                  " samples 2, 8 confidence 0.95 variance 0.01",
                  {"samples.adaptive": True, "samples.min": 2, "samples.max": 8, "samples.confidence": 0.95,
@@ -81,7 +85,7 @@ SCENES = {
 ORDER = {
     "": ["format", "version", "image", "mm_per_unit", "camera_frame", "main_lens", "microlens_array", "sensor",
          "samples", "diffraction", "principal_point_px", "microimage_lattice", "lftoolbox_lenslet_grid_model", "depth_map",
-         "microimages", "white_images"],
+         "virtual_depth_map", "microimages", "white_images"],
     "image": ["width", "height"],
     "camera_frame": ["location", "right", "up", "direction"],
     "main_lens": ["type", "focal_length_mm", "aperture_mm", "f_number", "distance_mm", "focus_distance",
