@@ -35,16 +35,20 @@ def find_project_tool():
     return "plenoptic-project"
 
 
-def project_points(metadata_path, points, tool=None):
+def project_points(metadata_path, points, tool=None, blur=False):
     """World points (scene units, N x 3) -> list of (point_index, lens_k, lens_l, u, v), one per
-    image of each point, by running plenoptic-project. Raises RuntimeError with its message."""
+    image of each point, by running plenoptic-project; with blur, each tuple also holds the
+    image's signed blur radius in pixels (plenoptic-project --blur). Raises RuntimeError with its
+    message."""
     tool = tool or find_project_tool()
     text = "\n".join("%.17g %.17g %.17g" % tuple(p) for p in points) + "\n"
-    run = subprocess.run([tool, metadata_path, "-"], input=text, capture_output=True, text=True)
+    run = subprocess.run([tool] + (["--blur"] if blur else []) + [metadata_path, "-"], input=text,
+                         capture_output=True, text=True)
     if run.returncode != 0:
         raise RuntimeError(run.stderr.strip() or "plenoptic-project failed with status %d" % run.returncode)
     hits = []
     for line in run.stdout.splitlines():
-        i, k, l, u, v = line.split()
-        hits.append((int(i), int(k), int(l), float(u), float(v)))
+        words = line.split()
+        hit = (int(words[0]), int(words[1]), int(words[2]), float(words[3]), float(words[4]))
+        hits.append(hit + (float(words[5]),) if blur else hit)
     return hits

@@ -19,12 +19,13 @@
 #include <vector>
 
 #include "plenoptic_metadata_reader.h"
+#include "plenoptic_blur.h"
 
 namespace {
 
 const char* kUsage =
-    "usage: plenoptic-project [--fraction] METADATA.json X Y Z [X Y Z ...]\n"
-    "       plenoptic-project [--fraction] METADATA.json -   (points from standard input, three numbers each)\n"
+    "usage: plenoptic-project [--fraction] [--blur] METADATA.json X Y Z [X Y Z ...]\n"
+    "       plenoptic-project [--fraction] [--blur] METADATA.json -   (points from standard input, three numbers each)\n"
     "Projects world points (scene units) into the render described by METADATA.json (the\n"
     "<image>.plenoptic.json a plenoptic render writes) and prints, for each point, one line per\n"
     "image of it: point_index lens_k lens_l u v\n"
@@ -33,6 +34,9 @@ const char* kUsage =
     "  u v          pixel coordinates, centre of pixel (column i, row j) at (i, j), v downwards\n"
     "  --fraction   adds a sixth column: the part of the point's light through the main aperture\n"
     "               that arrives in that image (1 where each image is a single ray: pinholes)\n"
+    "  --blur       adds a column (after the fraction, if asked for): the signed radius in pixels of\n"
+    "               the point's defocus blur through that microlens, libpleno's blur-aware point model\n"
+    "               r = (pitch / 2) d (1/f - 1/a - 1/d) (docs/ground-truth.md); nan where undefined\n"
     "Exit status: 0 done, 2 bad usage, unreadable or invalid metadata, or a malformed number.\n";
 
 bool parse_number(const std::string& text, double* value)
@@ -60,9 +64,9 @@ int main(int argc, char** argv)
         std::fputs(kUsage, stdout);
         return 0;
     }
-    bool with_fraction = false;
-    if (!args.empty() && args[0] == "--fraction") {
-        with_fraction = true;
+    bool with_fraction = false, with_blur = false;
+    while (!args.empty() && (args[0] == "--fraction" || args[0] == "--blur")) {
+        (args[0] == "--fraction" ? with_fraction : with_blur) = true;
         args.erase(args.begin());
     }
     if (args.empty())
@@ -110,12 +114,16 @@ int main(int argc, char** argv)
 
     for (size_t p = 0; p < values.size() / 3; ++p) {
         const std::vector<plenoptic::PixelHit> hits = plenoptic::project_world_point(metadata, &values[3 * p]);
+        double optics[3] = {0, 0, 0};
+        if (with_blur && !hits.empty())
+            plenoptic::world_to_optics_mm(metadata, &values[3 * p], optics);
         for (const plenoptic::PixelHit& hit : hits) {
+            std::printf("%zu %lld %lld %.6f %.6f", p, (long long)hit.lens.k, (long long)hit.lens.l, hit.u, hit.v);
             if (with_fraction)
-                std::printf("%zu %lld %lld %.6f %.6f %.6g\n", p, (long long)hit.lens.k, (long long)hit.lens.l, hit.u,
-                            hit.v, hit.fraction);
-            else
-                std::printf("%zu %lld %lld %.6f %.6f\n", p, (long long)hit.lens.k, (long long)hit.lens.l, hit.u, hit.v);
+                std::printf(" %.6g", hit.fraction);
+            if (with_blur)
+                std::printf(" %.6f", plenoptic::blur_radius_px(metadata.model, optics, hit.lens));
+            std::printf("\n");
         }
     }
     return std::fflush(stdout) == 0 ? 0 : 2;
