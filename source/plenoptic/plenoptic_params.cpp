@@ -96,9 +96,12 @@ std::string check_angle(const char* keyword, double degrees)
 
 std::string check_translation(const char* keyword, double value_mm)
 {
-    if (std::isfinite(value_mm))
+    // Bounded as lengths are: beyond 1e12 mm squared distances overflow (a fuzzed array
+    // translated by 8e283 mm gave NaN pixels under irradiance).
+    if (std::isfinite(value_mm) && std::fabs(value_mm) <= kMaxLengthMm)
         return "";
-    return str(keyword) + " must be a finite length in mm, got " + format_number(value_mm);
+    return str(keyword) + " must be a finite length from -" + format_number(kMaxLengthMm) + " to " +
+           format_number(kMaxLengthMm) + " mm, got " + format_number(value_mm);
 }
 
 std::string check_samples(const char* keyword, double value)

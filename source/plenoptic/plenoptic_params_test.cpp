@@ -44,6 +44,8 @@ TEST(Params, PerValueRefusalsNameKeywordValueAndRange)
         {check_angle("rotate", kNaN), "rotate", "nan"},
         {check_translation("translate", kInf), "translate", "inf"},
         {check_translation("offset", kNaN), "offset", "nan"},
+        {check_translation("translate", 8.0298913057934345e+283), "translate", "8.029891305793435e+283"},
+        {check_translation("offset", -2e12), "offset", "-2000000000000"},
         {check_samples("samples", 0), "samples", "got 0"},
         {check_samples("samples", 2.5), "samples", "2.5"},
         {check_samples("samples", 1e12), "samples", "1000000000000"},
@@ -79,6 +81,7 @@ TEST(Params, PerValueChecksAcceptValidValues)
     EXPECT_EQ(check_focus_distance(2.5), "");
     EXPECT_EQ(check_angle("rotate", -720), "");
     EXPECT_EQ(check_translation("translate", -3), "");
+    EXPECT_EQ(check_translation("offset", kMaxLengthMm), "");
     EXPECT_EQ(check_samples("samples", 1), "");
     EXPECT_EQ(check_samples("samples", 1000000), "");
     EXPECT_EQ(check_confidence(0.9), "");
