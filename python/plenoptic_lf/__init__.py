@@ -16,7 +16,8 @@ image and honours the file's own encoding, e.g. a linear 16-bit PNG) and Pillow 
 
 Modules: metadata (reading and checking the JSON), images (image input and output),
 lightfield (raw + metadata -> LightField, views, EPI, refocus), focus (the refocus sweep),
-projection (forward projection through plenoptic-project), contact_sheet, outputs (the
+projection (forward projection through plenoptic-project), hci (the HCI benchmark's layout with
+ground truth), total_focus (a focused raw's all-in-focus image), contact_sheet, outputs (the
 decoder's output folder), progress, errors, cli (the plenoptic-decode command).
 
 Importable with only its parent directory on sys.path: nothing here is generated at build time.
@@ -32,6 +33,8 @@ from .focus import (box3, default_slopes, distance_to_slope, gray, laplacian_ene
 from .images import (RawInfo, bilinear, check_encoding, inspect_raw, linear_to_srgb, read_depth_map, read_raw,
                      read_raw_image, require_openimageio, save_png, scaled_pil_image, srgb_to_linear, to_8bit,
                      to_linear)
+from .hci import HciGeometry, export_hci, write_pfm
+from .total_focus import total_focus
 from .lightfield import LIGHT_FIELD_LIMIT_BYTES, DecodePlan, LightField, angular_grid, decode, mosaic, plan_decode
 from .metadata import METADATA_FORMAT, METADATA_VERSION, Metadata, load_metadata, metadata_path_for
 from .outputs import write_outputs
@@ -53,6 +56,8 @@ __all__ = [
     "sharpest_slope_map", "pick_near_far", "pick_epi_row",
     # forward projection
     "find_project_tool", "project_points",
+    # ground-truth exports
+    "HciGeometry", "export_hci", "write_pfm", "total_focus",
     # pictures and the command
     "contact_sheet", "write_outputs", "Progress", "parse_slopes", "main",
 ]

@@ -18,11 +18,13 @@ import numpy as np
 from .errors import DecodeError, DependencyError, MetadataError
 from .hci import check_hci_camera, depth_map_path, export_hci
 from .focus import default_slopes, slopes_from_depth_map
-from .images import check_encoding, inspect_raw, read_raw_image, require_openimageio
+from .images import (check_encoding, inspect_raw, read_depth_map, read_raw_image, require_openimageio, save_exr,
+                     save_png)
 from .lightfield import decode, plan_decode
 from .metadata import load_metadata, metadata_path_for
 from .outputs import write_outputs
 from .progress import Progress
+from .total_focus import check_total_focus_camera, total_focus, virtual_depth_path
 from .sensor import demosaic_bilinear, devignette, dn_to_linear, read_out_of, white_image_of
 
 
@@ -138,6 +140,15 @@ def _argument_parser():
     parser.add_argument("--hci-all-views", action="store_true",
                         help="with --hci: also write gt_depth_lowres_CamNNN.pfm and gt_disp_lowres_CamNNN.pfm for "
                              "every view")
+    parser.add_argument("--total-focus", default=None, metavar="IMAGE",
+                        help="write instead the total-focus (all-in-focus) image of a focused (2.0) raw to IMAGE "
+                             "(.exr: linear float; otherwise 8-bit sRGB), from the render's virtual depth map "
+                             "(depth_map on the camera) or --virtual-depth (docs/total-focus.md)")
+    parser.add_argument("--virtual-depth", type=float, default=None, metavar="V",
+                        help="with --total-focus: one virtual depth for the whole picture instead of the render's map")
+    parser.add_argument("--total-focus-step", type=float, default=None, metavar="PX",
+                        help="with --total-focus: picture pixels between output samples (default: one raw pixel "
+                             "apart at the median virtual depth, about |v|)")
     parser.add_argument("--no-gif", action="store_true", help="do not write refocus.gif")
     parser.add_argument("--no-npy", action="store_true", help="do not write lightfield.npy")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
@@ -159,6 +170,12 @@ def main(argv=None):
         return fail(str(e), 1)
     if args.hci_all_views and not args.hci:
         return fail("--hci-all-views needs --hci DIR")
+    if (args.virtual_depth is not None or args.total_focus_step is not None) and not args.total_focus:
+        return fail("--virtual-depth and --total-focus-step need --total-focus IMAGE")
+    if args.hci and args.total_focus:
+        return fail("give --hci or --total-focus, not both")
+    if args.virtual_depth is not None and not (math.isfinite(args.virtual_depth) and abs(args.virtual_depth) >= 1e-3):
+        return fail("--virtual-depth must be a finite number other than 0, got %r" % args.virtual_depth)
     if not (args.step > 0 and math.isfinite(args.step)):
         return fail("--step must be a positive number of pixels")
     try:
@@ -183,6 +200,10 @@ def main(argv=None):
         if args.hci:
             check_hci_camera(meta)
             depth_map_path(meta)
+        elif args.total_focus:
+            check_total_focus_camera(meta)
+            if args.virtual_depth is None:
+                virtual_depth_path(meta)
         else:
             plan_decode(meta, args.angular, args.step)
         raw = read_picture(args.raw, meta, encoding, progress)
@@ -197,6 +218,22 @@ def main(argv=None):
             if not args.quiet:
                 print("plenoptic-decode: wrote %d x %d views and their ground truth to %s" % (n, n, args.hci),
                       file=sys.stderr)
+            return 0
+        if args.total_focus:
+            virtual = args.virtual_depth
+            if virtual is None:
+                path = virtual_depth_path(meta)
+                virtual = read_depth_map(path)
+                if virtual is None or virtual.shape != (meta.height, meta.width):
+                    return fail("cannot read the virtual depth map %s as a %d x %d image" % (path, meta.width, meta.height))
+            image, used = total_focus(raw, meta, virtual, args.total_focus_step)
+            progress.stage("total focus: %d x %d samples %.3g px apart" % (image.shape[1], image.shape[0], used))
+            if args.total_focus.lower().endswith(".exr"):
+                save_exr(args.total_focus, image)
+            else:
+                save_png(args.total_focus, np.clip(image, 0, 1))
+            if not args.quiet:
+                print("plenoptic-decode: wrote %s" % args.total_focus, file=sys.stderr)
             return 0
         lf = decode(raw, meta, args.angular, args.step, progress)
         if slopes is None:

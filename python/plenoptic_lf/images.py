@@ -189,6 +189,20 @@ def save_png(path, image):
     Image.fromarray(srgb).save(path)
 
 
+def save_exr(path, image):
+    """A linear float image (H, W, C) as a float OpenEXR file (OpenImageIO)."""
+    oiio = require_openimageio()
+    image = np.ascontiguousarray(image, dtype=np.float32)
+    spec = oiio.ImageSpec(image.shape[1], image.shape[0], image.shape[2], oiio.FLOAT)
+    out = oiio.ImageOutput.create(path)
+    if out is None or not out.open(path, spec):
+        raise OSError("cannot write %s: %s" % (path, oiio.geterror() or "no EXR writer"))
+    ok = out.write_image(image)
+    out.close()
+    if not ok:
+        raise OSError("cannot write %s: %s" % (path, out.geterror()))
+
+
 def scaled_pil_image(image, width=None, height=None, aspect=1.0):
     """Linear image -> PIL image scaled (nearest neighbour: every lens stays a visible cell) to
     fit width x height, with rows stretched by `aspect` (cell height / width)."""
