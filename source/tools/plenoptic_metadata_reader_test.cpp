@@ -173,20 +173,23 @@ TEST(MetadataReader, RefusesTruncatedAndMalformedText)
                                 "string \"hex\\nagonal\"")) << error;
 }
 
-TEST(MetadataReader, ReadsANullLatticeWhereTheWriterWritesOne)
+TEST(MetadataReader, ExtremeShiftsKeepALatticeTheReaderTakesBack)
 {
-    // An array shifted 1e300 mm sideways under 1e-9 mm pixels: accepted, but its lattice in pixels
-    // overflows, so the writer writes null (docs/metadata.md); the reader takes that back.
+    // An array shifted 1e300 mm sideways once passed the checks and its lattice in pixels
+    // overflowed (the writer wrote null); shifts are now bounded as lengths are. The largest
+    // accepted shift under the smallest pixels still has a finite lattice, written and read back.
     CameraParams p = hexagonal_camera();
     p.array.translate_mm[0] = 1e300;
-    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 1e-9;
+    EXPECT_TRUE(contains(check_camera(p), "translate")) << check_camera(p);
+    p.array.translate_mm[0] = 1e12;
+    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 1e-12;
     ASSERT_EQ(check_camera(p), "");
     const std::string text = metadata_json(make_model(p), p, 320, 240, kFrame, "");
-    ASSERT_TRUE(contains(text, "\"microimage_lattice\": null")) << text;
+    ASSERT_FALSE(contains(text, "\"microimage_lattice\": null")) << text;
     RenderMetadata metadata;
     std::string error;
     EXPECT_TRUE(parse_metadata(text, &metadata, &error)) << error;
-    // An ordinary camera's lattice may not be dropped.
+    // A lattice may not be dropped.
     error = refusal(edited(good_text(), "\"microimage_lattice\": {", "\"microimage_lattice\": null, \"x\": {"));
     EXPECT_TRUE(contains(error, "field 'microimage_lattice' must be an object")) << error;
 }

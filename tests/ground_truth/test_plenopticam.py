@@ -128,13 +128,20 @@ def area_resize(img, rows, cols):
                         (rows / img.shape[0], cols / img.shape[1]), order=1)
 
 
+_RUN_THIS_SESSION = set()
+
+
 def run_plenopticam(args, venv_python, name, grid, pitch):
-    """Renders the camera (once per session) and runs PlenoptiCam on it: (metadata, report, out)."""
+    """Renders the camera and runs PlenoptiCam on it once per test session (files left in the
+    work folder by an earlier session, perhaps by another build, are not reused): (metadata,
+    report, out)."""
     work = os.path.join(args.work, name)
     out = os.path.join(work, "plenopticam")
     report_path = os.path.join(out, "report.json")
     png = os.path.join(work, name + ".png")
-    if not os.path.exists(report_path) or not os.path.exists(png):
+    if name not in _RUN_THIS_SESSION:
+        if os.path.exists(report_path):
+            os.remove(report_path)
         png = pt.render(args.povray, work, name, CHART + camera(grid, pitch), W, H)
         white_png = os.path.splitext(png)[0] + ".white.png"
         os.makedirs(out, exist_ok=True)
@@ -145,6 +152,7 @@ def run_plenopticam(args, venv_python, name, grid, pitch):
         assert run.returncode == 0, "PlenoptiCam failed on %s:\n%s" % (name, (run.stdout + run.stderr)[-3000:])
         with open(report_path, "w") as f:
             f.write(run.stdout.strip().splitlines()[-1])
+        _RUN_THIS_SESSION.add(name)
     with open(report_path) as f:
         report = json.load(f)
     return pt.metadata_of(png), report, out, work

@@ -283,10 +283,18 @@ def read_pixels(path):
     """The pixels (H, W, channels) of any image OpenImageIO reads, as it gives them (float32;
     PNG as 0..1). Raises RenderError when the file cannot be read."""
     import OpenImageIO as oiio
-    buf = oiio.ImageBuf(path)
-    pixels = None if buf.has_error else buf.get_pixels(oiio.FLOAT)
-    if pixels is None or buf.has_error:
-        raise RenderError("cannot read %s: %s" % (path, buf.geterror()))
+    # ImageInput, not ImageBuf: an ImageBuf reads through OpenImageIO's shared cache, which
+    # returns the first pixels read from a path even after the file was written again.
+    image = oiio.ImageInput.open(path)
+    if image is None:
+        raise RenderError("cannot read %s: %s" % (path, oiio.geterror()))
+    pixels = image.read_image(oiio.FLOAT)
+    problem = image.geterror() if pixels is None else ""
+    image.close()
+    if pixels is None:
+        raise RenderError("cannot read %s: %s" % (path, problem))
+    if pixels.ndim == 2:
+        pixels = pixels[:, :, None]
     return pixels
 
 
