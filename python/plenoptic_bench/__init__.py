@@ -4,7 +4,7 @@
   tools/bench                 full run (about an hour on 2 cores); writes benchmarks/results/
   tools/bench --quick         tiny sizes, one run each: checks that the benchmark runs (CI)
   tools/bench --only trade    one section (overhead, lenses, trade, dark, threads, fullsize,
-                              real_lens, fullsize_real_lens, build)
+                              real_lens, fullsize_real_lens, realism, dataset, build)
   tools/bench --out DIR --report DIR/BENCHMARKS.md
                               a full run that leaves the committed results and report alone
 

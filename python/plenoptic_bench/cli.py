@@ -11,6 +11,7 @@ import time
 from . import __doc__ as USAGE
 from .build import section_build
 from .dark import section_dark
+from .dataset import section_dataset
 from .fullsize import section_fullsize
 from .lenses import section_lenses
 from .overhead import section_overhead
@@ -48,7 +49,7 @@ def main():
         return 2
     runs = 1 if args.quick else args.runs
     sections = args.only or ["overhead", "lenses", "trade", "dark", "threads", "fullsize", "real_lens",
-                             "fullsize_real_lens", "realism"]
+                             "fullsize_real_lens", "realism", "dataset"]
     os.makedirs(args.out, exist_ok=True)
     work = tempfile.mkdtemp(prefix="plenoptic-bench-")
     b = Bench(os.path.abspath(args.povray), work, runs)
@@ -127,6 +128,10 @@ def main():
             section_realism(b, (64, 48) if args.quick else (1440, 960), runs, 24 if args.quick else 96, results)
             save()
             done("realism")
+        if "dataset" in sections:
+            section_dataset(b, args.quick, runs, results)
+            save()
+            done("dataset")
         if "build" in sections:
             section_build(results)
             done("build")

@@ -2,6 +2,7 @@
 """BENCHMARKS.md from results.json, and the plots."""
 import os
 
+from .dataset_report import dataset_report
 from .util import ROOT, log
 
 
@@ -309,6 +310,8 @@ def write_report(results, path, plots, results_path):
         real_lens_report(L, results)
     if results.get("realism"):
         realism_report(L, results)
+    if results.get("dataset"):
+        dataset_report(L, results)
     analysis = os.path.join(ROOT, "benchmarks", "analysis.md")
     if os.path.exists(analysis):
         with open(analysis) as fh:

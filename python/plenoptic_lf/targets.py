@@ -30,11 +30,12 @@ import json
 import math
 import os
 import random
-import shutil
 import subprocess
 import sys
 
 import numpy as np
+
+from .locate import PREFIX, REPOSITORY, find_povray, find_project
 
 
 def rotation_xyz(degrees):
@@ -107,30 +108,11 @@ def scene_text(camera_path, target, pose):
             % (os.path.abspath(camera_path), target_object(target), *pose["rotate_deg"], *pose["translate"]))
 
 
-def _find(name, given, candidates):
-    """`given`, else the first candidate that exists, else `name` on PATH (never Debian's povray:
-    the renderer is looked for as povray-plenoptic)."""
-    if given:
-        return given
-    for c in candidates:
-        if os.path.exists(c):
-            return os.path.abspath(c)
-    found = shutil.which(name)
-    if not found:
-        raise FileNotFoundError("cannot find %s: give its path with --%s" % (name, "povray" if "povray" in name else "project"))
-    return found
-
-
-# This file is <repository>/python/plenoptic_lf/targets.py in the source tree, and
-# P/lib/python3/dist-packages/plenoptic_lf/targets.py when installed under the prefix P.
-_HERE = os.path.dirname(os.path.abspath(__file__))
-_REPOSITORY = os.path.dirname(os.path.dirname(_HERE))
-_PREFIX = os.path.normpath(os.path.join(_HERE, "..", "..", "..", ".."))
 
 
 def _include_dir():
     """The folder holding calibration_targets.inc: the source tree's scenes/ or the install's."""
-    for c in (os.path.join(_REPOSITORY, "scenes"), os.path.join(_PREFIX, "share", "povray-plenoptic", "scenes")):
+    for c in (os.path.join(REPOSITORY, "scenes"), os.path.join(PREFIX, "share", "povray-plenoptic", "scenes")):
         if os.path.exists(os.path.join(c, "calibration_targets.inc")):
             return os.path.abspath(c)
     raise FileNotFoundError("calibration_targets.inc not found beside the plenoptic_lf package")
@@ -169,10 +151,8 @@ def main(argv=None):
             args.lateral >= 0 and args.width >= 1 and args.height >= 1):
         return fail("need --count >= 1, 0 < MIN <= MAX, 0 <= --tilt < 90, --lateral >= 0 and a positive size")
     try:
-        povray = _find("povray-plenoptic", args.povray, [os.path.join(_REPOSITORY, "build", "povray"),
-                                                         os.path.join(_PREFIX, "bin", "povray-plenoptic")])
-        project = _find("plenoptic-project", args.project, [os.path.join(_REPOSITORY, "build", "plenoptic-project"),
-                                                            os.path.join(_PREFIX, "bin", "plenoptic-project")])
+        povray = find_povray(args.povray)
+        project = find_project(args.project)
         include = _include_dir()
     except FileNotFoundError as e:
         return fail(str(e))

@@ -73,7 +73,8 @@ def test_decoder_package(args):
     licence = project.get("license")
     licence = licence.get("text") if isinstance(licence, dict) else licence
     assert (licence == "AGPL-3.0-or-later" and project.get("requires-python") == ">=3.9"), "pyproject.toml: license %r, requires-python %r" % (licence, project.get("requires-python"))
-    assert project.get("scripts") == {"plenoptic-decode": "plenoptic_lf.cli:main"}, "pyproject.toml: scripts %r (want plenoptic-decode = plenoptic_lf.cli:main)" % project.get("scripts")
+    want = {"plenoptic-decode": "plenoptic_lf.cli:main", "plenoptic-dataset": "plenoptic_lf.dataset.cli:main"}
+    assert project.get("scripts") == want, "pyproject.toml: scripts %r (want %r)" % (project.get("scripts"), want)
     assert pyproject.get("build-system", {}).get("build-backend") == "setuptools.build_meta", "pyproject.toml: build backend %r" % pyproject.get("build-system", {}).get("build-backend")
 
     imports = third_party_imports(package_dir)
@@ -141,4 +142,8 @@ def test_pip_install_into_a_venv(args):
     assert (run.returncode == 0 and run.stdout == launcher.stdout
                  and where.stdout.strip().startswith(venv + os.sep)), ("the venv's plenoptic-decode --help (exit %d) prints the usage; the package loads from %s"
                  % (run.returncode, where.stdout.strip() or where.stderr.strip()[-300:]))
+    dataset = subprocess.run([os.path.join(venv, "bin", "plenoptic-dataset"), "--help"], capture_output=True, text=True,
+                             cwd=args.work)
+    assert dataset.returncode == 0 and dataset.stdout.startswith("usage: plenoptic-dataset"), (
+        "the venv's plenoptic-dataset --help (exit %d): %s" % (dataset.returncode, dataset.stderr[-300:]))
 

@@ -32,6 +32,8 @@ LAYOUT = [
     "bin/plenoptic-project",
     "bin/plenoptic-decode",
     "bin/plenoptic-targets",
+    "bin/plenoptic-dataset",
+    "lib/python3/dist-packages/plenoptic_lf/dataset/cli.py",
     "lib/python3/dist-packages/plenoptic_lf/__init__.py",
     "lib/python3/dist-packages/plenoptic_lf/cli.py",
     "share/povray-plenoptic/include/colors.inc",
@@ -44,6 +46,7 @@ LAYOUT = [
     "share/man/man1/plenoptic-project.1",
     "share/man/man1/plenoptic-decode.1",
     "share/man/man1/plenoptic-targets.1",
+    "share/man/man1/plenoptic-dataset.1",
     "share/povray-plenoptic/scenes/calibration_targets.inc",
     "share/doc/povray-plenoptic/copyright",
     "etc/povray-plenoptic/povray.ini",
@@ -230,6 +233,16 @@ def test_install_relocatable(args):
              "--width", "40", "--height", "30", "--target", "checkerboard:3x3:0.02"], cwd=run_dir, env=env, timeout=300)
     assert (r.returncode == 0 and os.path.isfile(os.path.join(run_dir, "targets", "target_000.points.csv"))), \
         "installed plenoptic-targets failed:\n" + r.stdout[-1500:] + r.stderr[-1500:]
+    # plenoptic-dataset finds the moved renderer by itself: one item of the installed demo spec.
+    with open(os.path.join(moved, "share", "povray-plenoptic", "scenes", "dataset_demo.toml")) as f:
+        spec_text = f.read().replace('scene = "dataset_demo.pov"', 'scene = "%s"' % os.path.join(
+            moved, "share", "povray-plenoptic", "scenes", "dataset_demo.pov")).replace("Focus = [1.0, 1.5]", "Focus = [1.0]")
+    with open(os.path.join(run_dir, "one.toml"), "w") as f:
+        f.write(spec_text.replace("Wall_Z = [2.0, 3.0]", "Wall_Z = [2.0]").replace("count = 2", "count = 1"))
+    r = run([os.path.join(moved, "bin", "plenoptic-dataset"), "run", "one.toml", "--out", "dataset", "-q"], cwd=run_dir,
+            env=env, timeout=300)
+    assert (r.returncode == 0 and os.path.isfile(os.path.join(run_dir, "dataset", "manifest.jsonl"))), \
+        "installed plenoptic-dataset failed:\n" + r.stdout[-1500:] + r.stderr[-1500:]
     # The launcher's imports without its main(): where plenoptic_lf came from.
     probe = ("import runpy, sys; runpy.run_path(%r, run_name='probe'); "
              "print(sys.modules['plenoptic_lf'].__file__)" % os.path.join(moved, "bin", "plenoptic-decode"))
