@@ -8,7 +8,7 @@ global_settings { assumed_gamma 1.0 }
 
 #ifndef (Sphere_X) #declare Sphere_X = 0; #end
 #ifndef (Sphere_Z) #declare Sphere_Z = 1.2; #end
-#ifndef (Sphere_Radius) #declare Sphere_Radius = 0.08; #end
+#ifndef (Sphere_Radius) #declare Sphere_Radius = 0.015; #end
 #ifndef (Wall_Z) #declare Wall_Z = 2.5; #end
 #ifndef (Focus) #declare Focus = 1.5; #end
 #ifndef (Dataset_Samples) #declare Dataset_Samples = 8; #end
@@ -27,5 +27,5 @@ camera {
 }
 #declare Glow = finish { emission 1 diffuse 0 ambient 0 }
 sphere { <Sphere_X, 0, Sphere_Z>, Sphere_Radius
-  pigment { checker rgb <0.9, 0.3, 0.2> rgb <0.2, 0.4, 0.9> scale 0.02 } finish { Glow } }
-plane { z, Wall_Z pigment { bozo color_map { [0 rgb 0.2] [1 rgb 0.9] } scale 0.05 } finish { Glow } }
+  pigment { checker rgb <0.9, 0.3, 0.2> rgb <0.2, 0.4, 0.9> scale 0.004 } finish { Glow } }
+plane { z, Wall_Z pigment { bozo color_map { [0 rgb 0.2] [1 rgb 0.9] } scale 0.01 } finish { Glow } }

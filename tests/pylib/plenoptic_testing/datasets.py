@@ -32,7 +32,7 @@ camera {
   #if (Diffract) radiometry irradiance diffraction #end
 }
 #declare Glow = finish { emission 1 diffuse 0 ambient 0 }
-sphere { <Sphere_X, 0, 1.2>, 0.1 pigment { checker rgb <0.9, 0.3, 0.2> rgb <0.2, 0.4, 0.9> scale 0.02 } finish { Glow } }
+sphere { <Sphere_X, 0, 1.2>, 0.012 pigment { checker rgb <0.9, 0.3, 0.2> rgb <0.2, 0.4, 0.9> scale 0.004 } finish { Glow } }
 plane { z, 2.5 pigment { bozo color_map { [0 rgb 0.2] [1 rgb 0.9] } scale 0.05 } finish { Glow } }
 """
 
