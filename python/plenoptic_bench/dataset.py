@@ -16,12 +16,12 @@ PYTHON = os.path.join(ROOT, "python")
 SCENE = os.path.join(ROOT, "scenes", "dataset_demo.pov")
 
 
-def _spec(path, width, height, samples, count, bands=1, slurm_cpus=None):
+def _spec(path, width, height, samples, count, bands=1, slurm_cpus=None, per_task=1):
     text = ('scene = "%s"\nwidth = %d\nheight = %d\nbands = %d\n[options]\nsamples = %d\ndepth_map = true\n'
             '[random]\ncount = %d\nseed = 3\nSphere_X = { uniform = [-0.05, 0.05] }\n'
             % (SCENE, width, height, bands, samples, count))
     if slurm_cpus:
-        text += '[slurm]\ncpus_per_task = %d\n' % slurm_cpus
+        text += '[slurm]\ncpus_per_task = %d\nitems_per_task = %d\n' % (slurm_cpus, per_task)
     with open(path, "w") as f:
         f.write(text)
     return path
@@ -81,13 +81,18 @@ def section_dataset(b, quick, runs, results):
                                    slurm_cpus=os.cpu_count())
                 row["slurm_s"] = _dataset(b.povray, ["run", slurm_spec, "--out", os.path.join(work, "slurm-%d" % r),
                                                      "--executor", "slurm"], env)
+                chunked_spec = _spec(os.path.join(work, "items_slurm6.toml"), size[0], size[1], samples, count,
+                                     slurm_cpus=os.cpu_count(), per_task=6)
+                row["slurm6_s"] = _dataset(b.povray, ["run", chunked_spec, "--out", os.path.join(work, "slurm6-%d" % r),
+                                                      "--executor", "slurm"], env)
             rows.append(row)
             log("  dataset run %d: %d items: bare %.2f s, local %.2f s%s" % (
-                r, n, bare, local, ", Slurm %.2f s" % row["slurm_s"] if "slurm_s" in row else ""))
-            for folder in ("bare", "local-%d" % r, "slurm-%d" % r):
+                r, n, bare, local, ", Slurm %.2f s, 6 items a task %.2f s" % (row["slurm_s"], row["slurm6_s"])
+                if "slurm_s" in row else ""))
+            for folder in ("bare", "local-%d" % r, "slurm-%d" % r, "slurm6-%d" % r):
                 shutil.rmtree(os.path.join(work, folder), ignore_errors=True)
         per_item = {key: statistics.median(row[key] / row["items"] for row in rows)
-                    for key in ("bare_s", "local_s", "slurm_s") if all(key in row for row in rows)}
+                    for key in ("bare_s", "local_s", "slurm_s", "slurm6_s") if all(key in row for row in rows)}
         results["dataset"] = {"items": count, "size": list(size), "samples": samples, "runs": rows,
                               "per_item_s": per_item}
         # One larger raw, whole and in 4 bands (the local executor renders the bands one after the

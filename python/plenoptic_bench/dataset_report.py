@@ -9,13 +9,15 @@ def dataset_report(L, results):
     L.append("`plenoptic-dataset` (docs/datasets.md) on `scenes/dataset_demo.pov`: %d items of %dx%d, %d samples, depth"
              " map on, rendered (1) by the same POV-Ray commands run bare one after the other, (2) by the local"
              " executor, (3) by the Slurm executor on `tools/slurm-local`'s one-node cluster (each array task"
-             " given every core, so that tasks run one after the other as the others do). Medians of %d rounds;"
-             " whole-command clock time, divided by the items.\n"
+             " given every core, so that tasks run one after the other as the others do; the cluster starts the"
+             " next task about a second after one ends, `tools/slurm-local`'s scheduler settings). Medians of %d"
+             " rounds; whole-command clock time, divided by the items.\n"
              % (d["items"], d["size"][0], d["size"][1], d["samples"], len(d["runs"])))
     L.append("| runner | per item, s | overhead per item against bare POV-Ray, s |\n|---|---|---|")
     bare = d["per_item_s"]["bare_s"]
     for key, label in (("bare_s", "bare POV-Ray runs"), ("local_s", "plenoptic-dataset, local"),
-                       ("slurm_s", "plenoptic-dataset, Slurm (one node)")):
+                       ("slurm_s", "plenoptic-dataset, Slurm (one node), one item a task"),
+                       ("slurm6_s", "plenoptic-dataset, Slurm (one node), 6 items a task (`items_per_task = 6`)")):
         if key in d["per_item_s"]:
             t = d["per_item_s"][key]
             L.append("| %s | %.3f | %+.3f |" % (label, t, t - bare))
@@ -38,8 +40,9 @@ def dataset_report(L, results):
         one = f["median_s"] * 16
         overhead = max(d["per_item_s"].get("slurm_s", d["per_item_s"]["local_s"]) - bare, 0.0)
         L.append("\n**On paper: 10,000 Lytro-class items.** The full-size section's %.1f Mpx raw traces in %.1f s"
-                 " at one sample on this 2-core machine; at 16 samples about 16 times that, %.0f s (%.1f min) an"
-                 " item, so 10,000 items take %.0f hours here. On N nodes of c cores (POV-Ray's threads scale about"
+                 " at one sample on this 2-core machine; at 16 samples at most 16 times that (the trace grows with"
+                 " the samples, start-up and set-up do not), %.0f s (%.1f min) an item, so 10,000 items take at"
+                 " most %.0f hours here. On N nodes of c cores (POV-Ray's threads scale about"
                  " linearly, section threads) that is %.0f / (N c / 2) hours: %.0f h on 10 nodes of 32 cores,"
                  " %.1f h on 100. The executor's own overhead, %.2f s an item measured above, adds %.1f node-hours"
                  " in all; each array task also waits for Slurm's scheduling (seconds) and reads the scene and"

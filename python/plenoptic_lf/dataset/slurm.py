@@ -38,17 +38,38 @@ def _slurm_dir(store):
     return os.path.join(store.root, "slurm")
 
 
+def _queued(job_ids):
+    """{array job id: [(task id, state)]} of these jobs that Slurm still lists (queued, running or
+    completing). Asks for the user's jobs rather than for the ids: Slurm forgets finished jobs
+    after a while (MinJobAge), and squeue -j refuses an id it has forgotten."""
+    import getpass
+    out = _run(["squeue", "-h", "-o", "%F %i %T", "-u", getpass.getuser()])
+    listed = {}
+    for line in out.splitlines():
+        parts = line.split()
+        if len(parts) == 3 and parts[0].isdigit() and int(parts[0]) in job_ids:
+            listed.setdefault(int(parts[0]), []).append((parts[1], parts[2]))
+    return listed
+
+
 def _running_jobs(store):
-    """The data set's jobs Slurm still knows as pending or running."""
+    """The data set's jobs Slurm still lists."""
     try:
         with open(os.path.join(_slurm_dir(store), "jobs.json")) as f:
             jobs = json.load(f)
     except (OSError, ValueError):
         return []
-    if not jobs:
-        return []
-    out = _run(["squeue", "-h", "-o", "%A", "-j", ",".join(str(j) for j in jobs)] if jobs else ["true"])
-    return sorted({int(line) for line in out.split() if line.strip().isdigit()})
+    return sorted(_queued(set(jobs))) if jobs else []
+
+
+def _item_finished(store, spec, item, bands):
+    """Whether the item, or every band of it, is finished (a cheap check for progress)."""
+    if os.path.exists(os.path.join(store.item_dir(item.id), "item.json")):
+        return True
+    if bands <= 1:
+        return False
+    return all(os.path.exists(os.path.join(band_dir(store, item.id, k), "band.json"))
+               for k in range(len(band_rows(spec.height, bands))))
 
 
 def _tasks(store, spec, bands, done):
@@ -146,12 +167,10 @@ def run_slurm(store, spec, povray, bands, spec_path, quiet=False):
                          % (job, len(tasks), len(items) - len(done), " in %d bands" % bands if bands > 1 else ""))
     try:
         while job is not None:
-            out = _run(["squeue", "-h", "-o", "%i %T", "-j", str(job)])
-            finished = sum(1 for item in items if item.id not in done
-                           and os.path.exists(os.path.join(store.item_dir(item.id), "item.json")))
-            progress.done = finished
+            listed = _queued({job})
+            progress.done = sum(1 for item in items if item.id not in done and _item_finished(store, spec, item, bands))
             progress.show()
-            if not out.strip():
+            if not listed:
                 break
             time.sleep(POLL_SECONDS)
     except KeyboardInterrupt:
