@@ -42,6 +42,8 @@ def test_items_of_the_spec(args):
             ("[options]\nsamples = 2.5", "options.samples", "whole number"),
             ("[sweep]\nDataset_Item = [1]", "sweep.Dataset_Item", "Dataset_"),
             ("wdith = 3", "wdith", "unknown key"),
+            ('povray_options = ["+FT"]', "povray_options", "(+FE)"),
+            ('povray_options = ["+O/tmp/x.png"]', "povray_options", "set by plenoptic-dataset"),
             ("[sweep\nFocus = [1]", None, "not valid TOML")):
         path = os.path.join(args.work, "spec", "bad.toml")
         pt.write_text(path, 'scene = "scene.pov"\nwidth = 96\nheight = 72\n' + text + "\n")

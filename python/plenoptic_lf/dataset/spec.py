@@ -90,6 +90,8 @@ class Spec:
         for o in options:
             if o[:2].upper() in ("+I", "-I", "+O", "-O", "+W", "-W", "+H", "-H") or o[:3].upper() in ("+SR", "+ER"):
                 fail("povray_options", "%r is set by plenoptic-dataset (scene, output, size and bands are its own)" % o)
+            if o[:2].upper() in ("+F", "-F") and o[:3].upper() not in ("+FN", "+FE"):
+                fail("povray_options", "%r: the image is a PNG (+FN, the default +FN16) or an OpenEXR file (+FE)" % o)
         self.povray_options = list(options)
         self.context = {"scene": scene_digest, "width": self.width, "height": self.height, "options": self.povray_options}
         bands = data.get("bands", 1)
