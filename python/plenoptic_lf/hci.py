@@ -45,7 +45,7 @@ def write_pfm(path, values):
 def check_hci_camera(meta):
     """DecodeError unless the render is a plenoptic 1.0 camera whose sub-aperture views form the
     benchmark's camera grid exactly: a thin main lens without distortion, one kind of thin
-    microlens with d = f, an array parallel to the sensor, square pixels."""
+    microlens with d = f, an array aligned with the sensor (not turned, not tilted), square pixels."""
     raw = meta.raw
     if meta.main_lens_type != "thin_lens":
         raise DecodeError("--hci needs a thin_lens main lens (its views are then an exact camera grid); this "
@@ -65,8 +65,9 @@ def check_hci_camera(meta):
                           "length f); this one has d = %g mm and f = %g mm, a focused (2.0) camera whose "
                           "microimages are not sub-aperture samples" % (d, f))
     rotate = array.get("rotate_deg", [0, 0, 0])
-    if any(abs(float(r)) > 0 for r in rotate[:2]):
-        raise DecodeError("--hci needs an array parallel to the sensor; this one is tilted (rotate <%g, %g, %g>)"
+    if any(abs(float(r)) > 0 for r in rotate):
+        raise DecodeError("--hci needs an array aligned with the sensor (rotate <0, 0, 0>); this one is turned "
+                          "(rotate <%g, %g, %g>): its views' pixel axes are not the camera grid's axes"
                           % tuple(float(r) for r in rotate))
     px, py = meta.pixel_size_mm
     if not math.isclose(px, py, rel_tol=1e-9):

@@ -16,7 +16,8 @@ def find_program(name, given, candidates, option):
     """`given`, else the first candidate that exists, else `name` on PATH; FileNotFoundError
     naming the option that gives it."""
     if given:
-        return given
+        # Absolute: renders run in other folders (and Slurm tasks on other nodes).
+        return os.path.abspath(given) if os.sep in given else (shutil.which(given) or given)
     for candidate in candidates:
         if os.path.exists(candidate):
             return os.path.abspath(candidate)

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """plenoptic-dataset on this machine (docs/datasets.md): the spec's items, the manifest against
-checksums computed here, the Declare= values reaching the camera (its metadata), resuming after
+checksums computed here, the declared values reaching the camera (its metadata) exactly, resuming after
 damage and after Ctrl-C, a failing item among good ones, row bands merged into the picture one
 render gives (pixel for pixel), and bands refused under diffraction.
 
@@ -28,7 +28,7 @@ def test_items_of_the_spec(args):
     assert len(items) == 3 * 2, "3 swept values x 2 draws: %d items" % len(items)
     assert [i["Focus"] for i in items] == [1.0, 1.0, 1.5, 1.5, 2.0, 2.0], "sweep order, draws fastest"
     draws = [i["Sphere_X"] for i in items]
-    assert all(-0.05 <= x <= 0.05 for x in draws), "uniform draws within [-0.05, 0.05]: %s" % draws
+    assert all(-0.01 <= x <= 0.01 for x in draws), "uniform draws within [-0.01, 0.01]: %s" % draws
     assert draws[0] == draws[2] == draws[4] and draws[1] == draws[3] == draws[5] and draws[0] != draws[1], (
         "draw k is the same for every swept value, and draws differ: %s" % draws)
     assert [i["Dataset_Samples"] for i in items] == [4] * 6 and [i["Dataset_Item"] for i in items] == list(range(6))
@@ -44,6 +44,9 @@ def test_items_of_the_spec(args):
             ("wdith = 3", "wdith", "unknown key"),
             ('povray_options = ["+FT"]', "povray_options", "(+FE)"),
             ('povray_options = ["+O/tmp/x.png"]', "povray_options", "set by plenoptic-dataset"),
+            ('povray_options = ["Width=64"]', "povray_options", "set by plenoptic-dataset"),
+            ('povray_options = ["Output_File_Type=J"]', "povray_options", "set by plenoptic-dataset"),
+            ('povray_options = ["+HIx.inc"]', "povray_options", "set by plenoptic-dataset"),
             ("[sweep\nFocus = [1]", None, "not valid TOML")):
         path = os.path.join(args.work, "spec", "bad.toml")
         pt.write_text(path, 'scene = "scene.pov"\nwidth = 96\nheight = 72\n' + text + "\n")
@@ -56,7 +59,8 @@ def test_items_of_the_spec(args):
 def test_local_run_resume_and_failures(args):
     work = os.path.join(args.work, "local")
     shutil.rmtree(work, ignore_errors=True)
-    spec = write_spec(work, "sweep")
+    # 12 digits: a Declare= option would reach the scene as a 32-bit float (1.234568).
+    spec = write_spec(work, "sweep", focus="[1.0, 1.23456789012]")
     out = os.path.join(work, "out")
     run = dataset(args, "run", spec, "--out", out)
     assert run.returncode == 0, "a run exits 0 (stderr: %s)" % run.stderr[-2000:]
@@ -65,7 +69,7 @@ def test_local_run_resume_and_failures(args):
     for record in records.values():
         meta = pt.read_json(os.path.join(out, "items", record["id"], record["id"] + ".plenoptic.json"))
         assert meta["main_lens"]["focus_distance"] == record["parameters"]["Focus"], (
-            "the item's Declare=Focus reached the camera: %s vs %s" % (meta["main_lens"]["focus_distance"],
+            "the item's Focus reached the camera exactly: %r vs %r" % (meta["main_lens"]["focus_distance"],
                                                                        record["parameters"]))
         assert meta["depth_map"] == record["id"] + ".depth.exr", "options.depth_map reached the camera"
         assert meta["samples"]["max"] == 4, "options.samples reached the camera"
@@ -153,6 +157,18 @@ def test_bands_merge_to_one_render(args):
                 assert sha256(left) == sha256(right), "%s: byte-identical" % name
     assert not os.path.exists(os.path.join(banded, "bands")) or not os.listdir(os.path.join(banded, "bands")), (
         "no band folder left after merging")
+    # With alpha (+UA): the merge keeps it as stored (unassociated), pixel for pixel.
+    # The sphere alone on nothing: alpha 1 on it, 0 around, fractions at its rim.
+    alpha = write_spec(work, "alpha", focus="[1.0]", extra='povray_options = ["+UA", "Declare=No_Wall=1"]')
+    a_whole, a_banded = os.path.join(work, "alpha_whole"), os.path.join(work, "alpha_banded")
+    assert dataset(args, "run", alpha, "--out", a_whole, "-q").returncode == 0
+    assert dataset(args, "run", alpha, "--out", a_banded, "--bands", "2", "-q").returncode == 0
+    record = manifest(a_banded)[0]
+    left = pixels(os.path.join(a_whole, "items", record["id"], record["image"]))
+    right = pixels(os.path.join(a_banded, "items", record["id"], record["image"]))
+    fractions = ((left[..., 3] > 0) & (left[..., 3] < 1)).sum()
+    assert left.shape[2] == 4 and fractions > 10, "partly covered pixels at the sphere's rim (%d)" % fractions
+    assert np.array_equal(left, right), "with alpha the merged bands = one render"
     # Diffraction convolves across rows: bands refused for it, with the reason.
     diffracted = write_spec(work, "diffracted", focus="[1.0]", extra="povray_options = [\"Declare=Diffract=1\"]")
     run = dataset(args, "run", diffracted, "--out", os.path.join(work, "diffracted"), "--bands", "2")

@@ -22,7 +22,8 @@ a far one at z = 2 m behind. For hexagonal and rectangular arrays:
   map says so), and several times better than unwarped or with the sign flipped;
 - --hci-all-views writes every view's disparity; an outer view's disparity warped the same way
   agrees with the centre's on the planes;
-- refusals: no depth map, a focused (2.0) camera, a square grid of views larger than fits.
+- refusals: no depth map, a focused (2.0) camera, a turned array, a square grid of views larger
+  than fits.
 """
 
 import configparser
@@ -239,6 +240,12 @@ def test_hci_refusals(args):
     run = run_decode(args, png, "--hci", os.path.join(args.work, "hci_focused"))
     assert run.returncode == 2 and "focused" in run.stderr and "Traceback" not in run.stderr, (
         "a focused camera: exit 2 saying why (got %d: %s)" % (run.returncode, run.stderr))
+
+    turned = SCENE.replace("distance %r }" % MICRO_F, "distance %r rotate <0, 0, 5> }" % MICRO_F)
+    png, _, _ = pt.render_ground_truth(args.povray, args.work, "hci_turned", turned % ("hexagonal", "depth_map"), W, H)
+    run = run_decode(args, png, "--hci", os.path.join(args.work, "hci_turned"))
+    assert run.returncode == 2 and "rotate" in run.stderr and "Traceback" not in run.stderr, (
+        "an array turned about the axis: exit 2 saying why (got %d: %s)" % (run.returncode, run.stderr))
 
     raw = os.path.join(args.work, "hci_hexagonal.png")
     if not os.path.exists(raw):

@@ -8,8 +8,6 @@ centres) must be byte-identical across bands and are taken from the first."""
 import json
 import os
 
-import numpy as np
-
 # Files written beside the image that hold one value per pixel, merged by rows.
 ROW_SUFFIXES = (".depth.exr", ".virtual_depth.exr", ".raw.png")
 
@@ -25,8 +23,13 @@ def band_rows(height, count):
 
 
 def _read(path):
+    import numpy as np
     import OpenImageIO as oiio
-    image = oiio.ImageInput.open(path)
+    # Alpha as stored (a PNG's is unassociated): OpenImageIO would otherwise premultiply it on
+    # reading and divide on writing, which is lossy.
+    config = oiio.ImageSpec()
+    config.attribute("oiio:UnassociatedAlpha", 1)
+    image = oiio.ImageInput.open(path, config)
     if image is None:
         raise BandError("cannot read %s: %s" % (path, oiio.geterror()))
     spec = image.spec()
@@ -38,7 +41,9 @@ def _read(path):
 
 
 def _write(path, spec, pixels):
+    import numpy as np
     import OpenImageIO as oiio
+    spec.attribute("oiio:UnassociatedAlpha", 1)
     out = oiio.ImageOutput.create(path)
     if out is None or not out.open(path, spec):
         raise BandError("cannot write %s: %s" % (path, oiio.geterror()))

@@ -3,7 +3,7 @@
 as a Slurm job array (docs/datasets.md).
 
     plenoptic-dataset run SPEC --out DIR [--executor local|slurm] [--bands N] [--povray PATH] [-q]
-    plenoptic-dataset items SPEC              the items and their Declare= values, one per line
+    plenoptic-dataset items SPEC              the items and their declared values, one per line
     plenoptic-dataset task SPEC --out DIR --task K --tasks-file JSON   one Slurm array task (internal)
 
 Exit status: 0 every item finished; 1 some item failed (each reported with its log; the others
@@ -11,7 +11,10 @@ were rendered); 2 a bad spec or option (one line naming the file, key and what i
 130 interrupted (finished items stay finished; run again to resume)."""
 
 import argparse
+import fcntl
 import json
+import os
+import signal
 import sys
 
 from ..locate import find_povray
@@ -34,7 +37,7 @@ def _parser():
                           "spec's bands, else 1)")
     run.add_argument("--povray", default=None, help="the renderer (default: povray-plenoptic)")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress")
-    items = commands.add_parser("items", help="list the items and their Declare= values")
+    items = commands.add_parser("items", help="list the items and their declared values")
     items.add_argument("spec")
     task = commands.add_parser("task", help="render one Slurm array task's items (used by the job script)")
     task.add_argument("spec")
@@ -46,8 +49,16 @@ def _parser():
     return parser
 
 
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
 def main(argv=None):
     args = _parser().parse_args(sys.argv[1:] if argv is None else argv)
+    # kill, a closed terminal or Slurm's scancel stop the run as Ctrl-C does: POV-Ray (in its own
+    # session) is stopped too, and no partial folder stays.
+    for signum in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(signum, _interrupt)
 
     def fail(message, status=2):
         print("plenoptic-dataset: error: %s" % message, file=sys.stderr)
@@ -73,10 +84,25 @@ def main(argv=None):
         if args.command == "task":
             from .slurm import run_task
             return run_task(store, spec, povray, args.task, bands, args.tasks_file)
+        # One driver at a time per data set (tasks of a Slurm job take no lock).
+        os.makedirs(store.root, exist_ok=True)
+        lock = open(os.path.join(store.root, ".lock"), "w")
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            return fail("another plenoptic-dataset run is using %s" % store.root, 1)
         if args.executor == "slurm":
             from .slurm import run_slurm
             finished, failures = run_slurm(store, spec, povray, bands, args.spec, quiet=args.quiet)
         else:
+            from .slurm import SlurmError, _running_jobs
+            try:
+                running = _running_jobs(store)
+            except SlurmError:  # no Slurm here: no job either
+                running = []
+            if running:
+                return fail("job %s of this data set is still queued or running on Slurm: wait for it, or cancel "
+                            "it with scancel, then run again" % " ".join(map(str, running)), 1)
             finished, failures = run_local(store, spec, povray, bands, quiet=args.quiet)
     except KeyboardInterrupt:
         print("\nplenoptic-dataset: interrupted; finished items are kept, run the same command again to resume",

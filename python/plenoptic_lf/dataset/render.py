@@ -21,13 +21,17 @@ def image_extension(spec):
     return extension
 
 
+DECLARATIONS = "declarations.inc"
+
+
 def povray_command(povray, spec, item, out_path, band=None):
     """The command that renders `item` (or rows band = (first, last), 0-based, of it) to
     out_path. Defaults first (16-bit linear PNG, no display, no pause), then the spec's options,
-    then the item's Declare= values."""
+    then the item's values: DECLARATIONS beside out_path, read before the scene (Include_Header)."""
     cmd = [povray, "+I" + spec.scene, "+O" + out_path, "+W%d" % spec.width, "+H%d" % spec.height,
            "-D", "-P", "+L" + os.path.dirname(spec.scene), "+FN16", "File_Gamma=1.0"]
-    cmd += spec.povray_options + item.declare_options()
+    cmd += spec.povray_options
+    cmd += ["Include_Header=" + os.path.join(os.path.dirname(out_path), DECLARATIONS)]
     if band is not None:
         cmd += ["+SR%d" % (band[0] + 1), "+ER%d" % (band[1] + 1)]
     return cmd
@@ -51,6 +55,8 @@ def render(povray, spec, item, folder, band=None):
     """Renders into `folder` (the image is <folder>/<item id><ext>, its sidecars beside it).
     KeyboardInterrupt stops POV-Ray at once (it is sent SIGINT and waited for) and propagates."""
     out = os.path.join(folder, item.id + image_extension(spec))
+    with open(os.path.join(folder, DECLARATIONS), "w") as f:
+        f.write("// plenoptic-dataset: item %s's values\n" % item.id + item.declarations())
     cmd = povray_command(povray, spec, item, out, band)
     log_path = os.path.join(folder, "render.log")
     before = resource.getrusage(resource.RUSAGE_CHILDREN)

@@ -10,6 +10,7 @@ import time
 
 from .bands import BandError, band_rows, check_mergeable, merge
 from .render import image_extension, render
+from .store import replace_folder
 
 
 class ItemFailed(Exception):
@@ -63,9 +64,7 @@ def render_band(store, spec, item, povray, k, rows):
             json.dump(record, f, indent=1, sort_keys=True)
         final = band_dir(store, item.id, k)
         os.makedirs(os.path.dirname(final), exist_ok=True)
-        if os.path.exists(final):
-            shutil.rmtree(final)
-        os.rename(partial, final)
+        replace_folder(partial, final)
         return record
     finally:
         if os.path.exists(partial):
@@ -73,11 +72,11 @@ def render_band(store, spec, item, povray, k, rows):
 
 
 def merge_item(store, spec, item, bands):
-    """Merges the item's finished bands (all of them must be there) into its folder; its record."""
+    """Merges the item's finished bands (all of them must be there) into its folder; its record.
+    Whatever happens, no partial folder is left behind."""
     rows = band_rows(spec.height, bands)
     folders = [band_dir(store, item.id, k) for k in range(len(rows))]
     records = [band_record(folder) for folder in folders]
-    partial = store.partial_dir(item.id)
     logs = ""
     for folder in folders:
         try:
@@ -85,22 +84,27 @@ def merge_item(store, spec, item, bands):
                 logs += f.read()
         except OSError:
             pass
+    partial = store.partial_dir(item.id)
     try:
-        if any(r is None or r.get("rows") != list(band) for r, band in zip(records, rows)):
-            raise BandError("not every band is finished (or they were rendered with another band count)")
-        merge(folders, rows, item.id, image_extension(spec), partial)
-    except (BandError, OSError) as e:
-        path = store.fail(partial, item.id, logs + "\nplenoptic-dataset: merging the bands failed: %s\n" % e)
-        raise ItemFailed("item %s: merging its %d bands failed: %s" % (item.id, len(rows), e), path) from None
-    with open(os.path.join(partial, "render.log"), "w") as f:
-        f.write(logs)
-    record = base_record(spec, item)
-    record["host"] = records[0]["host"]
-    record["render_seconds"] = round(sum(r["render_seconds"] for r in records), 3)
-    record["cpu_seconds"] = round(sum(r["cpu_seconds"] for r in records), 3)
-    record["bands"] = [{"rows": r["rows"], "render_seconds": r["render_seconds"], "host": r["host"],
-                        "command": r["command"]} for r in records]
-    record = store.finish(partial, item.id, record)
+        try:
+            if any(r is None or r.get("rows") != list(band) for r, band in zip(records, rows)):
+                raise BandError("not every band is finished (or they were rendered with another band count)")
+            merge(folders, rows, item.id, image_extension(spec), partial)
+        except (BandError, OSError) as e:
+            path = store.fail(partial, item.id, logs + "\nplenoptic-dataset: merging the bands failed: %s\n" % e)
+            raise ItemFailed("item %s: merging its %d bands failed: %s" % (item.id, len(rows), e), path) from None
+        with open(os.path.join(partial, "render.log"), "w") as f:
+            f.write(logs)
+        record = base_record(spec, item)
+        record["host"] = records[0]["host"]
+        record["render_seconds"] = round(sum(r["render_seconds"] for r in records), 3)
+        record["cpu_seconds"] = round(sum(r["cpu_seconds"] for r in records), 3)
+        record["bands"] = [{"rows": r["rows"], "render_seconds": r["render_seconds"], "host": r["host"],
+                            "command": r["command"]} for r in records]
+        record = store.finish(partial, item.id, record)
+    finally:
+        if os.path.exists(partial):
+            shutil.rmtree(partial, ignore_errors=True)
     shutil.rmtree(os.path.join(store.root, "bands", item.id), ignore_errors=True)
     try:
         os.rmdir(os.path.join(store.root, "bands"))  # when no other item's bands wait there

@@ -42,13 +42,12 @@ def _queued(job_ids):
     """{array job id: [(task id, state)]} of these jobs that Slurm still lists (queued, running or
     completing). Asks for the user's jobs rather than for the ids: Slurm forgets finished jobs
     after a while (MinJobAge), and squeue -j refuses an id it has forgotten."""
-    import getpass
-    out = _run(["squeue", "-h", "-o", "%F %i %T", "-u", getpass.getuser()])
+    out = _run(["squeue", "-h", "--me", "-o", "%F %i %T %r"])
     listed = {}
     for line in out.splitlines():
-        parts = line.split()
-        if len(parts) == 3 and parts[0].isdigit() and int(parts[0]) in job_ids:
-            listed.setdefault(int(parts[0]), []).append((parts[1], parts[2]))
+        parts = line.split(None, 3)
+        if len(parts) >= 3 and parts[0].isdigit() and int(parts[0]) in job_ids:
+            listed.setdefault(int(parts[0]), []).append((parts[1], parts[2], parts[3] if len(parts) > 3 else ""))
     return listed
 
 
@@ -73,19 +72,20 @@ def _item_finished(store, spec, item, bands):
 
 
 def _tasks(store, spec, bands, done):
-    """The work still missing, as array tasks: lists of [item index, band or -1]."""
+    """The work still missing, as array tasks: lists of [item index, item id, band or -1]. The id
+    lets a task refuse work whose spec or scene changed after the submission."""
     per_task = max(1, spec.slurm.get("items_per_task", 1))
     units = []
     for item in spec.items():
         if item.id in done:
             continue
         if bands <= 1:
-            units.append([item.index, -1])
+            units.append([item.index, item.id, -1])
             continue
         for k, rows in enumerate(band_rows(spec.height, bands)):
             record = band_record(band_dir(store, item.id, k))
             if record is None or record.get("rows") != list(rows):
-                units.append([item.index, k])
+                units.append([item.index, item.id, k])
     return [units[i:i + per_task] for i in range(0, len(units), per_task)]
 
 
@@ -120,7 +120,12 @@ def run_task(store, spec, povray, task, bands, tasks_file):
         print("plenoptic-dataset: task %d of %d does not exist" % (task, len(tasks)), file=sys.stderr)
         return 2
     status = 0
-    for index, band in tasks[task]:
+    for index, item_id, band in tasks[task]:
+        if index >= spec.item_count() or spec.item(index).id != item_id:
+            print("plenoptic-dataset: item %s: the spec or its scene changed since the job was submitted; run "
+                  "plenoptic-dataset again to submit the changed items" % item_id, file=sys.stderr)
+            status = 1
+            continue
         item = spec.item(index)
         try:
             if band < 0:
@@ -148,35 +153,60 @@ def run_slurm(store, spec, povray, bands, spec_path, quiet=False):
     progress = ItemProgress(len(items), len(done), enabled=not quiet)
     folder = _slurm_dir(store)
     os.makedirs(os.path.join(folder, "logs"), exist_ok=True)
-    job = None
-    if tasks:
-        stamp = time.strftime("%Y%m%d-%H%M%S")
-        tasks_file = os.path.join(folder, "tasks-%s.json" % stamp)
-        with open(tasks_file, "w") as f:
-            json.dump(tasks, f)
-        script = os.path.join(folder, "job-%s.sh" % stamp)
-        with open(script, "w") as f:
-            f.write(job_script(store, spec, spec_path, povray, bands, tasks_file))
-        array = "0-%d" % (len(tasks) - 1)
-        if "max_parallel" in spec.slurm:
-            array += "%%%d" % spec.slurm["max_parallel"]
-        job = int(_run(["sbatch", "--parsable", "--array=" + array, script]).strip().split(";")[0])
-        with open(os.path.join(folder, "jobs.json"), "w") as f:
-            json.dump([job], f)
-        progress.message("plenoptic-dataset: submitted job %d: %d array tasks for %d items%s"
-                         % (job, len(tasks), len(items) - len(done), " in %d bands" % bands if bands > 1 else ""))
+    jobs = []  # (job id, tasks of that array)
     try:
-        while job is not None:
-            listed = _queued({job})
+        if tasks:
+            limit = _max_array_size()
+            stamp = time.strftime("%Y%m%d-%H%M%S")
+            for part, start in enumerate(range(0, len(tasks), limit)):
+                chunk = tasks[start:start + limit]
+                tasks_file = os.path.join(folder, "tasks-%s-%d.json" % (stamp, part))
+                with open(tasks_file, "w") as f:
+                    json.dump(chunk, f)
+                script = os.path.join(folder, "job-%s-%d.sh" % (stamp, part))
+                with open(script, "w") as f:
+                    f.write(job_script(store, spec, spec_path, povray, bands, tasks_file))
+                array = "0-%d" % (len(chunk) - 1)
+                if "max_parallel" in spec.slurm:
+                    array += "%%%d" % spec.slurm["max_parallel"]
+                job = int(_run(["sbatch", "--parsable", "--array=" + array, script]).strip().split(";")[0])
+                jobs.append((job, chunk))
+                with open(os.path.join(folder, "jobs.json"), "w") as f:
+                    json.dump([j for j, _ in jobs], f)
+            progress.message("plenoptic-dataset: submitted job%s %s: %d array tasks for %d items%s"
+                             % ("s" if len(jobs) > 1 else "", ", ".join(str(j) for j, _ in jobs), len(tasks),
+                                len(items) - len(done), " in %d bands" % bands if bands > 1 else ""))
+        failed_polls, reason_shown = 0, None
+        while jobs:
+            try:
+                listed = _queued({j for j, _ in jobs})
+                failed_polls = 0
+            except SlurmError as e:  # slurmctld busy or restarting: try again, give up after a minute
+                failed_polls += 1
+                if failed_polls * POLL_SECONDS > 60:
+                    raise SlurmError("%s; the job%s %s may still run: run plenoptic-dataset again when it has "
+                                     "ended, or cancel it" % (e, "s" if len(jobs) > 1 else "",
+                                                               " ".join(str(j) for j, _ in jobs))) from None
+                time.sleep(POLL_SECONDS)
+                continue
             progress.done = sum(1 for item in items if item.id not in done and _item_finished(store, spec, item, bands))
             progress.show()
             if not listed:
                 break
+            states = [entry for entries in listed.values() for entry in entries]
+            if all(state == "PENDING" for _, state, _ in states):
+                reason = states[0][2]
+                if reason and reason != reason_shown and reason not in ("None", "Priority", "Resources",
+                                                                        "JobArrayTaskLimit"):
+                    progress.message("plenoptic-dataset: the job waits: %s (squeue's reason)" % reason)
+                    reason_shown = reason
             time.sleep(POLL_SECONDS)
     except KeyboardInterrupt:
-        if job is not None:
+        for job, _ in jobs:
             subprocess.run(["scancel", str(job)], capture_output=True)
-            progress.message("plenoptic-dataset: cancelled job %d" % job)
+        if jobs:
+            progress.message("plenoptic-dataset: cancelled job%s %s" % ("s" if len(jobs) > 1 else "",
+                                                                        " ".join(str(j) for j, _ in jobs)))
         raise
     finally:
         progress.close()
@@ -195,7 +225,7 @@ def run_slurm(store, spec, povray, bands, spec_path, quiet=False):
         if record is None:
             log = os.path.join(store.failed_dir, item.id + ".log")
             if not os.path.exists(log):
-                log = _task_log(store, job, tasks, item.index)
+                log = _task_log(store, jobs, item.index)
             failures.append(ItemFailed("item %s did not finish" % item.id, log))
             continue
         records.append(record)
@@ -205,10 +235,26 @@ def run_slurm(store, spec, povray, bands, spec_path, quiet=False):
     return len(records), failures
 
 
-def _task_log(store, job, tasks, index):
+def _task_log(store, jobs, index):
     """The Slurm output file of the array task that had item `index` (a task killed before it
     wrote the item's own log)."""
-    for k, units in enumerate(tasks):
-        if any(unit[0] == index for unit in units):
-            return os.path.join(_slurm_dir(store), "logs", "%s_%d.out" % (job, k))
+    for job, tasks in jobs:
+        for k, units in enumerate(tasks):
+            if any(unit[0] == index for unit in units):
+                return os.path.join(_slurm_dir(store), "logs", "%s_%d.out" % (job, k))
     return os.path.join(_slurm_dir(store), "logs")
+
+
+def _max_array_size():
+    """Slurm's MaxArraySize less one (array indices run from 0 to MaxArraySize - 1); 1000 when
+    scontrol cannot tell."""
+    try:
+        out = _run(["scontrol", "show", "config"])
+    except SlurmError:
+        return 1000
+    for line in out.splitlines():
+        if line.strip().startswith("MaxArraySize"):
+            value = line.split("=", 1)[1].strip()
+            if value.isdigit() and int(value) > 1:
+                return int(value) - 1
+    return 1000

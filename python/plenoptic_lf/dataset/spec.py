@@ -2,7 +2,7 @@
 """A data set's specification: a TOML file naming a scene, the render size, a sweep over the
 scene's #declare'd identifiers, seeded random draws, per-item options and Slurm resources
 (docs/datasets.md). load_spec checks every value and says which key is wrong and what is allowed;
-Spec.items() lists the items, each with the Declare= values of its render."""
+Spec.items() lists the items, each with the values declared for its render."""
 
 import hashlib
 import json
@@ -48,12 +48,42 @@ class Item:
         text = json.dumps({"declares": declares, "context": context}, sort_keys=True)
         self.id = "%05d-%s" % (index, hashlib.sha256(text.encode()).hexdigest()[:8])
 
-    def declare_options(self):
-        return ["Declare=%s=%s" % (name, _number_text(value)) for name, value in self.declares.items()]
+    def declarations(self):
+        """The item's values as POV-Ray #declare lines, exact (the scene's Include_Header): POV-Ray
+        keeps a Declare= option's value as a 32-bit float (about 7 digits), which would round
+        large seeds and indices and record values other than those rendered."""
+        return "".join("#declare %s = %s;\n" % (name, _number_text(value)) for name, value in self.declares.items())
 
 
 def _number_text(value):
     return repr(float(value)) if not float(value).is_integer() else str(int(value))
+
+
+# POV-Ray options plenoptic-dataset sets itself: switches (+X or -X followed by a value; +I and +O take
+# a file name, which may start with any letter) and INI keys.
+_OWN_SWITCHES = ("I", "O", "SR", "ER", "HI")
+_OWN_KEYS = ("input_file_name", "output_file_name", "width", "height", "start_row", "end_row", "include_header",
+             "output_file_type", "output_to_file")
+
+
+def _own_option(option):
+    """Why `option` is plenoptic-dataset's own, or None."""
+    text = option.strip()
+    if "=" in text and text[0] not in "+-":
+        key = text.split("=", 1)[0].strip().lower()
+        if key in _OWN_KEYS:
+            return "is set by plenoptic-dataset (scene, output, size, bands, format and declarations are its own)"
+        return None
+    if len(text) < 2 or text[0] not in "+-":
+        return None
+    body = text[1:].upper()
+    if body[:1] in ("W", "H") and (len(body) == 1 or body[1].isdigit()):
+        return "is set by plenoptic-dataset (the spec's width and height)"
+    if any(body.startswith(s) for s in _OWN_SWITCHES):
+        return "is set by plenoptic-dataset (scene, output, bands and declarations are its own)"
+    if body[:1] == "F" and body[:2] not in ("FN", "FE"):
+        return "chooses another image format: the image is a PNG (+FN, the default +FN16) or an OpenEXR file (+FE)"
+    return None
 
 
 def _is_number(value):
@@ -88,10 +118,9 @@ class Spec:
         if not (isinstance(options, list) and all(isinstance(o, str) and o for o in options)):
             fail("povray_options", "a list of POV-Ray options as strings, e.g. [\"+A0.1\"], got %r" % (options,))
         for o in options:
-            if o[:2].upper() in ("+I", "-I", "+O", "-O", "+W", "-W", "+H", "-H") or o[:3].upper() in ("+SR", "+ER"):
-                fail("povray_options", "%r is set by plenoptic-dataset (scene, output, size and bands are its own)" % o)
-            if o[:2].upper() in ("+F", "-F") and o[:3].upper() not in ("+FN", "+FE"):
-                fail("povray_options", "%r: the image is a PNG (+FN, the default +FN16) or an OpenEXR file (+FE)" % o)
+            why = _own_option(o)
+            if why:
+                fail("povray_options", "%r %s" % (o, why))
         self.povray_options = list(options)
         self.context = {"scene": scene_digest, "width": self.width, "height": self.height, "options": self.povray_options}
         bands = data.get("bands", 1)
@@ -123,7 +152,7 @@ class Spec:
             where = "sweep.%s" % name
             self._check_identifier(fail, where, name)
             if not (isinstance(values, list) and values and all(_is_number(v) for v in values)):
-                fail(where, "a non-empty list of finite numbers (POV-Ray's Declare= takes numbers), got %r" % (values,))
+                fail(where, "a non-empty list of finite numbers (declared as POV-Ray floats), got %r" % (values,))
             self.sweep[name] = [float(v) if isinstance(v, float) else v for v in values]
 
         self.count, self.seed, self.draws = 1, 0, {}

@@ -24,6 +24,30 @@ def sha256_of(path):
     return digest.hexdigest()
 
 
+def replace_folder(new, final):
+    """Renames the folder `new` to `final`. An earlier `final` (unverified, or another finisher's)
+    is first renamed aside and removed only after the new one is in place, so that at every moment
+    one complete folder or none stands under the final name."""
+    old = None
+    if os.path.exists(final):
+        old = tempfile.mkdtemp(prefix=".partial-old-", dir=os.path.dirname(final))
+        os.rmdir(old)
+        try:
+            os.rename(final, old)
+        except FileNotFoundError:  # another finisher moved it first
+            old = None
+    try:
+        os.rename(new, final)
+    except OSError:
+        if old is not None and not os.path.exists(final):
+            os.rename(old, final)
+            old = None
+        raise
+    finally:
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+
+
 class Store:
     def __init__(self, root):
         self.root = os.path.abspath(root)
@@ -78,10 +102,7 @@ class Store:
             json.dump(record, f, indent=1, sort_keys=True)
             f.flush()
             os.fsync(f.fileno())
-        final = self.item_dir(item_id)
-        if os.path.exists(final):
-            shutil.rmtree(final)
-        os.rename(partial, final)
+        replace_folder(partial, self.item_dir(item_id))
         failed = os.path.join(self.failed_dir, item_id + ".log")
         if os.path.exists(failed):
             os.remove(failed)

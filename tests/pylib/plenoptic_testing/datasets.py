@@ -20,6 +20,7 @@ global_settings { assumed_gamma 1.0 }
 #ifndef (Slow_Item) #declare Slow_Item = -1; #end
 #ifndef (Dataset_Item) #declare Dataset_Item = 0; #end
 #ifndef (Diffract) #declare Diffract = 0; #end
+#ifndef (No_Wall) #declare No_Wall = 0; #end
 #ifndef (Dataset_Samples) #declare Dataset_Samples = 4; #end
 #ifndef (Dataset_Depth_Map) #declare Dataset_Depth_Map = 0; #end
 camera {
@@ -33,7 +34,7 @@ camera {
 }
 #declare Glow = finish { emission 1 diffuse 0 ambient 0 }
 sphere { <Sphere_X, 0, 1.2>, 0.012 pigment { checker rgb <0.9, 0.3, 0.2> rgb <0.2, 0.4, 0.9> scale 0.004 } finish { Glow } }
-plane { z, 2.5 pigment { bozo color_map { [0 rgb 0.2] [1 rgb 0.9] } scale 0.05 } finish { Glow } }
+#if (!No_Wall) plane { z, 2.5 pigment { bozo color_map { [0 rgb 0.2] [1 rgb 0.9] } scale 0.05 } finish { Glow } } #end
 """
 
 SPEC = """scene = "scene.pov"
@@ -50,7 +51,7 @@ Focus = %s
 [random]
 count = 2
 seed = 11
-Sphere_X = { uniform = [-0.05, 0.05] }
+Sphere_X = { uniform = [-0.01, 0.01] }
 """
 
 
