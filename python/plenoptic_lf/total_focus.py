@@ -85,11 +85,13 @@ def _nearest_lattice(meta, P):
 
 def default_step(meta, virtual):
     """Output sample spacing (pixels of the picture) that reads the raw about one pixel apart at
-    the scene's typical virtual depth: (1 + d/D) / |1/v + d/D| for the median |v|."""
+    the scene's typical virtual depth: (1 + d/D) / k, k the median over the map of |1/v + d/D|
+    (the scale from picture to raw at v)."""
     D, d = meta.main_distance_mm, meta.array_distance_mm
-    finite = np.abs(virtual[np.isfinite(virtual)]) if np.ndim(virtual) else np.array([abs(virtual)])
-    v = float(np.median(finite)) if finite.size else 2.0
-    return (1 + d / D) / max(abs(1 / max(v, 1e-6) + d / D), 1e-6)
+    values = np.asarray(virtual, dtype=np.float64).ravel()
+    values = values[np.isfinite(values) & (np.abs(values) >= 1e-3)]
+    scale = float(np.median(np.abs(1 / values + d / D))) if values.size else abs(0.5 + d / D)
+    return (1 + d / D) / max(scale, 1e-6)
 
 
 def total_focus(raw, meta, virtual=None, step=None, iterations=4):
@@ -166,5 +168,5 @@ def total_focus(raw, meta, virtual=None, step=None, iterations=4):
     total = np.where((count == 0)[..., None], nearest, total)
     count = np.maximum(count, 1)
     image = total / np.maximum(count, 1)[..., None]
-    image[np.isnan(v) | (count == 0)] = 0
+    image[np.isnan(v)] = 0
     return image.astype(np.float32), step
