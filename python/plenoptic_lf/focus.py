@@ -3,7 +3,6 @@
 slopes <-> distances, a focus measure, and choosing the 'near' and 'far' refocus and the EPI
 row to show. Refocusing itself is LightField.refocus."""
 
-import os
 
 import numpy as np
 from scipy import ndimage
@@ -59,10 +58,9 @@ def slopes_from_depth_map(lf, count=9):
     'depth_map', beside the metadata file) and the main lens is thin: from the 2nd to the 98th
     percentile of the finite depths, widened by a quarter of the span on each side and always
     including slope 0. None when there is no usable depth map."""
-    name = lf.meta.raw.get("depth_map")
-    if not isinstance(name, str) or lf.meta.main_lens_type != "thin_lens":
+    path = lf.meta.sidecar_path("depth_map")
+    if path is None or lf.meta.main_lens_type != "thin_lens":
         return None
-    path = os.path.join(os.path.dirname(os.path.abspath(lf.meta.path)), name)
     depth = read_depth_map(path)
     if depth is None:
         return None

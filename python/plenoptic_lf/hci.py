@@ -103,7 +103,7 @@ class HciGeometry:
         return self.baseline * self.focal_px * (inverse - 1.0 / self.z0)
 
 
-def planar_depth_mm(meta, distance_units, pixel_u, pixel_v, centre_u, centre_v):
+def planar_depth_mm(meta, geometry, distance_units, pixel_u, pixel_v, centre_u, centre_v):
     """Depth along the optical axis (mm, from the main lens) of the surface the chief ray of raw
     pixel (pixel_u, pixel_v) meets at the depth map's distance (scene units), for a pixel of the
     microimage centred at (centre_u, centre_v). The chief ray runs from the main lens point
@@ -113,9 +113,7 @@ def planar_depth_mm(meta, distance_units, pixel_u, pixel_v, centre_u, centre_v):
     frame, which leaves the ray's length unchanged). +inf stays +inf; -1 (blocked) gives NaN."""
     px, py = meta.pixel_size_mm
     pu, pv = meta.raw["principal_point_px"]
-    D, d = meta.main_distance_mm, meta.array_distance_mm
-    F = meta.focal_length_mm
-    z0 = F * D / (D - F)
+    D, d, z0 = geometry.D, geometry.d, geometry.z0
     x = np.stack([(np.asarray(pixel_u, float) - pu) * px, (np.asarray(pixel_v, float) - pv) * py])
     m = np.stack([(np.asarray(centre_u, float) - pu) * px, (np.asarray(centre_v, float) - pv) * py])
     c = m * D / (D + d)
@@ -271,11 +269,10 @@ def _write_parameters(path, meta, geometry, n, width, height, disp_range, scene)
 
 def depth_map_path(meta):
     """The render's depth map beside its metadata; DecodeError when the render wrote none."""
-    name = meta.raw.get("depth_map")
-    if not isinstance(name, str):
+    path = meta.sidecar_path("depth_map")
+    if path is None:
         raise DecodeError("--hci computes the ground truth from the render's depth map, and this render wrote "
                           "none: add depth_map to the camera and render again")
-    path = os.path.join(os.path.dirname(os.path.abspath(meta.path)), name)
     if not os.path.exists(path):
         raise DecodeError("--hci needs the render's depth map %s, which does not exist" % path)
     return path
@@ -300,7 +297,7 @@ def export_hci(raw, meta, outdir, n=None, step=1.0, all_views=False, progress=No
 
     def view_depth_mm(i, j):
         pixel_u, pixel_v, centre_u, centre_v = _nearest_samples(meta, plan, lf.du[j], lf.dv[i])
-        depth = planar_depth_mm(meta, distances[pixel_v, pixel_u], pixel_u, pixel_v, centre_u, centre_v)
+        depth = planar_depth_mm(meta, geometry, distances[pixel_v, pixel_u], pixel_u, pixel_v, centre_u, centre_v)
         return _resample_rows(depth, rows, nearest=True)
 
     os.makedirs(outdir, exist_ok=True)

@@ -161,6 +161,14 @@ class Metadata:
         self.main_distance_mm = main_lens_to_array_mm - array_shift_z_mm
         self.array_distance_mm = array_to_sensor_mm + array_shift_z_mm
 
+    def sidecar_path(self, field):
+        """The file a top-level field names (depth_map, virtual_depth_map, ...), beside the
+        metadata file; None when the field names none (the render did not write it)."""
+        name = self.raw.get(field)
+        if not isinstance(name, str):
+            return None
+        return os.path.join(os.path.dirname(os.path.abspath(self.path)), name)
+
     def centre(self, k, l):
         """Microimage centre(s) of skew lens index (k, l), pixels."""
         k = np.asarray(k, dtype=float)

@@ -47,11 +47,10 @@ def check_total_focus_camera(meta):
 
 def virtual_depth_path(meta):
     """The render's virtual depth map beside its metadata; DecodeError when it wrote none."""
-    name = meta.raw.get("virtual_depth_map")
-    if not isinstance(name, str):
+    path = meta.sidecar_path("virtual_depth_map")
+    if path is None:
         raise DecodeError("--total-focus needs the virtual depth: render the focused camera with depth_map (which "
                           "writes <stem>.virtual_depth.exr), or give a constant one with --virtual-depth V")
-    path = os.path.join(os.path.dirname(os.path.abspath(meta.path)), name)
     if not os.path.exists(path):
         raise DecodeError("--total-focus needs the render's virtual depth map %s, which does not exist" % path)
     return path
