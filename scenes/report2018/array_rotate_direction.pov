@@ -1,15 +1,16 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // array_rotate_direction.pov: the 2018 report's full plenoptic camera, with the array rotated
-// by 20 degrees about the viewing direction.
-// The report's camera in its normalised units (one unit = 24 mm, report2018.inc): a main
-// lens of focal length F = 10 units (240 mm) with the array D = 15/8 units (45 mm) behind
-// it, 30 x 30 square microlenses of pitch 1/30 unit (0.8 mm) and focal length 1/8 unit
-// (3 mm), and a sensor 1 unit (24 mm) wide. D < F: the main lens cannot focus any real
-// object onto the array, so the array sees the scene out of focus (as if focused 55 mm
-// behind the lens, 1 / (1/240 - 1/45)), and each microimage holds a small picture.
-// The lattice turns in its plane: the grid of microimages turns with it, by -20 degrees in the
-// picture (the sensor is read out upside down, docs/camera.md), while each microimage, the
-// image of the round aperture and its little picture of the scene, stays upright.
+// by 20 degrees about the viewing direction. The report's camera in its normalised units (one
+// unit = 24 mm, report2018.inc): a main lens of focal length F = 10 units (240 mm) with the
+// array D = 15/8 units (45 mm) behind it, 30 x 30 square microlenses of pitch 1/30 unit (0.8
+// mm) and focal length 1/8 unit (3 mm), and a sensor 1 unit (24 mm) wide. D < F: the main lens
+// cannot focus any real object onto the array: the 6.2 m sphere's image lies 1 / (1/240 -
+// 1/6200) = 250 mm behind the lens, far beyond the sensor, so on the array each scene point
+// covers a disc of A (250 - 45) / 250 = 9.8 mm, about 12 lenses. The lattice turns in its
+// plane: the grid of microimages turns with it, 20 degrees counter-clockwise on screen (-20
+// degrees in pixel coordinates, whose v axis points down: the metadata's Rot), while each
+// microimage, the image of the round aperture and its little picture of the scene, stays
+// upright.
 //
 // Render from the repository root (any size: the sensor's width is fixed in mm):
 //   build/povray +Iscenes/report2018/array_rotate_direction.pov +Lscenes/report2018 +Oarray_rotate_direction.png +W480 +H480
@@ -32,7 +33,7 @@ camera {
     rectangular
     pitch R18_Pitch                  // 0.8 mm
     focal_length R18_Microlens_F     // 3 mm
-    distance R18_d               // d = 3 mm
+    distance R18_d                   // d = 3 mm
     rotate <0, 0, 20>                // 20 degrees about the viewing direction
   }
   sensor { pixel_size R18_Pixel }    // 24 mm across

@@ -1,16 +1,16 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // array_rotate_right.pov: the 2018 report's full plenoptic camera, with the array tilted by 20
-// degrees about the right axis.
-// The report's camera in its normalised units (one unit = 24 mm, report2018.inc): a main
-// lens of focal length F = 10 units (240 mm) with the array D = 15/8 units (45 mm) behind
-// it, 30 x 30 square microlenses of pitch 1/30 unit (0.8 mm) and focal length 1/8 unit
-// (3 mm), and a sensor 1 unit (24 mm) wide. D < F: the main lens cannot focus any real
-// object onto the array, so the array sees the scene out of focus (as if focused 55 mm
-// behind the lens, 1 / (1/240 - 1/45)), and each microimage holds a small picture.
-// The array's upper half tilts towards the main lens, its lower half towards the sensor: the
-// distance to the sensor runs from 3 - 12 sin 20 < 0 to 3 + 12 sin 20 = 7.1 mm, so the array
-// would cross the sensor 3 / tan 20 = 8.2 mm below the axis (those pixels receive nothing), and above the
-// axis the microimages grow and blur, as d moves away from f.
+// degrees about the right axis. The report's camera in its normalised units (one unit = 24 mm,
+// report2018.inc): a main lens of focal length F = 10 units (240 mm) with the array D = 15/8
+// units (45 mm) behind it, 30 x 30 square microlenses of pitch 1/30 unit (0.8 mm) and focal
+// length 1/8 unit (3 mm), and a sensor 1 unit (24 mm) wide. D < F: the main lens cannot focus
+// any real object onto the array: the 6.2 m sphere's image lies 1 / (1/240 - 1/6200) = 250 mm
+// behind the lens, far beyond the sensor, so on the array each scene point covers a disc of A
+// (250 - 45) / 250 = 9.8 mm, about 12 lenses. The array's upper half tilts towards the main
+// lens, its lower half towards the sensor: the distance from the sensor to the array along each
+// pixel's chief ray runs from below 0 to 6.8 mm at the sensor's upper edge, so the array would
+// cross the sensor 3 / tan 20 = 8.2 mm below the axis (those pixels receive nothing), and above
+// the axis the microimages grow and blur, as d moves away from f.
 //
 // Render from the repository root (any size: the sensor's width is fixed in mm):
 //   build/povray +Iscenes/report2018/array_rotate_right.pov +Lscenes/report2018 +Oarray_rotate_right.png +W480 +H480
@@ -33,7 +33,7 @@ camera {
     rectangular
     pitch R18_Pitch                  // 0.8 mm
     focal_length R18_Microlens_F     // 3 mm
-    distance R18_d               // d = 3 mm
+    distance R18_d                   // d = 3 mm
     rotate <20, 0, 0>                // 20 degrees about the camera's right axis
   }
   sensor { pixel_size R18_Pixel }    // 24 mm across

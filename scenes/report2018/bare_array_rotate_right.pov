@@ -1,14 +1,13 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // bare_array_rotate_right.pov: the 2018 report's bare microlens array, rotated 20 degrees about
-// the camera's right axis: no main lens; 30 x 30 square
-// lenses of pitch 0.8 mm and focal length 3 mm cover the 24 mm sensor, 3 mm in front of it
-// (the report's d = 1/8 unit; units in report2018.inc).
-// The array's upper half tilts away from the sensor (up to 3 + 12 sin 20 = 7.1 mm) and its
-// lower half towards it: below y = -3 / tan 20 = -8.2 mm it would lie behind the sensor, which
-// no real array can, and those pixels receive nothing. Each lens's picture is scaled by its own
-// distance to the sensor and blurred by p |d - f| / f where that distance d is not the focal
-// length f. With the sensor read out upside down (docs/camera.md), the array's upper lenses
-// fill the lower rows of the image.
+// the camera's right axis: no main lens; 30 x 30 square lenses of pitch 0.8 mm and focal length
+// 3 mm cover the 24 mm sensor, 3 mm in front of it (the report's d = 1/8 unit; units in
+// report2018.inc). The array's upper half tilts away from the sensor (3 + 12 tan 20 = 7.4 mm
+// above the sensor's edge) and its lower half towards it: below y = -3 / tan 20 = -8.2 mm it
+// would lie behind the sensor, which no real array can, and those pixels receive nothing. Each
+// lens's picture is scaled by its own distance to the sensor and blurred by p |d - f| / f where
+// that distance d is not the focal length f. With the sensor read out upside down
+// (docs/camera.md), the array's upper lenses fill the lower rows of the image.
 //
 // Render from the repository root (any size: the sensor is always 24 mm wide):
 //   build/povray +Iscenes/report2018/bare_array_rotate_right.pov +Lscenes/report2018 +Obare_array_rotate_right.png +W480 +H480

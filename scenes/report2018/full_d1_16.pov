@@ -1,14 +1,14 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// full_d1_16.pov: the 2018 report's full plenoptic camera, with d = 1/16.
-// The report's camera in its normalised units (one unit = 24 mm, report2018.inc): a main
-// lens of focal length F = 10 units (240 mm) with the array D = 15/8 units (45 mm) behind
-// it, 30 x 30 square microlenses of pitch 1/30 unit (0.8 mm) and focal length 1/8 unit
-// (3 mm), and a sensor 1 unit (24 mm) wide. D < F: the main lens cannot focus any real
-// object onto the array, so the array sees the scene out of focus (as if focused 55 mm
-// behind the lens, 1 / (1/240 - 1/45)), and each microimage holds a small picture.
-// d = 1/16 unit (1.5 mm), half the microlenses' focal length: the lenses no longer focus the
-// main lens's aperture onto the sensor. The f-number-matched cone still fills each cell, but
-// the rays of one pixel cross the main lens over a patch p |1 + D/d - D/f| = 0.8 x 16 = 12.8 mm
+// full_d1_16.pov: the 2018 report's full plenoptic camera, with d = 1/16. The report's camera
+// in its normalised units (one unit = 24 mm, report2018.inc): a main lens of focal length F =
+// 10 units (240 mm) with the array D = 15/8 units (45 mm) behind it, 30 x 30 square microlenses
+// of pitch 1/30 unit (0.8 mm) and focal length 1/8 unit (3 mm), and a sensor 1 unit (24 mm)
+// wide. D < F: the main lens cannot focus any real object onto the array: the 6.2 m sphere's
+// image lies 1 / (1/240 - 1/6200) = 250 mm behind the lens, far beyond the sensor, so on the
+// array each scene point covers a disc of A (250 - 45) / 250 = 9.8 mm, about 12 lenses. d =
+// 1/16 unit (1.5 mm), half the microlenses' focal length: the lenses no longer focus the main
+// lens's aperture onto the sensor. The f-number-matched cone still fills each cell, but the
+// rays of one pixel cross the main lens over a patch p |1 + D/d - D/f| = 0.8 x 16 = 12.8 mm
 // across, wider than the 12 mm aperture: every pixel mixes light from the whole aperture, the
 // microimages are soft discs and the direction of the light is lost. (At d = f that patch is p
 // = 0.8 mm, 1/15 of the aperture.)

@@ -1,17 +1,18 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // full_d1_8.pov: the 2018 report's full plenoptic camera, with d = 1/8 (the report's own
-// set-up, which it found "most satisfying").
-// The report's camera in its normalised units (one unit = 24 mm, report2018.inc): a main
-// lens of focal length F = 10 units (240 mm) with the array D = 15/8 units (45 mm) behind
-// it, 30 x 30 square microlenses of pitch 1/30 unit (0.8 mm) and focal length 1/8 unit
-// (3 mm), and a sensor 1 unit (24 mm) wide. D < F: the main lens cannot focus any real
-// object onto the array, so the array sees the scene out of focus (as if focused 55 mm
-// behind the lens, 1 / (1/240 - 1/45)), and each microimage holds a small picture.
-// d = 1/8 unit (3 mm) = the microlenses' focal length: each lens images the main lens's
-// aperture sharply onto the sensor (its image lies 1 / (1/3 - 1/45) = 3.21 mm behind the lens),
-// and the aperture chosen here makes those images (A d / D = 0.8 mm) just fill their cells:
-// every pixel records one direction. This is the plenoptic 1.0 design rule, and the optical
-// reason 1/8 looks best.
+// set-up, which it found "most satisfying"). The report's camera in its normalised units (one
+// unit = 24 mm, report2018.inc): a main lens of focal length F = 10 units (240 mm) with the
+// array D = 15/8 units (45 mm) behind it, 30 x 30 square microlenses of pitch 1/30 unit (0.8
+// mm) and focal length 1/8 unit (3 mm), and a sensor 1 unit (24 mm) wide. D < F: the main lens
+// cannot focus any real object onto the array: the 6.2 m sphere's image lies 1 / (1/240 -
+// 1/6200) = 250 mm behind the lens, far beyond the sensor, so on the array each scene point
+// covers a disc of A (250 - 45) / 250 = 9.8 mm, about 12 lenses. d = 1/8 unit (3 mm) = the
+// microlenses' focal length: each lens images the main lens's aperture onto the sensor (its
+// image lies 1 / (1/3 - 1/45) = 3.21 mm behind the lens, 0.21 mm beyond the sensor: its edge is
+// soft by 0.8 x 0.21 / 3.21 = 0.05 mm, about 1 pixel), and the aperture chosen here makes those
+// images (0.85 mm, the cell's width p (1 + d/D) on the sensor) just fill their cells, each
+// holding a small picture of the scene: every pixel records one direction. This is the
+// plenoptic 1.0 design rule, and the optical reason 1/8 looks best.
 //
 // Render from the repository root (any size: the sensor's width is fixed in mm):
 //   build/povray +Iscenes/report2018/full_d1_8.pov +Lscenes/report2018 +Ofull_d1_8.png +W480 +H480
@@ -34,7 +35,7 @@ camera {
     rectangular
     pitch R18_Pitch                  // 0.8 mm
     focal_length R18_Microlens_F     // 3 mm
-    distance R18_d               // d = 3 mm
+    distance R18_d                   // d = 3 mm
   }
   sensor { pixel_size R18_Pixel }    // 24 mm across
   samples 64

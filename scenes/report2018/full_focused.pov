@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // full_focused.pov: not in the report: its full camera at d = 1/8 (full_d1_8.pov) with the one
 // change the optics asks for. With F = 10 units (240 mm) and D = 15/8 (45 mm) the main lens
-// cannot focus any real object onto the array (D < F). A plenoptic 1.0 camera wants the
-// scene focused on the array: here F = 1 / (1/45 + 1/6200) = 44.68 mm focuses the white
-// sphere, 6.2 m away, onto it. Every microimage is then a flat disc of one colour where the
-// scene is in focus, and holds a small picture only where it is not (the near cyan sphere,
-// the far cylinder): the raw a light-field decoder expects. Units in report2018.inc.
+// cannot focus any real object onto the array (D < F). A plenoptic 1.0 camera wants the scene
+// focused on the array: here F = 1 / (1/45 + 1/6200) = 44.68 mm focuses the white sphere, 6.2 m
+// away, onto it. On the array, a point anywhere in the scene (3.4 m to infinity) is then
+// blurred by at most A |D (1/F - 1/z) - 1| = 0.09 mm, a ninth of a pitch, so every microimage
+// is a flat disc of one colour: the raw a light-field decoder expects. Units in report2018.inc.
 //
 // Render from the repository root (any size: the sensor is always 24 mm wide):
 //   build/povray +Iscenes/report2018/full_focused.pov +Lscenes/report2018 +Ofull_focused.png +W480 +H480

@@ -1,16 +1,16 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // sensor_doubled.pov: the 2018 report's full plenoptic camera, with the sensor doubled in size.
-// The report's camera in its normalised units (one unit = 24 mm, report2018.inc): a main
-// lens of focal length F = 10 units (240 mm) with the array D = 15/8 units (45 mm) behind
-// it, 30 x 30 square microlenses of pitch 1/30 unit (0.8 mm) and focal length 1/8 unit
-// (3 mm), and a sensor 1 unit (24 mm) wide. D < F: the main lens cannot focus any real
-// object onto the array, so the array sees the scene out of focus (as if focused 55 mm
-// behind the lens, 1 / (1/240 - 1/45)), and each microimage holds a small picture.
-// The sensor is 2 units (48 mm) wide with the same pixel count, so each pixel is twice as wide.
-// The optical image on the sensor does not change: its centre 24 mm is the picture of
-// full_d1_8.pov at half the scale in pixels (the report's "smaller image"), and around it the
-// sensor sees a wider field. Our array has no edge (docs/camera.md), so the outer ring of the
-// sensor has microimages too; the report's 30 x 30 array would end at 24 mm (see
+// The report's camera in its normalised units (one unit = 24 mm, report2018.inc): a main lens
+// of focal length F = 10 units (240 mm) with the array D = 15/8 units (45 mm) behind it, 30 x
+// 30 square microlenses of pitch 1/30 unit (0.8 mm) and focal length 1/8 unit (3 mm), and a
+// sensor 1 unit (24 mm) wide. D < F: the main lens cannot focus any real object onto the array:
+// the 6.2 m sphere's image lies 1 / (1/240 - 1/6200) = 250 mm behind the lens, far beyond the
+// sensor, so on the array each scene point covers a disc of A (250 - 45) / 250 = 9.8 mm, about
+// 12 lenses. The sensor is 2 units (48 mm) wide with the same pixel count, so each pixel is
+// twice as wide. The optical image on the sensor does not change: its centre 24 mm is the
+// picture of full_d1_8.pov at half the scale in pixels (the report's "smaller image"), and
+// around it the sensor sees a wider field. Our array has no edge (docs/camera.md), so the outer
+// ring of the sensor has microimages too; the report's 30 x 30 array would end at 24 mm (see
 // docs/report2018.md).
 //
 // Render from the repository root (any size: the sensor's width is fixed in mm):
@@ -34,7 +34,7 @@ camera {
     rectangular
     pitch R18_Pitch                  // 0.8 mm
     focal_length R18_Microlens_F     // 3 mm
-    distance R18_d               // d = 3 mm
+    distance R18_d                   // d = 3 mm
   }
   sensor { pixel_size 2 * R18_Pixel }  // 48 mm across: the sensor doubled
   samples 64
