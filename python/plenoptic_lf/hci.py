@@ -269,13 +269,9 @@ def _write_parameters(path, meta, geometry, n, width, height, disp_range, scene)
 
 def depth_map_path(meta):
     """The render's depth map beside its metadata; DecodeError when the render wrote none."""
-    path = meta.sidecar_path("depth_map")
-    if path is None:
-        raise DecodeError("--hci computes the ground truth from the render's depth map, and this render wrote "
-                          "none: add depth_map to the camera and render again")
-    if not os.path.exists(path):
-        raise DecodeError("--hci needs the render's depth map %s, which does not exist" % path)
-    return path
+    return meta.required_sidecar("depth_map", "--hci", "depth map",
+                                 "--hci computes the ground truth from the render's depth map, and this render "
+                                 "wrote none: add depth_map to the camera and render again")
 
 
 def export_hci(raw, meta, outdir, n=None, step=1.0, all_views=False, progress=None):

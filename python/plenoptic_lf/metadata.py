@@ -13,7 +13,7 @@ import re
 
 import numpy as np
 
-from .errors import MetadataError
+from .errors import DecodeError, MetadataError
 
 METADATA_FORMAT = "povray-plenoptic-metadata"
 METADATA_VERSION = 1
@@ -168,6 +168,16 @@ class Metadata:
         if not isinstance(name, str):
             return None
         return os.path.join(os.path.dirname(os.path.abspath(self.path)), name)
+
+    def required_sidecar(self, field, option, what, none_written):
+        """sidecar_path(field) for an option that cannot do without the file: DecodeError
+        `none_written` when the render wrote none, and one naming the path when it is missing."""
+        path = self.sidecar_path(field)
+        if path is None:
+            raise DecodeError(none_written)
+        if not os.path.exists(path):
+            raise DecodeError("%s needs the render's %s %s, which does not exist" % (option, what, path))
+        return path
 
     def centre(self, k, l):
         """Microimage centre(s) of skew lens index (k, l), pixels."""

@@ -19,7 +19,6 @@ from the microimage centre's), or is the constant given.
 """
 
 import math
-import os
 
 import numpy as np
 
@@ -47,13 +46,10 @@ def check_total_focus_camera(meta):
 
 def virtual_depth_path(meta):
     """The render's virtual depth map beside its metadata; DecodeError when it wrote none."""
-    path = meta.sidecar_path("virtual_depth_map")
-    if path is None:
-        raise DecodeError("--total-focus needs the virtual depth: render the focused camera with depth_map (which "
-                          "writes <stem>.virtual_depth.exr), or give a constant one with --virtual-depth V")
-    if not os.path.exists(path):
-        raise DecodeError("--total-focus needs the render's virtual depth map %s, which does not exist" % path)
-    return path
+    return meta.required_sidecar("virtual_depth_map", "--total-focus", "virtual depth map",
+                                 "--total-focus needs the virtual depth: render the focused camera with depth_map "
+                                 "(which writes <stem>.virtual_depth.exr), or give a constant one with "
+                                 "--virtual-depth V")
 
 
 def _nearest_lattice(meta, P):

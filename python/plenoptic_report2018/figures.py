@@ -25,6 +25,8 @@ import time
 import numpy as np
 import OpenImageIO as oiio
 
+from plenoptic_lf.images import linear_to_srgb
+
 REFERENCE = "full_d1_8"
 
 
@@ -58,9 +60,7 @@ def solid_angle(meta):
 
 
 def to_srgb8(linear):
-    x = np.clip(linear, 0.0, 1.0)
-    srgb = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
-    return np.round(srgb * 255).astype(np.uint8)
+    return np.round(linear_to_srgb(linear) * 255).astype(np.uint8)
 
 
 def write_png(path, rgb8):

@@ -232,6 +232,12 @@ def test_doubled_sensor_centre_is_the_raw_binned(work):
     assert shifted > 3 * fit
 
 
+def srgb(linear):
+    """The sRGB encoding (IEC 61966-2-1), clipped to [0, 1]."""
+    x = np.clip(linear, 0, 1)
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
+
+
 def test_figure_tool_writes_the_figures(work):
     """tools/report2018-figures (the page's figures): every PNG written, the reference scene at
     E / C_ref = its own E / C, a refused scene name refused."""
@@ -247,17 +253,13 @@ def test_figure_tool_writes_the_figures(work):
     # the reference is shown at its own exposure: the sRGB PNG of its linear render
     linear, _ = render_scene(work, "full_d1_8", 48, ext="exr", tag="_48")
     shown = pt.load(os.path.join(out, "full_d1_8.png"))
-    x = np.clip(linear, 0, 1)
-    srgb = np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
-    assert np.abs(shown - srgb).max() < 0.01      # half-float EXR and 8-bit rounding
+    assert np.abs(shown - srgb(linear)).max() < 0.01      # half-float EXR and 8-bit rounding
     # another array scene is shown at the reference's exposure: its E / C times C / C_ref
     other, other_meta = render_scene(work, "full_d1_16", 48, ext="exr", tag="_48")
     _, ref_meta = render_scene(work, "full_d1_8", 48, ext="exr", tag="_48")
     scale = (other_meta["sensor"]["radiometry"]["projected_solid_angle_sr"]
              / ref_meta["sensor"]["radiometry"]["projected_solid_angle_sr"])
     assert scale == pytest.approx(cell_solid_angle(UNIT / 16) / cell_solid_angle(UNIT / 8), rel=1e-4)
-    x = np.clip(other * scale, 0, 1)
-    srgb = np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
-    assert np.abs(pt.load(os.path.join(out, "full_d1_16.png")) - srgb).max() < 0.01
+    assert np.abs(pt.load(os.path.join(out, "full_d1_16.png")) - srgb(other * scale)).max() < 0.01
     bad = pt.run_process([sys.executable, tool, "--povray", work.povray, "--out", out, "--only", "no_such"])
     assert bad.returncode != 0 and "no such scene: no_such" in bad.output
