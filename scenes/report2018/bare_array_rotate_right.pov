@@ -7,7 +7,9 @@
 // would lie behind the sensor, which no real array can, and those pixels receive nothing. Each
 // lens's picture is scaled by its own distance to the sensor and blurred by p |d - f| / f where
 // that distance d is not the focal length f. With the sensor read out upside down
-// (docs/camera.md), the array's upper lenses fill the lower rows of the image.
+// (docs/camera.md), the array's upper lenses fill the lower rows of the image. The irradiance
+// goes as 1 / distance^2: the tiles dim where the array recedes and brighten (a PNG clips them)
+// near the crossing.
 //
 // Render from the repository root (any size: the sensor is always 24 mm wide):
 //   build/povray +Iscenes/report2018/bare_array_rotate_right.pov +Lscenes/report2018 +Obare_array_rotate_right.png +W480 +H480
