@@ -18,14 +18,14 @@ import numpy as np
 from .errors import DecodeError, DependencyError, MetadataError
 from .hci import check_hci_camera, depth_map_path, export_hci
 from .focus import default_slopes, slopes_from_depth_map
-from .images import (check_encoding, inspect_raw, read_depth_map, read_raw_image, require_openimageio, save_exr,
-                     save_png)
+from .images import (check_encoding, inspect_raw, png_layout, read_depth_map, read_raw_image, require_openimageio,
+                     save_exr, save_png)
 from .lightfield import decode, plan_decode
 from .metadata import load_metadata, metadata_path_for
 from .outputs import write_outputs
 from .progress import Progress
 from .total_focus import check_total_focus_camera, total_focus, virtual_depth_path
-from .sensor import demosaic_bilinear, devignette, dn_to_linear, read_out_of, white_image_of
+from .sensor import demosaic_bilinear, devignette, dn_to_linear, picture_reading, white_reading
 
 
 SLOPES_FORM = "START:STOP:COUNT (two numbers and a whole number >= 2, e.g. -0.8:0.8:17)"
@@ -82,25 +82,32 @@ def _stored_pixels(path):
     return pixels[:, :, None] if pixels.ndim == 2 else pixels
 
 
-def read_picture(path, meta, encoding, progress, white=False):
-    """The picture (H, W, 3) linear: the render's image as its encoding says; the sensor's raw
-    (<stem>.raw.png, or a white image in DN) through dn_to_linear and, for a mosaic,
-    demosaic_bilinear; a linear white image as stored."""
-    read_out = meta.raw.get("sensor", {}).get("read_out")
-    entry = white_image_of(meta, path) if white else None
-    in_dn = (entry is not None and entry.get("values") == "dn") or (not white and read_out_of(meta, path) is not None)
-    if in_dn:
-        pixels = dn_to_linear(_stored_pixels(path), read_out)
+def read_picture(path, meta, encoding, progress, white=False, raw=False, white_values=None, white_scale=None,
+                 reading=None):
+    """The picture (H, W, 3) linear. What the file is comes from the options, its name in the
+    metadata and its content (sensor.picture_reading, sensor.white_reading): the sensor's raw or
+    a white image in DN through dn_to_linear and, for a mosaic, demosaic_bilinear; a linear white
+    image as stored times its scale; the render's picture as its encoding says (`encoding`
+    other than 'auto' is --encoding, which only a picture takes). `reading`: the decision already
+    made (read_picture's checks without its reading)."""
+    if reading is None:
+        reading = (white_reading(meta, path, png_layout(path), white_values, white_scale) if white
+                   else picture_reading(meta, path, png_layout(path), raw, encoding != "auto"))
+    name = os.path.basename(path)
+    if reading.warning:
+        print("plenoptic-decode: warning: %s" % reading.warning, file=sys.stderr)
+    if reading.kind == "dn":
+        read_out = reading.read_out
+        pixels = dn_to_linear(_stored_pixels(path), read_out, path)
         if read_out.get("bayer"):
-            progress.stage("%s: the sensor's raw in DN, %s mosaic: demosaiced (bilinear)"
-                           % (os.path.basename(path), read_out["bayer"]))
+            progress.stage("%s: %s, %s mosaic: demosaiced (bilinear)" % (name, reading.why, read_out["bayer"]))
             return demosaic_bilinear(pixels[..., 0], read_out["bayer"])
-        progress.stage("%s: the sensor's raw in DN" % os.path.basename(path))
+        progress.stage("%s: %s" % (name, reading.why))
         return np.ascontiguousarray(np.repeat(pixels[..., :1], 3, axis=2) if pixels.shape[2] == 1 else pixels[..., :3])
-    if white:
-        # A linear white image: value x 65535 / scale, grey or RGB (the metadata's white_images).
-        scale = float(entry.get("scale", 1)) if entry is not None else 1.0
-        pixels = _stored_pixels(path) * np.float32(scale)
+    if reading.kind == "linear":
+        # A linear white image: value x 65535 / scale, grey or RGB.
+        progress.stage("%s: %s" % (name, reading.why))
+        pixels = _stored_pixels(path) * np.float32(reading.scale)
         return np.ascontiguousarray(np.repeat(pixels[..., :1], 3, axis=2) if pixels.shape[2] < 3 else pixels[..., :3])
     return read_raw_image(path, encoding)[0]
 
@@ -131,6 +138,15 @@ def _argument_parser():
     parser.add_argument("--white", default=None, metavar="PNG",
                         help="devignette: divide the raw by this white image of the camera (its <stem>.white.png, "
                              "linear or in DN) where the white image carries light")
+    parser.add_argument("--raw", dest="raw_dn", action="store_true",
+                        help="RAW is the sensor's raw in DN (the render's <stem>.raw.png under any name): refused "
+                             "unless its content can be (16-bit PNG, the read-out's channels and sBIT)")
+    parser.add_argument("--white-values", choices=("dn", "linear"), default=None,
+                        help="with --white: the white image is in DN (through the metadata's read-out) or linear; "
+                             "needed only when neither its name (the metadata's white_images) nor its content says")
+    parser.add_argument("--white-scale", type=float, default=None, metavar="S",
+                        help="with --white: a linear white image's scale (stored value x S = irradiance; the "
+                             "metadata's white_images entry records it), for one renamed from the renderer's name")
     parser.add_argument("--hci", default=None, metavar="DIR",
                         help="write the HCI 4D light-field benchmark's layout to DIR instead of the usual outputs: "
                              "N x N views input_CamNNN.png, parameters.cfg, and the centre view's ground-truth "
@@ -186,6 +202,10 @@ def main(argv=None):
         slopes = parse_slopes(args.slopes) if args.slopes is not None else None
     except ValueError as e:
         return fail(str(e))
+    if (args.white_values is not None or args.white_scale is not None) and not args.white:
+        return fail("--white-values and --white-scale need --white PNG")
+    if args.white_scale is not None and not (math.isfinite(args.white_scale) and args.white_scale > 0):
+        return fail("--white-scale must be a positive number, found %r" % args.white_scale)
     meta_path = args.metadata or metadata_path_for(args.raw)
     outdir = args.output or os.path.splitext(args.raw)[0] + ".lightfield"
     progress = Progress(not args.quiet)
@@ -206,11 +226,15 @@ def main(argv=None):
                 virtual_depth_path(meta)
         else:
             plan_decode(meta, args.angular, args.step)
-        raw = read_picture(args.raw, meta, encoding, progress)
+        # What the raw and the white image are (options, names, content), before reading either.
+        reading = picture_reading(meta, args.raw, png_layout(args.raw), args.raw_dn, encoding != "auto")
         if args.white:
             if not os.path.exists(args.white):
                 return fail("%s: the white image does not exist" % args.white)
-            white = read_picture(args.white, meta, encoding, progress, white=True)
+            white_read = white_reading(meta, args.white, png_layout(args.white), args.white_values, args.white_scale)
+        raw = read_picture(args.raw, meta, encoding, progress, reading=reading)
+        if args.white:
+            white = read_picture(args.white, meta, encoding, progress, white=True, reading=white_read)
             raw = devignette(raw, white)
             progress.stage("devignetted with %s" % os.path.basename(args.white))
         if args.hci:

@@ -109,6 +109,78 @@ class RawInfo:
             encoding, self.encoding_source)
 
 
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+# PNG colour type -> (channels, colour name, has alpha); sBIT holds one byte per channel.
+_PNG_COLOUR_TYPES = {0: (1, "grey", False), 2: (3, "RGB", False), 3: (3, "palette", False),
+                     4: (2, "grey + alpha", True), 6: (4, "RGBA", True)}
+# Chunks that record how a PNG's values encode light: what a picture carries and a raw does not.
+PNG_ENCODING_CHUNKS = ("gAMA", "sRGB", "iCCP", "cICP")
+
+
+class PngLayout:
+    """What a PNG's header chunks say (the chunks before the first IDAT): bit_depth (per sample),
+    channels, colour ('grey', 'RGB', ...), alpha, sbit (the sBIT chunk's significant bits per
+    channel, a tuple, or None without one) and encoding_chunks (those of PNG_ENCODING_CHUNKS it has).
+    OpenImageIO does not report sBIT, so the chunks are read here: a file format fact."""
+
+    def __init__(self, bit_depth, colour_type, sbit, chunks):
+        self.bit_depth = bit_depth
+        self.channels, self.colour, self.alpha = _PNG_COLOUR_TYPES[colour_type]
+        self.sbit = sbit
+        self.encoding_chunks = tuple(name for name in PNG_ENCODING_CHUNKS if name in chunks)
+
+    def describe(self):
+        """'a 16-bit grey PNG, sBIT 12, no colour-encoding chunk'."""
+        bits = sorted(set(self.sbit or ()))
+        sbit = ("sBIT %s" % "/".join(str(b) for b in (bits if len(bits) == 1 else self.sbit))) if bits \
+            else "no sBIT chunk"
+        encoding = ("colour encoding in %s" % ", ".join(self.encoding_chunks) if self.encoding_chunks
+                    else "no colour-encoding chunk")
+        return "a%s %d-bit %s PNG, %s, %s" % ("n" if self.bit_depth == 8 else "", self.bit_depth, self.colour,
+                                             sbit, encoding)
+
+
+def png_layout(path):
+    """The PngLayout of a PNG file, or None when the file is not a PNG. DecodeError when it
+    starts as a PNG but its header chunks are broken."""
+    import struct
+    try:
+        with open(path, "rb") as f:
+            if f.read(8) != _PNG_SIGNATURE:
+                return None
+            header, sbit, chunks = None, None, set()
+            while True:
+                head = f.read(8)
+                if len(head) < 8:
+                    raise DecodeError("%s: a PNG whose chunks end before its image data" % path)
+                length, kind = struct.unpack(">I4s", head)
+                kind = kind.decode("latin-1")
+                if kind in ("IDAT", "IEND"):
+                    break
+                if length > 1 << 24:
+                    data = b""
+                    f.seek(length + 4, 1)
+                else:
+                    data = f.read(length)
+                    if len(data) < length or len(f.read(4)) < 4:
+                        raise DecodeError("%s: a PNG cut short in its %s chunk" % (path, kind))
+                chunks.add(kind)
+                if kind == "IHDR" and len(data) >= 10:
+                    header = (data[8], data[9])
+                elif kind == "sBIT":
+                    sbit = tuple(data)
+    except OSError as e:
+        raise DecodeError("cannot read %s: %s" % (path, e.strerror or e))
+    if header is None or header[1] not in _PNG_COLOUR_TYPES:
+        raise DecodeError("%s: a PNG without a valid IHDR chunk" % path)
+    bit_depth, colour_type = header
+    layout = PngLayout(bit_depth, colour_type, None, chunks)
+    if sbit is not None:
+        wanted = 3 if colour_type == 3 else layout.channels
+        layout.sbit = sbit[:wanted] if len(sbit) >= wanted else sbit
+    return layout
+
+
 def _open_raw(path):
     """OpenImageIO ImageBuf of the raw image with its header read (no pixels yet)."""
     oiio = require_openimageio()
