@@ -3,9 +3,11 @@
 
 #include "plenoptic_prescription.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <iomanip>
 #include <sstream>
 
 namespace plenoptic {
@@ -19,6 +21,64 @@ std::string row_name(const LensSurface& s, int index)
     std::ostringstream out;
     out << (s.stop ? "the stop (surface " : "surface ") << index + 1 << (s.stop ? ")" : "");
     return out.str();
+}
+
+std::string mm(double value)
+{
+    std::ostringstream out;
+    out << std::setprecision(6) << value << " mm";
+    return out.str();
+}
+
+// row_name with the row's line: "surface 3 (line 7)", "the stop (surface 2, line 6)".
+std::string row_at(const LensSurface& s, int index)
+{
+    const std::string line = s.line > 0 ? "line " + std::to_string(s.line) : std::string();
+    if (s.stop)
+        return "the stop (surface " + std::to_string(index + 1) + (line.empty() ? "" : ", " + line) + ")";
+    return row_name(s, index) + (line.empty() ? "" : " (" + line + ")");
+}
+
+// How far a surface's sphere lies from its vertex plane at height h from the axis (+z towards
+// the image), for h within its clear aperture: R - sign(R) sqrt(R^2 - h^2), written without
+// cancellation. 0 for a flat surface and the stop.
+double sag(const LensSurface& s, double h)
+{
+    if (s.stop || s.radius_mm == 0)
+        return 0;
+    const double R = s.radius_mm;
+    const double root = std::sqrt(std::max(0.0, R * R - h * h));
+    return h * h / (R + (R > 0 ? root : -root));
+}
+
+// Consecutive rows i and i + 1 cross when, somewhere within the smaller of their clear
+// apertures, row i + 1 lies in front of row i (towards the object). Their axial gap
+// thickness_i + sag_{i+1}(h) - sag_i(h) is monotonic in h^2 (each sag is, and the difference
+// of two sags of one sign is, since d sag / d(h^2) = 1 / (2 sqrt(R^2 - h^2)) shrinks with |R|),
+// so it is least at the axis or at the rim: if the rim's gap is negative, the crossing height is
+// where the gap is 0, found by bisection.
+std::string crossing(const Prescription& lens, int i)
+{
+    const LensSurface& a = lens.surfaces[i];
+    const LensSurface& b = lens.surfaces[i + 1];
+    const double rim = 0.5 * std::min(a.aperture_mm, b.aperture_mm);
+    const auto gap = [&](double h) { return a.thickness_mm + sag(b, h) - sag(a, h); };
+    const double at_rim = gap(rim);
+    const double tolerance = 1e-9 + 1e-12 * (std::fabs(sag(a, rim)) + std::fabs(sag(b, rim)) + a.thickness_mm);
+    if (!(at_rim < -tolerance))
+        return "";
+    double lo = 0, hi = rim;  // gap(lo) >= 0 > gap(hi)
+    for (int k = 0; k < 200 && hi - lo > 1e-12 * rim; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (gap(mid) >= 0 ? lo : hi) = mid;
+    }
+    std::ostringstream msg;
+    msg << row_at(a, i) << " and " << row_at(b, i + 1) << " cross inside their clear apertures: they meet "
+        << mm(lo) << " from the axis, and at " << mm(rim) << " from it (the smaller clear aperture's rim) "
+        << row_name(b, i + 1) << " lies " << mm(-at_rim) << " in front of " << row_name(a, i)
+        << "; consecutive surfaces may touch but not cross within their clear apertures (a larger thickness on "
+        << row_name(a, i) << ", now " << mm(a.thickness_mm) << ", or smaller apertures)";
+    return msg.str();
 }
 
 bool parse_number(const std::string& token, double* value)
@@ -193,9 +253,36 @@ Traced trace(const Prescription& lens, const double* z, const double* before, co
 
 } // namespace
 
-ParsedPrescription parse_lens_file(const std::string& text)
+double flat_radius(double radius_mm)
+{
+    return std::fabs(radius_mm) > kPrescriptionMaxLengthMm ? 0.0 : radius_mm;
+}
+
+double reduced_blade_rotation(double degrees, int blades)
+{
+    if (!std::isfinite(degrees))
+        return degrees;
+    // fmod is exact; the second step's rounding is at most an ulp of 360 degrees.
+    double turn = std::fmod(degrees, 360.0);
+    if (turn < 0)
+        turn += 360.0;
+    if (blades >= 3) {
+        const double period = 360.0 / blades;
+        turn -= std::floor(turn / period) * period;
+        if (!(turn >= 0 && turn < period))
+            turn = 0;  // only a rounding at the period itself lands here
+    } else if (turn >= 360.0) {
+        turn = 0;  // -tiny + 360 rounds to 360
+    }
+    return turn;
+}
+
+ParsedPrescription parse_lens_file(const std::string& file_text)
 {
     ParsedPrescription parsed = ParsedPrescription();
+    // A UTF-8 byte-order mark (editors on Windows write one) is not part of the first row.
+    const std::string bom = "\xEF\xBB\xBF";
+    const std::string text = file_text.compare(0, bom.size(), bom) == 0 ? file_text.substr(bom.size()) : file_text;
     std::istringstream lines(text);
     std::string line;
     int number = 0;
@@ -225,7 +312,18 @@ ParsedPrescription parse_lens_file(const std::string& text)
                 parsed.error = PrescriptionError{"'" + tokens[k] + "' is not a finite number", number};
                 return parsed;
             }
-        parsed.prescription.surfaces.push_back(LensSurface{v[0], v[1], v[2], v[3], v[0] == 0, number});
+        const bool stop = v[0] == 0;
+        parsed.prescription.surfaces.push_back(LensSurface{stop ? 0.0 : flat_radius(v[0]), v[1], v[2], v[3], stop, number});
+    }
+    if (parsed.prescription.surfaces.empty()) {
+        const std::string what = file_text.empty()
+            ? "the lens file is empty (0 bytes)"
+            : "the lens file holds no surface row (only " +
+                  std::string(text.find_first_not_of(" \t\r\n\f\v") == std::string::npos ? "blank lines" : "comments and blank lines") +
+                  ")";
+        parsed.error = PrescriptionError{what + "; a lens file has one row per surface, object side first, of four numbers "
+                                                "(radius, thickness, index of refraction, aperture diameter, in mm)", 0};
+        return parsed;
     }
     parsed.error = check_prescription(parsed.prescription);
     return parsed;
@@ -242,6 +340,19 @@ PrescriptionError check_prescription(const Prescription& lens)
         if (!std::isfinite(s.radius_mm) || !std::isfinite(s.thickness_mm) || !std::isfinite(s.ior) ||
             !std::isfinite(s.aperture_mm))
             return PrescriptionError{name + ": every number must be finite", s.line};
+        const double bound = kPrescriptionMaxLengthMm;
+        if (std::fabs(s.radius_mm) > bound)
+            return PrescriptionError{name + ": the radius " + mm(s.radius_mm) + " lies beyond +-" + mm(bound) +
+                                         " (a lens file or prescription { } reads such a radius as a flat surface, radius 0)",
+                                     s.line};
+        if (s.thickness_mm > bound)
+            return PrescriptionError{name + ": the thickness " + mm(s.thickness_mm) + " exceeds " + mm(bound) +
+                                         ", the bound of every length",
+                                     s.line};
+        if (s.aperture_mm > bound)
+            return PrescriptionError{name + ": the aperture diameter " + mm(s.aperture_mm) + " exceeds " + mm(bound) +
+                                         ", the bound of every length",
+                                     s.line};
         if (!(s.aperture_mm > 0))
             return PrescriptionError{name + ": the aperture diameter must be > 0 mm", s.line};
         if (s.thickness_mm < 0)
@@ -273,6 +384,31 @@ PrescriptionError check_prescription(const Prescription& lens)
         return PrescriptionError{row_name(lens.surfaces.back(), int(lens.surfaces.size()) - 1) +
                                      ": the last surface must open into air (index 1), where the sensor is",
                                  lens.surfaces.back().line};
+    for (size_t i = 0; i + 1 < lens.surfaces.size(); ++i) {
+        const std::string message = crossing(lens, int(i));
+        if (!message.empty())
+            return PrescriptionError{message, lens.surfaces[i].line};
+    }
+    // The power, in one pass (system_matrix looks each medium up from the first surface).
+    Mat2 S = kIdentity;
+    double n = 1;
+    for (size_t i = 0; i < lens.surfaces.size(); ++i) {
+        const LensSurface& s = lens.surfaces[i];
+        if (i > 0)
+            S = transfer(lens.surfaces[i - 1].thickness_mm, n) * S;
+        if (s.stop)
+            continue;
+        if (s.radius_mm != 0)
+            S = refraction((s.ior - n) / s.radius_mm) * S;
+        n = s.ior;
+    }
+    if (S.c > 0) {
+        std::ostringstream msg;
+        msg << "the lens diverges: its effective focal length is " << mm(-1 / S.c)
+            << " (paraxial, from its surfaces); a plenoptic camera's main lens must form a real image of the scene on "
+               "or near its microlens array, which needs a positive focal length";
+        return PrescriptionError{msg.str(), 0};
+    }
     return PrescriptionError{"", 0};
 }
 
@@ -349,6 +485,7 @@ ImageDistance paraxial_image_distance(const Prescription& lens, double object_mm
 TracingLens::TracingLens(const Prescription& lens)
     : lens_(lens), z_(vertex_positions(lens)), before_(lens.surfaces.size()), after_(lens.surfaces.size())
 {
+    lens_.blade_rotation_deg = reduced_blade_rotation(lens.blade_rotation_deg, lens.blades);
     double n = 1;
     for (size_t i = 0; i < lens.surfaces.size(); ++i) {
         before_[i] = n;

@@ -50,17 +50,36 @@ struct ParsedPrescription {
     PrescriptionError error;
 };
 
+// Every length of a prescription is bounded as the camera's other lengths are (1e12 mm); a
+// surface radius beyond it in magnitude is read as a flat surface (flat_radius).
+const double kPrescriptionMaxLengthMm = 1e12;
+
+// The radius a parser stores for a written surface radius: 0 (flat) beyond
+// +-kPrescriptionMaxLengthMm, whose curvature no lens can show (a power below 1e-12 per mm) and
+// whose sphere the trace cannot hold in double precision; the radius itself otherwise.
+double flat_radius(double radius_mm);
+
 // Reads pbrt's RealisticCamera lens file format: one surface per row, object side first, four
 // numbers: curvature radius, thickness, index of refraction (of the medium after the surface),
 // aperture diameter, in mm. A row with radius 0 is the aperture stop (pbrt writes its index as 0
-// or 1: the stop does not refract either way). `#` starts a comment; blank lines are skipped.
-// The prescription is checked (check_prescription) before it is returned.
+// or 1: the stop does not refract either way); a refracting row with a radius beyond
+// +-kPrescriptionMaxLengthMm is flat (flat_radius). `#` starts a comment; blank lines are skipped,
+// and so is a leading UTF-8 byte-order mark. The prescription is checked (check_prescription)
+// before it is returned.
 ParsedPrescription parse_lens_file(const std::string& text);
 
 // The refusals of issue 13: no surface, no stop or more than one, a non-positive or non-finite
 // number where one is needed, an index below 1, a surface whose clear aperture exceeds its
-// sphere (aperture > 2 |radius|; a surface of radius 0, possible only inline, is flat), a negative thickness.
+// sphere (aperture > 2 |radius|; a surface of radius 0, possible only inline, is flat), a negative thickness;
+// a length beyond kPrescriptionMaxLengthMm (a radius there must have been made flat by the parser);
+// two consecutive rows that cross inside the smaller of their clear apertures; a lens that
+// diverges (negative effective focal length: no real image for a plenoptic camera's array).
 PrescriptionError check_prescription(const Prescription& lens);
+
+// The iris's turn reduced by its symmetry: degrees modulo 360 / blades (360 without an iris),
+// in [0, 360 / blades). A rotation of 1e300 degrees is as valid as any and must not swamp the
+// 360 / blades between the blades' angles.
+double reduced_blade_rotation(double degrees, int blades);
 
 // The z of each surface's vertex (the first at 0).
 std::vector<double> vertex_positions(const Prescription& lens);

@@ -56,7 +56,7 @@ struct Refusal {
 TEST(Prescription, RefusesWhatTheIssueNames)
 {
     const Refusal cases[] = {
-        {"# nothing\n", 0, "at least one surface"},
+        {"# nothing\n", 0, "no surface row"},
         {"100 5 1.5 40\n-100 40 1 40\n", 0, "no aperture stop"},
         {"0 1 0 10\n100 5 1.5 40\n0 1 0 10\n-100 40 1 40\n", 3, "two aperture stops"},
         {"0 1 0 10\n100 5 1.5 0\n-100 40 1 40\n", 2, "aperture diameter must be > 0"},

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
+
 #include "backend/frame.h"
 #include "backend/parser/parse.h"
 #include "backend/scene/camera.h"
@@ -314,6 +316,8 @@ void Parser::Parse_Plenoptic_Main_Lens(plenoptic::CameraParams& params)
 				Plenoptic_Unknown("main_lens", kMainLensKeywords);
 		}
 	}
+	// The iris turned by a multiple of 360 / blades is the same iris: the metadata keeps the turn in [0, 360 / blades).
+	lens.blade_rotation_deg = plenoptic::reduced_blade_rotation(lens.blade_rotation_deg, lens.blades);
 	// A real lens without thin_lens, pinhole or thick_lens is traced surface by surface.
 	if (lens.type == plenoptic::MainLensType::None && lens.has_prescription)
 		lens.type = plenoptic::MainLensType::Prescription;
@@ -333,13 +337,24 @@ void Parser::Parse_Plenoptic_Lens_File(plenoptic::MainLensParams& lens)
 	char *name = Parse_C_String(true);
 	const std::string file(name);
 	POV_FREE(name);
-	UCS2String ignored;
-	IStream *stream = Locate_File(this, sceneData, ASCIItoUCS2String(file.c_str()), POV_File_Text_User, ignored, false);
+	if (file.empty())
+		Plenoptic_Check_At("lens_file \"\" names no file: give the name of a lens file (pbrt's format, one row per surface)",
+		                   position, column);
+	UCS2String found;
+	IStream *stream = Locate_File(this, sceneData, ASCIItoUCS2String(file.c_str()), POV_File_Text_User, found, false);
 	if (stream == NULL)
-		stream = Locate_File(this, sceneData, ASCIItoUCS2String(("lenses/" + file).c_str()), POV_File_Text_User, ignored, false);
+		stream = Locate_File(this, sceneData, ASCIItoUCS2String(("lenses/" + file).c_str()), POV_File_Text_User, found, false);
 	if (stream == NULL)
 		Plenoptic_Check_At("lens_file \"" + file + "\" was not found beside the scene, in the library paths (+L) or in "
 		                   "the lenses folder installed with the program", position, column);
+	// A directory opens, and reads as no bytes: say what it is rather than "no surface".
+	struct stat status;
+	const std::string path = UCS2toASCIIString(found);
+	if (stat(path.c_str(), &status) == 0 && S_ISDIR(status.st_mode))
+	{
+		delete stream;
+		Plenoptic_Check_At("lens_file \"" + file + "\" names a directory (" + path + "), not a lens file", position, column);
+	}
 	std::string text;
 	for (int c = stream->Read_Byte(); c != EOF && text.size() <= kMaxLensFileBytes; c = stream->Read_Byte())
 		text.push_back((char)c);
@@ -376,7 +391,8 @@ void Parser::Parse_Plenoptic_Prescription(plenoptic::MainLensParams& lens)
 			const Word word = Word_Of(Token);
 			if (word == Word::Radius && !surface.stop)
 			{
-				surface.radius_mm = Plenoptic_Float("surface radius", Check_Finite_Only);
+				// Beyond +-1e12 mm (the bound of every length) a radius is flat, as in a lens file.
+				surface.radius_mm = plenoptic::flat_radius(Plenoptic_Float("surface radius", Check_Finite_Only));
 				has_radius = true;
 			}
 			else if (word == Word::Thickness)

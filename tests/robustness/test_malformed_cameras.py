@@ -353,6 +353,17 @@ REAL_LENS_CASES = [
      ["thick_lens", "blades"], "the paraxial equivalent has a round pupil"),
     ("thick_lens without a lens", camera(main=main_with("thick_lens", "focus_distance 2", close=BRACE)),
      ["thick_lens", "lens_file"], "the paraxial equivalent of what?"),
+    # A biconcave singlet R1 = -30, R2 = 30, n = 1.5, 2 mm thick: 1/f = (n - 1) [1/R1 - 1/R2 +
+    # (n - 1) t / (n R1 R2)] gives f = -29.67 mm.
+    ("diverging lens", camera(main=main_with("prescription {", STOP, "  surface { radius -30 thickness 2 ior 1.5 aperture 20 }",
+                                             "  surface { radius 30 thickness 0 ior 1 aperture 20 }", "}  " + MARK, "distance 50")),
+     ["prescription", "diverges", "effective focal length is -29.67", "positive focal length"],
+     "a plenoptic main lens must form a real image"),
+    # R = +-30 over 20 mm: each sag at the rim is 30 - sqrt(800) = 1.72 mm, so a 0.5 mm thick
+    # element crosses itself where 30 - sqrt(900 - h^2) = 0.25: h = 3.865 mm.
+    ("surfaces that cross", camera(main=main_with("prescription {", STOP, "  surface { radius 30 thickness 0.5 ior 1.5 aperture 20 }  " + MARK,
+                                                  S2, "}", "focus_distance 2")),
+     ["surface 2", "surface 3", "cross", "meet 3.8649", "smaller clear aperture"], "glass cannot pass through glass"),
 ]
 
 GROUPS = {"camera": CASES, "placement": PLACEMENT_CASES, "real_lens": REAL_LENS_CASES}
