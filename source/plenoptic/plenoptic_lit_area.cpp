@@ -15,6 +15,7 @@
 #include <cstdint>
 
 #include "plenoptic_radiometry.h"
+#include "plenoptic_setup_progress.h"
 
 namespace plenoptic {
 
@@ -56,8 +57,11 @@ LitAreaTable::LitAreaTable(const MainLens& traced, const PupilBounds& bounds, do
     const double paraxial_area = kPi * pupil * pupil;
     if (!(step_mm_ > 0) || !(paraxial_area > 0))
         return;  // no light passes anywhere: an empty table, at() is 0
-    for (int i = 0; i <= kIntervals; ++i)
+    for (int i = 0; i <= kIntervals; ++i) {
+        report_setup("lit-area table", i, kIntervals + 1);
         relative_area_.push_back(relative_lit_area(traced, bounds, i * step_mm_, paraxial_area, irradiance_k_mm2, angular_exponent));
+    }
+    report_setup("lit-area table", kIntervals + 1, kIntervals + 1);
 }
 
 double LitAreaTable::at(Vec3 point) const

@@ -14,6 +14,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plenoptic_setup_progress.h"
+
 namespace plenoptic {
 
 namespace {
@@ -131,11 +133,14 @@ PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, doubl
     // The edge of the field: double a radius until no light passes, then bins up to it.
     double cx, radius;
     double edge = 0.5 * lens.surfaces.back().aperture_mm;
-    for (int k = 0; k < kMaxFieldDoublings && bin_disc(lens, probe, edge, &cx, &radius); ++k)
+    for (int k = 0; k < kMaxFieldDoublings && bin_disc(lens, probe, edge, &cx, &radius); ++k) {
         edge *= 2;
+        report_setup("pupil bounds", 0, kBins + 1);
+    }
     step_mm_ = edge / kBins;
     std::vector<Bin> bins;
     for (int i = 0; i <= kBins; ++i) {
+        report_setup("pupil bounds", i, kBins + 1);
         Bin bin{0, 0};
         if (bin_disc(lens, probe, i * step_mm_, &cx, &radius))
             bin = Bin{cx, radius};
@@ -143,6 +148,7 @@ PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, doubl
         if (bin.radius > 0)
             field_radius_mm_ = (i + 1) * step_mm_;
     }
+    report_setup("pupil bounds", kBins + 1, kBins + 1);
     for (int i = 0; i < kBins; ++i) {
         const Bin& a = bins[i];
         const Bin& b = bins[i + 1];

@@ -10,7 +10,9 @@
 // the same name can even serve as a value (`pitch pitch / 100`). New keywords go into
 // kContextWords below, never into POV-Ray's reserved-word table.
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -24,6 +26,7 @@
 #include "plenoptic/plenoptic_diffraction.h"
 #include "plenoptic/plenoptic_light_check.h"
 #include "plenoptic/plenoptic_radiometry.h"
+#include "plenoptic/plenoptic_setup_progress.h"
 #include "povray_glue/plenoptic_setup.h"
 
 #include "base/povdebug.h"
@@ -131,6 +134,8 @@ std::string Check_Angular_Exponent(const char *, DBL value) { return plenoptic::
 // Most bytes read from a lens file: a prescription is a few hundred; this bounds a wrong file
 // (a device, an image) to a prompt refusal.
 const size_t kMaxLensFileBytes = 1 << 20;
+// A traced lens with this many surfaces or more prints its setup's progress (about a second's work for 100).
+const size_t kSetupProgressSurfaces = 100;
 
 bool Finite(const VECTOR v) { return std::isfinite(v[X]) && std::isfinite(v[Y]) && std::isfinite(v[Z]); }
 
@@ -815,8 +820,31 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 	if (setup->white_image.given)
 		Plenoptic_Check(plenoptic::check_white_image(setup->white_image, params));
 	Plenoptic_Check(plenoptic::check_diffraction(params.diffraction, params));
-	setup->model = plenoptic::make_model(params);
-	Plenoptic_Check(plenoptic::check_diffraction_size(setup->model, params.diffraction));
+	{
+		// A traced lens's tables cost a fixed number of traces, each linear in its surfaces: a lens of
+		// 2,000 surfaces sets up for tens of seconds. Ctrl-C stops the parse there as anywhere (the
+		// parser's Cooperate throws), and a lens of many surfaces says how far on stderr.
+		const size_t surfaces = params.main.prescription.surfaces.size();
+		std::string last_step;
+		int last_tenth = -1;
+		plenoptic::ScopedSetupReporter reporter([&](const char *step, int done, int total)
+		{
+			Cooperate();
+			if (surfaces < kSetupProgressSurfaces)
+				return;
+			const int tenth = total > 0 ? std::min(10, done * 10 / total) : 10;
+			if (tenth == last_tenth && last_step == step)
+				return;
+			last_tenth = tenth;
+			last_step = step;
+			std::fprintf(stderr, "plenoptic camera: setting up a lens of %zu surfaces: %s %d %%\n", surfaces, step, 10 * tenth);
+		});
+		setup->model = plenoptic::make_model(params);
+		Plenoptic_Check(plenoptic::check_diffraction_size(setup->model, params.diffraction));
+		for (size_t k = 0; k < setup->white_image.f_numbers.size() && params.diffraction.given; k++)
+			Plenoptic_Check(plenoptic::check_diffraction_size(
+				plenoptic::make_model(plenoptic::at_f_number(params, setup->white_image.f_numbers[k])), params.diffraction));
+	}
 	for (size_t k = 0; k < setup->white_image.f_numbers.size() && params.diffraction.given; k++)
 		Plenoptic_Check(plenoptic::check_diffraction_size(
 			plenoptic::make_model(plenoptic::at_f_number(params, setup->white_image.f_numbers[k])), params.diffraction));
