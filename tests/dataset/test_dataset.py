@@ -173,3 +173,97 @@ def test_bands_merge_to_one_render(args):
     diffracted = write_spec(work, "diffracted", focus="[1.0]", extra="povray_options = [\"Declare=Diffract=1\"]")
     run = dataset(args, "run", diffracted, "--out", os.path.join(work, "diffracted"), "--bands", "2")
     assert run.returncode == 1 and "diffraction" in run.stderr and "without bands" in run.stderr, run.stderr[-1500:]
+
+
+def _ids(out):
+    return sorted(n for n in os.listdir(os.path.join(out, "items")) if not n.startswith("."))
+
+
+def test_another_specs_data_set_is_refused_unless_replaced(args):
+    work = os.path.join(args.work, "other_spec")
+    shutil.rmtree(work, ignore_errors=True)
+    first = write_spec(work, "first", focus="[1.0]")
+    second = write_spec(work, "second", focus="[1.0, 1.5]")  # the first's 2 items, and 2 others
+    out = os.path.join(work, "out")
+    run = dataset(args, "run", first, "--out", out, "-q")
+    assert run.returncode == 0, run.stderr
+    kept = check_manifest(out, 2)
+    times = {i: os.path.getmtime(os.path.join(out, "items", i, "item.json")) for i in kept}
+    second_ids = [line.split(" ", 1)[0] for line in dataset(args, "items", second).stdout.splitlines()]
+    assert len(second_ids) == 4 and set(kept) < set(second_ids), "the second spec shares the first's 2 items"
+
+    # Another spec into the folder: refused, one line naming the folder's spec and --replace; nothing changes.
+    run = dataset(args, "run", second, "--out", out)
+    line = run.stderr.strip()
+    assert run.returncode == 2 and "first.toml" in line and "--replace" in line and "\n" not in line, line
+    assert sorted(check_manifest(out, 2)) == sorted(kept) and _ids(out) == sorted(kept), "the folder is untouched"
+
+    # The same spec resumes, also with its [slurm] table edited (the same items).
+    with open(first, "a") as f:
+        f.write('\n[slurm]\npartition = "other"\n')
+    run = dataset(args, "run", first, "--out", out)
+    assert run.returncode == 0 and "2 of 2 items already finished" in run.stderr, run.stderr
+    assert all(os.path.getmtime(os.path.join(out, "items", i, "item.json")) == t for i, t in times.items())
+
+    # --replace: the folder becomes the second spec's; the items both specs have are kept, not rendered again.
+    os.makedirs(os.path.join(out, "failed"), exist_ok=True)
+    pt.write_text(os.path.join(out, "failed", "00009-deadbeef.log"), "an old item's log\n")
+    run = dataset(args, "run", second, "--out", out, "--replace")
+    assert run.returncode == 0 and "replaced" in run.stderr and "2 of 4 items already finished" in run.stderr, run.stderr
+    assert sorted(check_manifest(out, 4)) == sorted(second_ids) == _ids(out)
+    assert all(os.path.getmtime(os.path.join(out, "items", i, "item.json")) == t for i, t in times.items())
+    assert os.listdir(os.path.join(out, "failed")) == [], "the other spec's failed logs are gone"
+    record = pt.read_json(os.path.join(out, "dataset.json"))
+    assert record["spec"] == os.path.abspath(second) and record["items"] == 4, record
+    run = dataset(args, "run", first, "--out", out)
+    assert run.returncode == 2 and "second.toml" in run.stderr, "now the first spec is the other one: " + run.stderr
+
+    # A folder without a record (an older plenoptic-dataset's) holding another spec's items: refused too.
+    os.remove(os.path.join(out, "dataset.json"))
+    third = write_spec(work, "third", focus="[2.0]")
+    run = dataset(args, "run", third, "--out", out)
+    assert run.returncode == 2 and "--replace" in run.stderr and len(manifest(out)) == 4, run.stderr
+
+
+def test_reserved_words_are_refused_before_rendering(args):
+    work = os.path.join(args.work, "reserved")
+    shutil.rmtree(work, ignore_errors=True)
+    # `plenoptic` is the one word the fork adds to POV-Ray's table (docs/specification.md, section 6);
+    # clock, x and sphere are POV-Ray's own. Camera words such as pitch are read inside the camera only.
+    for text, key in (("[sweep]\nplenoptic = [1]", "sweep.plenoptic"),
+                      ("[random]\ncount = 1\nclock = { uniform = [0, 1] }", "random.clock"),
+                      ("[sweep]\nSphere_Size = [1]\nx = [1, 2]", "sweep.x"),
+                      ("[sweep]\nsphere = [1]", "sweep.sphere")):
+        spec = os.path.join(work, "reserved.toml")
+        write_spec(work, "unused")
+        pt.write_text(spec, 'scene = "scene.pov"\nwidth = 96\nheight = 72\n' + text + "\n")
+        out = os.path.join(work, "out")
+        run = dataset(args, "run", spec, "--out", out)
+        line = run.stderr.strip()
+        assert run.returncode == 2 and key in line and "reserved word" in line and "\n" not in line, (
+            "%r: exit 2, one line naming %s (%s)" % (text, key, line[-1500:]))
+        assert not os.path.exists(out), "nothing rendered, no folder made"
+    spec = write_spec(work, "pitch", focus="[1.0]", extra="")
+    with open(spec) as f:
+        text = f.read().replace("count = 2", "count = 1").replace("[sweep]", "[sweep]\npitch = [0.1]")
+    pt.write_text(spec, text)
+    run = dataset(args, "run", spec, "--out", os.path.join(work, "pitch_out"), "-q")
+    assert run.returncode == 0, "a camera word is not a global reserved word: " + run.stderr[-1500:]
+
+
+def test_items_into_a_closed_pipe_end_quietly(args):
+    work = os.path.join(args.work, "pipe")
+    spec = write_spec(work, "many")
+    with open(spec) as f:
+        text = f.read().replace("count = 2", "count = 5000")
+    pt.write_text(spec, text)
+    env = dict(os.environ, PYTHONPATH=args.python, PLENOPTIC_POVRAY=args.povray)
+    process = subprocess.Popen([sys.executable, "-m", "plenoptic_lf.dataset", "items", spec], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, env=env)
+    first = process.stdout.readline()  # as `head -1`: read a line, then stop reading
+    process.stdout.close()
+    err = process.stderr.read().decode()
+    process.wait(timeout=60)
+    assert first.startswith(b"00000-"), first
+    assert err == "", "no traceback, no message: %s" % err[-1500:]
+    assert process.returncode == -signal.SIGPIPE, "ended by SIGPIPE as Unix tools are (%s)" % process.returncode

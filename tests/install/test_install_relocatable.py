@@ -243,6 +243,14 @@ def test_install_relocatable(args):
             env=env, timeout=300)
     assert (r.returncode == 0 and os.path.isfile(os.path.join(run_dir, "dataset", "manifest.jsonl"))), \
         "installed plenoptic-dataset failed:\n" + r.stdout[-1500:] + r.stderr[-1500:]
+    # ... and checks identifiers against the moved renderer's reserved words (`plenoptic`: the fork's own).
+    with open(os.path.join(run_dir, "reserved.toml"), "w") as f:
+        f.write(spec_text.replace("[sweep]", "[sweep]\nplenoptic = [1]"))
+    r = run([os.path.join(moved, "bin", "plenoptic-dataset"), "run", "reserved.toml", "--out", "reserved", "-q"],
+            cwd=run_dir, env=env, timeout=300)
+    assert (r.returncode == 2 and "sweep.plenoptic" in r.stderr and "reserved word" in r.stderr
+            and not os.path.exists(os.path.join(run_dir, "reserved"))), \
+        "installed plenoptic-dataset did not refuse a reserved word:\n" + r.stdout[-1500:] + r.stderr[-1500:]
     # The launcher's imports without its main(): where plenoptic_lf came from.
     probe = ("import runpy, sys; runpy.run_path(%r, run_name='probe'); "
              "print(sys.modules['plenoptic_lf'].__file__)" % os.path.join(moved, "bin", "plenoptic-decode"))

@@ -2,13 +2,15 @@
 """plenoptic-dataset: render a data set described by a TOML spec, resumably, on this machine or
 as a Slurm job array (docs/datasets.md).
 
-    plenoptic-dataset run SPEC --out DIR [--executor local|slurm] [--bands N] [--povray PATH] [-q]
+    plenoptic-dataset run SPEC --out DIR [--executor local|slurm] [--bands N] [--povray PATH] [--replace] [-q]
     plenoptic-dataset items SPEC              the items and their declared values, one per line
     plenoptic-dataset task SPEC --out DIR --task K --tasks-file JSON   one Slurm array task (internal)
 
 Exit status: 0 every item finished; 1 some item failed (each reported with its log; the others
-were rendered); 2 a bad spec or option (one line naming the file, key and what is allowed);
-130 interrupted (finished items stay finished; run again to resume)."""
+were rendered); 2 a bad spec or option (one line naming the file, key and what is allowed), or
+DIR holding another spec's data set (without --replace); 130 interrupted (finished items stay
+finished; run again to resume). `items` piped into a command that stops reading (head) ends as
+Unix tools do, by SIGPIPE, without a message."""
 
 import argparse
 import fcntl
@@ -20,7 +22,7 @@ import sys
 from ..locate import find_povray
 from .runner import run_local
 from .spec import SpecError, load_spec
-from .store import Store
+from .store import OtherDataset, Store
 
 
 def _parser():
@@ -36,6 +38,9 @@ def _parser():
                      help="render each raw as N row bands (separate tasks on Slurm), merged by rows (default: the "
                           "spec's bands, else 1)")
     run.add_argument("--povray", default=None, help="the renderer (default: povray-plenoptic)")
+    run.add_argument("--replace", action="store_true",
+                     help="when DIR holds another spec's data set, make it this spec's: delete the items this spec "
+                          "does not have, keep those it has (default: refuse)")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress")
     items = commands.add_parser("items", help="list the items and their declared values")
     items.add_argument("spec")
@@ -69,6 +74,8 @@ def main(argv=None):
     except SpecError as e:
         return fail(str(e))
     if args.command == "items":
+        # `items SPEC | head`: a reader that stops early ends the command as it ends Unix tools.
+        signal.signal(signal.SIGPIPE, signal.SIG_DFL)
         for item in spec.items():
             print("%s %s" % (item.id, json.dumps(item.declares, sort_keys=True)))
         return 0
@@ -79,6 +86,11 @@ def main(argv=None):
         povray = find_povray(args.povray)
     except FileNotFoundError as e:
         return fail(str(e))
+    if args.command == "run":
+        try:
+            spec.check_reserved_words(povray)
+        except SpecError as e:
+            return fail(str(e))
     store = Store(args.out)
     try:
         if args.command == "task":
@@ -91,6 +103,20 @@ def main(argv=None):
             fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
             return fail("another plenoptic-dataset run is using %s" % store.root, 1)
+
+        def jobs_running():
+            from .slurm import SlurmError, _running_jobs
+            try:
+                return _running_jobs(store)
+            except SlurmError:  # no Slurm here: no job either
+                return []
+        try:
+            deleted = store.claim(spec, spec.items(), replace=args.replace, jobs_running=jobs_running)
+        except OtherDataset as e:
+            return fail(str(e))
+        if deleted is not None and not args.quiet:
+            print("plenoptic-dataset: replaced the data set in %s: deleted %d finished items of the other spec"
+                  % (store.root, deleted), file=sys.stderr)
         if args.executor == "slurm":
             from .slurm import run_slurm
             finished, failures = run_slurm(store, spec, povray, bands, args.spec, quiet=args.quiet)

@@ -10,6 +10,8 @@ import math
 import os
 import random
 import re
+import subprocess
+import tempfile
 import tomllib
 
 IDENTIFIER = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -219,6 +221,37 @@ class Spec:
         if name.startswith("Dataset_"):
             fail(where, "identifiers starting with Dataset_ are plenoptic-dataset's own ([options])")
 
+    def check_reserved_words(self, povray):
+        """Refuses (SpecError) a swept or drawn identifier that is one of the renderer's reserved
+        words (x, pi, clock, sphere, plenoptic, ...), which every item's render would refuse. Asks
+        the renderer itself: it parses `#declare NAME = 0;` for each of them (no image), and
+        names the line of the first it refuses as a reserved word."""
+        names = list(self.sweep) + list(self.draws)
+        if not names:
+            return
+        with tempfile.TemporaryDirectory(prefix="plenoptic-dataset-") as folder:
+            scene = os.path.join(folder, "identifiers.pov")
+            with open(scene, "w") as f:
+                f.write("".join("#declare %s = 0;\n" % name for name in names))
+            try:
+                run = subprocess.run([povray, "+I" + os.path.basename(scene), "+W1", "+H1", "-F", "-D", "-P"], cwd=folder,
+                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace",
+                                     timeout=120)
+            except (OSError, subprocess.TimeoutExpired) as e:
+                raise SpecError("%s: cannot check the identifiers with %s: %s" % (self.path, povray, e)) from None
+        if run.returncode == 0:
+            return
+        # POV-Ray wraps its messages at 80 columns.
+        refused = re.search(r"line (\d+): Parse Error: Expected 'undeclared identifier'", " ".join(run.stdout.split()))
+        if refused and 1 <= int(refused.group(1)) <= len(names):
+            name = names[int(refused.group(1)) - 1]
+            raise SpecError("%s: %s.%s: %r is a reserved word of POV-Ray (the renderer refuses to #declare it); "
+                            "choose another identifier for the scene" % (self.path, "sweep" if name in self.sweep
+                                                                          else "random", name, name))
+        tail = " | ".join(line.strip() for line in run.stdout.strip().splitlines()[-3:])
+        raise SpecError("%s: cannot check the identifiers: %s exits %s on a scene that only declares them: %s"
+                        % (self.path, povray, run.returncode, tail))
+
     def item_count(self):
         combos = 1
         for values in self.sweep.values():
@@ -262,7 +295,9 @@ class Spec:
         return Item(index, declares, self.context)
 
     def items(self):
-        return [self.item(i) for i in range(self.item_count())]
+        if getattr(self, "_items", None) is None:
+            self._items = [self.item(i) for i in range(self.item_count())]
+        return self._items
 
 
 def load_spec(path):
