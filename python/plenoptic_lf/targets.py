@@ -11,11 +11,14 @@ plenoptic-project):
                       [--tilt DEG] [--target checkerboard:ROWSxCOLS:SQUARE | circles:ROWSxCOLS:SPACING:RADIUS]
                       [--width W --height H] [--povray PATH] [--project PATH] [-- POVRAY OPTIONS]
 
-CAMERA.inc holds the camera, `camera { plenoptic ... }`, at POV-Ray's default placement: at the
-origin, looking along +z with +y up (no location, look_at or rotate). A pose is: a distance z
-drawn uniformly from [MIN, MAX] (scene units) along +z, an offset across of up to --lateral
-times z, tilts about x and y drawn uniformly from [-DEG, DEG] and a roll about z from
-[-180, 180); the target is rotated (x, then y, then z, POV-Ray's order) and then moved.
+CAMERA.inc holds the camera, `camera { plenoptic ... }`, placed anywhere (location, look_at,
+transforms). A pose is relative to the camera, in its frame (x right, y up, z the viewing
+direction, from its `location`): a distance z drawn uniformly from [MIN, MAX] (scene units) along
+the viewing direction, an offset across of up to --lateral times z, tilts about x and y drawn
+uniformly from [-DEG, DEG] and a roll about z from [-180, 180); the target is rotated (x, then
+y, then z, POV-Ray's order), then moved, then carried into the world by the camera's placement,
+which the first view's metadata gives (when the camera is not at POV-Ray's default placement,
+the first view is rendered again, placed). A camera that is not plenoptic is refused.
 
 For view k, DIR holds target_<k>.png (and what the camera writes beside it: the metadata, white
 image, raw...), target_<k>.pov, and target_<k>.points.csv: one line per image of a feature point,
@@ -95,17 +98,52 @@ def draw_pose(rng, distance, tilt, lateral):
             "translate": [rng.uniform(-lateral, lateral) * z, rng.uniform(-lateral, lateral) * z, z]}
 
 
-def world_points(target, pose):
+def posed_points(target, pose):
+    """[(row, col, point)]: the feature points posed, in the camera's frame."""
     r = rotation_xyz(pose["rotate_deg"])
     t = np.array(pose["translate"])
     return [(row, col, r @ np.array(p) + t) for row, col, p in feature_points(target)]
 
 
-def scene_text(camera_path, target, pose):
+# POV-Ray's default camera placement: at the origin, x right, y up, looking along +z.
+DEFAULT_PLACEMENT = {"location": [0.0, 0.0, 0.0], "right": [1.0, 0.0, 0.0], "up": [0.0, 1.0, 0.0],
+                     "direction": [0.0, 0.0, 1.0]}
+
+
+def camera_placement(meta):
+    """The camera's placement in the world from its metadata: its `location` (the main-lens centre;
+    a real lens's front vertex, front_vertex_z_mm ahead of the optics frame's origin, the rear
+    vertex, along the viewing direction) and the unit vectors right, up and direction. The
+    default placement exactly when it is that within 1e-12."""
+    frame = meta["camera_frame"]
+    location = np.array(frame["location"], dtype=float)
+    direction = np.array(frame["direction"], dtype=float)
+    lens = meta.get("main_lens") or {}
+    if lens.get("type") in ("thick_lens", "prescription"):
+        location = location + lens["paraxial"]["front_vertex_z_mm"] / meta["mm_per_unit"] * direction
+    placement = {"location": location.tolist(), "right": [float(v) for v in frame["right"]],
+                 "up": [float(v) for v in frame["up"]], "direction": direction.tolist()}
+    if all(abs(a - b) <= 1e-12 for key in DEFAULT_PLACEMENT for a, b in zip(placement[key], DEFAULT_PLACEMENT[key])):
+        return dict(DEFAULT_PLACEMENT)
+    return placement
+
+
+def to_world(placement, point):
+    """A point of the camera's frame (x right, y up, z the viewing direction, from its location)
+    in the world."""
+    return (np.array(placement["location"]) + point[0] * np.array(placement["right"]) +
+            point[1] * np.array(placement["up"]) + point[2] * np.array(placement["direction"]))
+
+
+def scene_text(camera_path, target, pose, placement=DEFAULT_PLACEMENT):
+    place = ""
+    if placement != DEFAULT_PLACEMENT:  # POV-Ray's matrix: the images of x, y, z, then the translation
+        place = " matrix <%s>" % ", ".join("%.17g" % v for key in ("right", "up", "direction", "location")
+                                           for v in placement[key])
     return ("// SPDX-License-Identifier: AGPL-3.0-or-later\n// Written by plenoptic-targets.\n#version 3.7;\n"
             "global_settings { assumed_gamma 1.0 }\nbackground { rgb 0.2 }\n#include \"calibration_targets.inc\"\n"
-            "#include \"%s\"\nobject { %s rotate <%.17g, %.17g, %.17g> translate <%.17g, %.17g, %.17g> }\n"
-            % (os.path.abspath(camera_path), target_object(target), *pose["rotate_deg"], *pose["translate"]))
+            "#include \"%s\"\nobject { %s rotate <%.17g, %.17g, %.17g> translate <%.17g, %.17g, %.17g>%s }\n"
+            % (os.path.abspath(camera_path), target_object(target), *pose["rotate_deg"], *pose["translate"], place))
 
 
 
@@ -120,7 +158,7 @@ def _include_dir():
 
 def main(argv=None):
     p = argparse.ArgumentParser(prog="plenoptic-targets", description=__doc__.split("\n\n")[0])
-    p.add_argument("camera", help="a file holding camera { plenoptic ... } at POV-Ray's default placement")
+    p.add_argument("camera", help="a file holding camera { plenoptic ... } (the poses are relative to it)")
     p.add_argument("--out", required=True, help="output folder")
     p.add_argument("--count", type=int, default=10)
     p.add_argument("--seed", type=int, default=0)
@@ -158,22 +196,45 @@ def main(argv=None):
         return fail(str(e))
     os.makedirs(args.out, exist_ok=True)
     rng = random.Random(args.seed)
+    poses = [draw_pose(rng, args.distance, args.tilt, args.lateral) for _ in range(args.count)]
     views = []
+    placement = None  # the camera's, from the first view's metadata
     try:
-        for k in range(args.count):
-            pose = draw_pose(rng, args.distance, args.tilt, args.lateral)
+        k = 0
+        while k < args.count:
+            pose = poses[k]
             name = "target_%03d" % k
             pov = os.path.join(args.out, name + ".pov")
             with open(pov, "w") as f:
-                f.write(scene_text(args.camera, target, pose))
+                f.write(scene_text(args.camera, target, pose, placement or DEFAULT_PLACEMENT))
             png = os.path.join(args.out, name + ".png")
+            meta = os.path.join(args.out, name + ".plenoptic.json")
+            if os.path.exists(meta):  # an earlier run's: the render below must write its own
+                os.remove(meta)
             cmd = [povray, "+I" + pov, "+O" + png, "+W%d" % args.width, "+H%d" % args.height, "-D", "-P",
                    "+L" + include, "+FN16", "File_Gamma=1.0"] + list(args.povray_options)
             run = subprocess.run(cmd, capture_output=True, text=True)
             if run.returncode != 0 or not os.path.exists(png):
                 return fail("the render of view %d failed (%s):\n%s" % (k, " ".join(cmd), run.stderr[-2000:]))
-            meta = os.path.join(args.out, name + ".plenoptic.json")
-            points = world_points(target, pose)
+            if not os.path.exists(meta):
+                for leftover in os.listdir(args.out):
+                    if leftover.startswith(name + "."):
+                        os.remove(os.path.join(args.out, leftover))
+                return fail("%s: the camera is not plenoptic (POV-Ray wrote no plenoptic metadata): plenoptic-targets "
+                            "needs a file holding camera { plenoptic ... }" % args.camera)
+            if placement is None:
+                try:
+                    with open(meta) as f:
+                        placement = camera_placement(json.load(f))
+                except (OSError, ValueError, KeyError, TypeError) as e:
+                    return fail("%s: cannot read the camera's placement (camera_frame): %s" % (meta, e))
+                if placement != DEFAULT_PLACEMENT:
+                    print("plenoptic-targets: the camera is placed at <%s>, looking along <%s>: the targets are posed "
+                          "relative to it (view 0 rendered again)" % (", ".join("%.6g" % v for v in placement["location"]),
+                                                                       ", ".join("%.6g" % v for v in placement["direction"])),
+                          file=sys.stderr)
+                    continue
+            points = [(row, col, to_world(placement, p)) for row, col, p in posed_points(target, pose)]
             stdin = "".join("%.17g %.17g %.17g\n" % tuple(p) for _, _, p in points)
             proj = subprocess.run([project, meta, "-"], input=stdin, capture_output=True, text=True)
             if proj.returncode != 0:
@@ -190,14 +251,17 @@ def main(argv=None):
                           "feature_points": len(points), "images_of_points": images})
             print("plenoptic-targets: view %d of %d: %d feature points, %d images of them"
                   % (k + 1, args.count, len(points), images), file=sys.stderr)
+            k += 1
     except KeyboardInterrupt:
         print("plenoptic-targets: interrupted after %d views" % len(views), file=sys.stderr)
         return 130
     finally:
-        with open(os.path.join(args.out, "targets.json"), "w") as f:
-            json.dump({"target": target, "seed": args.seed, "distance": args.distance, "tilt_deg": args.tilt,
-                       "lateral": args.lateral, "size": [args.width, args.height], "camera": os.path.abspath(args.camera),
-                       "views": views}, f, indent=1)
+        if views:  # the views made (all of them, or those before a failure or an interruption)
+            with open(os.path.join(args.out, "targets.json"), "w") as f:
+                json.dump({"target": target, "seed": args.seed, "distance": args.distance, "tilt_deg": args.tilt,
+                           "lateral": args.lateral, "size": [args.width, args.height],
+                           "camera": os.path.abspath(args.camera), "camera_placement": placement, "views": views},
+                          f, indent=1)
     return 0
 
 

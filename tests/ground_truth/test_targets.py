@@ -46,21 +46,22 @@ def rows_of(path):
         return list(csv.DictReader(f))
 
 
-def test_pinhole_corners_are_where_the_pinhole_projects_them_and_the_render_shows_corners(args):
-    rows_n, cols_n, square = 5, 7, 0.012
-    out, data = run_tool(args, "pinhole", PINHOLE, ["--count", "3", "--seed", "5", "--distance", "0.9", "1.2",
-                                                    "--tilt", "30", "--target", "checkerboard:%dx%d:%r" % (rows_n, cols_n, square)])
+def check_pinhole_views(out, data, rows_n, cols_n, square, camera_rotate=(0, 0, 0), camera_location=(0, 0, 0)):
+    """Every corner of every view where the pinhole of PINHOLE (rotated by camera_rotate, then
+    moved to camera_location, as the camera file says) projects it, and a corner rendered there."""
     D, s = 20.0, 0.01
+    C, c0 = pt.rotation_xyz(camera_rotate), np.array(camera_location, dtype=float)
 
     def pixel(world_m):
-        X, Y, Z = (c * 1000 for c in world_m)  # mm
+        X, Y, Z = (c * 1000 for c in C.T @ (world_m - c0))  # the camera's frame, mm
         return W / 2 - 0.5 + D * X / (Z * s), H / 2 - 0.5 - D * Y / (Z * s)
 
     for view in data["views"]:
         pose = view["pose"]
         assert 0.9 <= pose["translate"][2] <= 1.2
         assert all(abs(t) <= 30 for t in pose["rotate_deg"][:2])
-        R, t = pt.rotation_xyz(pose["rotate_deg"]), np.array(pose["translate"])
+        # The pose is relative to the camera: carried into the world by the camera's placement.
+        R, t = C @ pt.rotation_xyz(pose["rotate_deg"]), C @ np.array(pose["translate"]) + c0
         rows = rows_of(os.path.join(out, view["points"]))
         assert len(rows) == view["feature_points"] == (rows_n - 1) * (cols_n - 1)  # one image each
         image = pt.read_linear(os.path.join(out, view["image"]))[..., 1]
@@ -69,7 +70,7 @@ def test_pinhole_corners_are_where_the_pinhole_projects_them_and_the_render_show
             # The corner from its row and column, as calibration_targets.inc places it, posed here.
             local = np.array([(int(r["col"]) + 1 - cols_n / 2.0) * square, (int(r["row"]) + 1 - rows_n / 2.0) * square, 0])
             world = R @ local + t
-            assert np.abs(world - [float(r[k]) for k in ("x", "y", "z")]).max() < 1e-12, r
+            assert np.abs(world - [float(r[k]) for k in ("x", "y", "z")]).max() < 1e-12 * (1 + np.abs(c0).max()), r
             u, v = pixel(world)
             assert abs(float(r["u"]) - u) < 1e-6 and abs(float(r["v"]) - v) < 1e-6, r
             # The render: the centres of the four squares around the corner, a pair of each colour.
@@ -81,6 +82,44 @@ def test_pinhole_corners_are_where_the_pinhole_projects_them_and_the_render_show
                 abs(values[0] - values[2]) > 0.5, (r, values)
             checked += 1
         assert checked >= 12, checked
+
+
+def test_pinhole_corners_are_where_the_pinhole_projects_them_and_the_render_shows_corners(args):
+    rows_n, cols_n, square = 5, 7, 0.012
+    out, data = run_tool(args, "pinhole", PINHOLE, ["--count", "3", "--seed", "5", "--distance", "0.9", "1.2",
+                                                    "--tilt", "30", "--target", "checkerboard:%dx%d:%r" % (rows_n, cols_n, square)])
+    check_pinhole_views(out, data, rows_n, cols_n, square)
+
+
+def test_a_placed_camera_gets_targets_posed_relative_to_it(args):
+    # The camera file places the camera itself: turned 70 degrees about y (to look along +x
+    # mostly), tilted 10 degrees about x, moved off the origin.
+    rotate, location = (10, 70, 0), (0.3, -0.2, 0.5)
+    camera = PINHOLE.replace("sensor { pixel_size 0.01 }", "sensor { pixel_size 0.01 } rotate <%r, %r, %r> "
+                             "translate <%r, %r, %r>" % (rotate + location))
+    rows_n, cols_n, square = 5, 7, 0.012
+    out, data = run_tool(args, "placed", camera, ["--count", "2", "--seed", "5", "--distance", "0.9", "1.2",
+                                                  "--tilt", "30", "--target", "checkerboard:%dx%d:%r" % (rows_n, cols_n, square)])
+    check_pinhole_views(out, data, rows_n, cols_n, square, rotate, location)
+    placement = data["camera_placement"]
+    C = pt.rotation_xyz(rotate)
+    assert np.abs(np.array(placement["location"]) - location).max() < 1e-9, placement
+    assert np.abs(np.array(placement["direction"]) - C[:, 2]).max() < 1e-9, placement
+
+
+def test_a_camera_that_is_not_plenoptic_is_named_so(args):
+    work = os.path.join(args.work, "not_plenoptic")
+    os.makedirs(work, exist_ok=True)
+    out = os.path.join(work, "out")
+    for name, camera in (("perspective", "camera { perspective location <0, 0, 0> look_at <0, 0, 1> }\n"),
+                         ("none", "// no camera: POV-Ray's default perspective camera\n")):
+        cam = pt.write_text(os.path.join(work, name + ".inc"), camera)
+        cmd = [sys.executable, os.path.join(args.tools, "plenoptic-targets"), cam, "--out", out, "--count", "1",
+               "--width", "32", "--height", "24", "--povray", args.povray, "--project", args.project]
+        run = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+        line = run.stderr.strip()
+        assert run.returncode == 2 and "not plenoptic" in line and name + ".inc" in line and "\n" not in line, line
+        assert not [n for n in os.listdir(out) if n.startswith("target_")], "no view left: %s" % os.listdir(out)
 
 
 def test_seeds_decide_the_data_set(args):
