@@ -243,14 +243,15 @@ private:
 
 } // namespace
 
-std::shared_ptr<const MainLens> make_prescription_lens(const Prescription& lens, double stop_mm, bool exact)
+std::shared_ptr<const MainLens> make_prescription_lens(const Prescription& lens, double stop_mm, bool exact,
+                                                       double image_distance_mm)
 {
     Prescription sized = lens;
     if (stop_mm > 0)
         for (LensSurface& surface : sized.surfaces)
             if (surface.stop)
                 surface.aperture_mm = stop_mm;
-    const ParaxialData p = paraxial_data(sized);
+    const ParaxialData p = paraxial_data(sized, 0, image_distance_mm);
     if (!p.valid)
         return nullptr;
     const double length = p.rear_vertex_z;  // front vertex at z_optics = length, rear at 0
@@ -290,7 +291,7 @@ std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& p, double d
     }
     case MainLensType::ThickLens:
     case MainLensType::Prescription:
-        return make_prescription_lens(effective_prescription(p), 0, p.type == MainLensType::Prescription);
+        return make_prescription_lens(effective_prescription(p), 0, p.type == MainLensType::Prescription, distance_mm);
     case MainLensType::None:
         break;
     }

@@ -6,6 +6,7 @@
 #ifndef PLENOPTIC_MAIN_LENS_H
 #define PLENOPTIC_MAIN_LENS_H
 
+#include <cmath>
 #include <memory>
 
 #include "plenoptic_params.h"
@@ -69,12 +70,17 @@ struct Prescription;
 // `exact`: rays are traced surface by surface (Snell, every clear aperture, the stop or iris);
 // otherwise the lens is its paraxial equivalent, a thick lens: an ideal lens of the prescription's
 // effective focal length between its principal planes, with its exit pupil as the aperture.
+// The exit pupil (exit_pupil_centre, exit_pupil_radius) is the image of the aperture that limits
+// the axial beam converging image_distance_mm behind the rear vertex (the array, or the sensor;
+// paraxial_data); of the stop when image_distance_mm is not given (NaN).
 // nullptr when the prescription has no paraxial data (afocal, or a pupil at infinity).
-std::shared_ptr<const MainLens> make_prescription_lens(const Prescription& lens, double stop_mm, bool exact);
+std::shared_ptr<const MainLens> make_prescription_lens(const Prescription& lens, double stop_mm, bool exact,
+                                                       double image_distance_mm = NAN);
 
 // The main lens of checked parameters (nullptr for none). A lens knows only itself, and D
 // (distance_mm: main lens to array, or sensor) only for a thin lens's distortion, which acts on
-// the plane z = -D.
+// the plane z = -D, and for a real lens's pupils (the images of the aperture that limits the
+// axial beam converging at z = -D).
 std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& params, double distance_mm);
 
 // The unit-direction ray (origin, direction); passed false when it is not finite or does not head

@@ -141,6 +141,10 @@ Json paraxial_json(const Model& m)
     json["f_number"] = number(p.f_number);
     // Image side, as f-number matching needs it: exit pupil to the array (or sensor) over its diameter.
     json["working_f_number"] = number((exit_pupil_z + m.distance_mm) / p.exit_pupil_mm);
+    // The aperture the pupils image (index into prescription.surfaces: the stop's, unless a rim
+    // limits the axial beam), and the widest stop that still limits it (null: no rim ever does).
+    json["limiting_surface"] = p.aperture_surface;
+    json["largest_stop_diameter_mm"] = number(p.largest_stop_mm);
     return json;
 }
 

@@ -116,7 +116,8 @@ Model make_model(const CameraParams& params)
     }
     if (is_prescription_type(m.main_lens)) {
         m.prescription = effective_prescription(main);
-        m.paraxial = paraxial_data(m.prescription);
+        // Pupils and f-number of the aperture that limits the axial beam to the array (or sensor).
+        m.paraxial = paraxial_data(m.prescription, 0, main_lens_distance_mm(main, params.mm_per_unit));
         m.lens_file = main.lens_file;
         m.lens_length_mm = m.paraxial.rear_vertex_z;
         m.focal_length_mm = m.paraxial.efl_mm;
@@ -171,7 +172,7 @@ Model make_model(const CameraParams& params)
         // The round stop holds the iris: bounds from the lens without blades hold the lens with them.
         Prescription round = m.prescription;
         round.blades = 0;
-        const std::shared_ptr<const MainLens> traced = make_prescription_lens(round, 0, true);
+        const std::shared_ptr<const MainLens> traced = make_prescription_lens(round, 0, true, m.distance_mm);
         m.pupil_bounds = std::make_shared<PupilBounds>(round, *traced, m.grid == GridType::None ? m.sensor_z_mm : m.pose.centre_mm.z);
         if (m.grid == GridType::None && m.prescription.blades == 0)
             m.lit_area = std::make_shared<LitAreaTable>(*traced, *m.pupil_bounds, m.irradiance_k_mm2, m.angular_exponent);
@@ -219,9 +220,35 @@ Model make_model(const CameraParams& params)
     return m;
 }
 
+std::string limiting_aperture_warning(const Model& m)
+{
+    if (!is_prescription_type(m.main_lens) || !m.paraxial.valid || m.paraxial.aperture_surface < 0)
+        return "";
+    const std::vector<LensSurface>& rows = m.prescription.surfaces;
+    const LensSurface& limiting = rows[size_t(m.paraxial.aperture_surface)];
+    if (limiting.stop)
+        return "";
+    int stop = 0;
+    while (!rows[size_t(stop)].stop)
+        ++stop;
+    return describe_surface(m.prescription, stop, m.lens_file) + " is written " + format_number(m.paraxial.stop_mm) +
+           " mm wide, wider than the lens can use: " +
+           describe_surface(m.prescription, m.paraxial.aperture_surface, m.lens_file) + ", clear aperture " +
+           format_number(limiting.aperture_mm) + " mm, limits the axial beam, so the lens works at f/" +
+           format_rounded(m.paraxial.f_number, true) + " (the stop alone would give f/" +
+           format_rounded(f_number_for_stop_diameter(m.prescription, m.paraxial.stop_mm), true) +
+           "); the pupils, f-numbers and microimage diameter in the metadata are those of that surface. A stop of at "
+           "most " + format_rounded(m.paraxial.largest_stop_mm, false) + " mm (f_number " +
+           format_rounded(f_number_for_stop_diameter(m.prescription, m.paraxial.largest_stop_mm), true) +
+           " or slower) limits the beam itself";
+}
+
 std::vector<std::string> warnings(const Model& m)
 {
     std::vector<std::string> out;
+    const std::string aperture = limiting_aperture_warning(m);
+    if (!aperture.empty())
+        out.push_back(aperture);
     if (m.grid == GridType::None)
         return out;
 

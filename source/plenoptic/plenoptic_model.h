@@ -101,6 +101,10 @@ Model make_model(const CameraParams& params);
 
 // Legal but implausible parameters, one sentence each (empty when nothing is odd).
 std::vector<std::string> warnings(const Model& model);
+// The warning for a real lens whose stop, as written (no f_number or aperture), does not limit the
+// axial beam: names the stop, the limiting surface (row, line) and the f-number the lens works at;
+// "" when the stop limits it.
+std::string limiting_aperture_warning(const Model& model);
 
 // Rotation about x, then y, then z, in degrees: v -> Rz * Ry * Rx * v, with the same
 // matrices as POV-Ray's Compute_Rotation_Transform (which applies them to row vectors).

@@ -233,15 +233,74 @@ std::string check_real_lens(const MainLensParams& main, double mm_per_unit)
                    "(focal length " + format_number(bare.efl_mm) + " mm): focus farther than that";
     }
     const double D = main_lens_distance_mm(main, mm_per_unit);
-    const double pupil_behind = bare.exit_pupil_z - bare.rear_vertex_z;  // the stop's size does not move it
+    // The exit pupil of the aperture that limits the axial beam to z = -D (the stop's, unless a
+    // rim limits it: then the reach check below, or a warning when the stop is as written).
+    const ParaxialData at_d = paraxial_data(effective_prescription(main), 0, D);
+    if (!at_d.valid)
+        return "main_lens: the aperture that limits the lens's axial beam (" +
+               describe_surface(main.prescription, at_d.aperture_surface, main.lens_file) + ") images at infinity";
+    const double pupil_behind = at_d.exit_pupil_z - at_d.rear_vertex_z;
     if (!(D > pupil_behind))
         return "main_lens: the array (or sensor) at D = " + format_number(D) + " mm behind the rear vertex lies in "
                "front of the lens's exit pupil, " + format_number(pupil_behind) + " mm behind the rear vertex; "
                "the image side of a lens starts there";
-    return "";
+    return check_aperture_reach(main, mm_per_unit);
 }
 
 } // namespace
+
+std::string format_rounded(double value, bool round_up)
+{
+    if (!(value > 0) || !std::isfinite(value))
+        return format_number(value);
+    const double scale = std::pow(10.0, 3 - std::floor(std::log10(value)));
+    const double rounded = (round_up ? std::ceil(value * scale - 1e-9) : std::floor(value * scale + 1e-9)) / scale;
+    char buffer[40];
+    std::snprintf(buffer, sizeof buffer, "%.4g", rounded);
+    return buffer;
+}
+
+std::string describe_surface(const Prescription& lens, int index, const std::string& lens_file)
+{
+    if (index < 0 || index >= int(lens.surfaces.size()))
+        return "no surface";
+    const LensSurface& s = lens.surfaces[size_t(index)];
+    std::string where;
+    if (s.line > 0)
+        where = lens_file.empty() ? "scene line " + std::to_string(s.line)
+                                  : "line " + std::to_string(s.line) + " of lens_file \"" + lens_file + "\"";
+    const std::string number = "surface " + std::to_string(index + 1);
+    if (s.stop)
+        return "the stop (" + number + (where.empty() ? "" : ", " + where) + ")";
+    return number + (where.empty() ? "" : " (" + where + ")");
+}
+
+std::string check_aperture_reach(const MainLensParams& main, double mm_per_unit)
+{
+    if (!is_prescription_type(main.type) || !(main.has_f_number || main.has_aperture) || !main.has_prescription)
+        return "";
+    const Prescription lens = effective_prescription(main);
+    const double D = main_lens_distance_mm(main, mm_per_unit);
+    const ParaxialData p = paraxial_data(lens, 0, D);
+    if (!p.valid || p.aperture_surface < 0 || lens.surfaces[size_t(p.aperture_surface)].stop)
+        return "";
+    const std::string asked = main.has_f_number ? "f_number " + format_number(main.f_number)
+                                                : "aperture " + format_number(main.aperture_mm);
+    const LensSurface& rim = lens.surfaces[size_t(p.aperture_surface)];
+    std::string message = "main_lens: " + asked + " asks for a stop " + format_rounded(p.stop_mm, false) +
+                          " mm wide, which this lens cannot deliver: at that size a clear aperture, not the stop, "
+                          "limits the beam to the array's (or sensor's) axial point: " +
+                          describe_surface(lens, p.aperture_surface, main.lens_file) + ", clear aperture " +
+                          format_number(rim.aperture_mm) + " mm";
+    if (p.largest_stop_mm > 0 && std::isfinite(p.largest_stop_mm))
+        message += "; the fastest f-number the lens reaches is " +
+                   format_rounded(f_number_for_stop_diameter(main.prescription, p.largest_stop_mm), true) +
+                   ", with a stop (aperture) of at most " + format_rounded(p.largest_stop_mm, false) + " mm";
+    else
+        message += "; the stop lies where the axial beam has no width and never limits it (the lens works at f/" +
+                   format_rounded(p.f_number, true) + " without f_number or aperture)";
+    return message;
+}
 
 Prescription effective_prescription(const MainLensParams& main)
 {
@@ -494,7 +553,7 @@ std::string check_camera(const CameraParams& camera)
         return "microlens_array translate z = " + format_number(tz) + " mm moves the array onto or in front "
                "of the main lens (distance D = " + format_number(main_distance) + " mm)";
     if (is_prescription_type(camera.main.type)) {
-        const ParaxialData p = paraxial_data(effective_prescription(camera.main));
+        const ParaxialData p = paraxial_data(effective_prescription(camera.main), 0, main_distance);
         const double pupil_behind = p.exit_pupil_z - p.rear_vertex_z;  // exit pupil behind the rear vertex (mm)
         if (!(main_eff > pupil_behind))
             return "microlens_array at " + format_number(main_eff) + " mm behind the lens's rear vertex lies in front "

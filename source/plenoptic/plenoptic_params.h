@@ -164,6 +164,18 @@ std::string check_angular_exponent(double value);                          // 0 
 
 // ---- Cross-field checks, run when a block's closing brace is read. ----
 std::string check_main_lens(const MainLensParams& main, double mm_per_unit);
+// Part of check_main_lens for a real lens (traced or thick_lens) with f_number or aperture: the
+// stop so sized must be the aperture that limits the axial beam to the array (or sensor), else the
+// lens cannot deliver it (the message names the keyword, its value, the limiting surface, the
+// fastest f-number the lens reaches and the largest useful stop). "" when it can, or when another
+// check of check_main_lens refuses the lens first.
+std::string check_aperture_reach(const MainLensParams& main, double mm_per_unit);
+// Where a surface was written, for messages: "surface 9 (line 46 of lens_file \"x.dat\")" or
+// "surface 3 (scene line 12)"; the stop is "the stop (surface 7, ...)".
+std::string describe_surface(const Prescription& lens, int index, const std::string& lens_file);
+// A positive number to 4 significant digits, rounded up (round_up) or down, for messages that
+// suggest a value to type.
+std::string format_rounded(double value, bool round_up);
 std::string check_array(const ArrayParams& array);
 std::string check_sensor(const SensorParams& sensor);
 std::string check_sampling(const SamplingParams& sampling);

@@ -251,6 +251,50 @@ Traced trace(const Prescription& lens, const double* z, const double* before, co
     return Traced{TraceResult::Passed, ray, -1};
 }
 
+// axial_limit with the stop at diameter stop_mm. The paraxial marginal ray through the axial
+// image point at z = rear vertex + D: in front of the lens it is (y0, u0) with
+// (S.a + D S.c) y0 + (S.b + D S.d) u0 = 0 (height 0 on that plane); traced forward, its height at
+// each surface's vertex. Heights scale with the ray, so the ratios of opening radius to height
+// order the apertures whatever ray is taken.
+AxialLimit axial_limit_sized(const Prescription& lens, double stop_mm, double image_distance_mm)
+{
+    AxialLimit limit;
+    const int count = int(lens.surfaces.size());
+    const int k = stop_index(lens);
+    if (count == 0 || k < 0 || !std::isfinite(image_distance_mm))
+        return limit;
+    const Mat2 S = system_matrix(lens, 0, count - 1);
+    const double D = image_distance_mm;
+    const double y0 = S.b + D * S.d, u0 = -(S.a + D * S.c);
+    double y = y0, nu = u0, n = 1;
+    double stop_ratio = INFINITY, stop_height = 0, rim_ratio = INFINITY;
+    for (int i = 0; i < count; ++i) {
+        const LensSurface& s = lens.surfaces[i];
+        if (i > 0)
+            y += lens.surfaces[i - 1].thickness_mm * nu / n;
+        const double radius = 0.5 * (s.stop ? stop_mm : s.aperture_mm);
+        const double ratio = y != 0 ? radius / std::fabs(y) : INFINITY;
+        if (s.stop) {
+            stop_ratio = ratio;
+            stop_height = std::fabs(y);
+            continue;
+        }
+        if (ratio < rim_ratio) {
+            rim_ratio = ratio;
+            limit.rim = i;
+        }
+        if (s.radius_mm != 0)
+            nu -= y * (s.ior - n) / s.radius_mm;
+        n = s.ior;
+    }
+    if (!std::isfinite(y) || !std::isfinite(nu))
+        return limit;
+    limit.valid = true;
+    limit.largest_stop_mm = limit.rim >= 0 ? 2 * stop_height * rim_ratio : INFINITY;
+    limit.surface = limit.rim >= 0 && rim_ratio < stop_ratio * (1 - kApertureTolerance) ? limit.rim : k;
+    return limit;
+}
+
 } // namespace
 
 double flat_radius(double radius_mm)
@@ -423,7 +467,7 @@ std::vector<double> vertex_positions(const Prescription& lens)
     return z;
 }
 
-ParaxialData paraxial_data(const Prescription& lens, double stop_mm)
+ParaxialData paraxial_data(const Prescription& lens, double stop_mm, double image_distance_mm)
 {
     ParaxialData p;
     const int count = int(lens.surfaces.size());
@@ -444,23 +488,38 @@ ParaxialData paraxial_data(const Prescription& lens, double stop_mm)
     p.front_principal_z = p.front_focal_z + p.efl_mm;
     p.stop_z = z[k];
     p.stop_mm = stop_mm > 0 ? stop_mm : lens.surfaces[k].aperture_mm;
-    // Entrance pupil: the stop imaged by the surfaces in front of it, seen from object space.
+    // The aperture the pupils image: the stop, or the one that limits the axial beam.
+    int a = k;
+    double a_mm = p.stop_mm;
+    if (std::isfinite(image_distance_mm)) {
+        const AxialLimit limit = axial_limit_sized(lens, p.stop_mm, image_distance_mm);
+        if (!limit.valid)
+            return p;
+        a = limit.surface;
+        a_mm = a == k ? p.stop_mm : lens.surfaces[a].aperture_mm;
+        p.largest_stop_mm = limit.largest_stop_mm;
+    }
+    p.aperture_surface = a;
+    p.aperture_z = z[a];
+    p.aperture_mm = a_mm;
+    // Entrance pupil: the aperture imaged by the surfaces in front of it, seen from object space
+    // (a rim lies on its own surface, whose refraction leaves it where it is).
     Mat2 F = kIdentity;
-    if (k > 0)
-        F = transfer(lens.surfaces[k - 1].thickness_mm, medium_after(lens, k - 1)) * system_matrix(lens, 0, k - 1);
+    if (a > 0)
+        F = transfer(lens.surfaces[a - 1].thickness_mm, medium_after(lens, a - 1)) * system_matrix(lens, 0, a - 1);
     if (F.a == 0)
         return p;  // entrance pupil at infinity
     p.entrance_pupil_z = F.b / F.a;
-    p.entrance_pupil_mm = p.stop_mm / std::fabs(F.a);
-    // Exit pupil: the stop imaged by the surfaces behind it, seen from image space.
+    p.entrance_pupil_mm = a_mm / std::fabs(F.a);
+    // Exit pupil: the aperture imaged by the surfaces behind it, seen from image space.
     Mat2 B = kIdentity;
-    if (k < count - 1)
-        B = system_matrix(lens, k + 1, count - 1) * transfer(lens.surfaces[k].thickness_mm, medium_after(lens, k));
+    if (a < count - 1)
+        B = system_matrix(lens, a + 1, count - 1) * transfer(lens.surfaces[a].thickness_mm, medium_after(lens, a));
     if (B.d == 0)
         return p;  // exit pupil at infinity
     const double s = -B.b / B.d;
     p.exit_pupil_z = p.rear_vertex_z + s;
-    p.exit_pupil_mm = p.stop_mm * std::fabs(B.a + s * B.c);
+    p.exit_pupil_mm = a_mm * std::fabs(B.a + s * B.c);
     p.f_number = p.efl_mm / p.entrance_pupil_mm;
     p.valid = std::isfinite(p.efl_mm) && std::isfinite(p.entrance_pupil_z) && std::isfinite(p.exit_pupil_z);
     return p;
@@ -516,6 +575,20 @@ double stop_diameter_for_f_number(const Prescription& lens, double f_number)
     // The entrance pupil scales with the stop: EP = stop / |F.a|.
     const double ratio = full.entrance_pupil_mm / full.stop_mm;
     return full.efl_mm / f_number / ratio;
+}
+
+double f_number_for_stop_diameter(const Prescription& lens, double stop_mm)
+{
+    const ParaxialData full = paraxial_data(lens);
+    if (!full.valid || !(stop_mm > 0))
+        return NAN;
+    return full.efl_mm / (stop_mm * full.entrance_pupil_mm / full.stop_mm);
+}
+
+AxialLimit axial_limit(const Prescription& lens, double image_distance_mm)
+{
+    const int k = stop_index(lens);
+    return axial_limit_sized(lens, k >= 0 ? lens.surfaces[size_t(k)].aperture_mm : 0, image_distance_mm);
 }
 
 } // namespace plenoptic

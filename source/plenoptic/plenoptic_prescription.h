@@ -12,6 +12,7 @@
 #ifndef PLENOPTIC_PRESCRIPTION_H
 #define PLENOPTIC_PRESCRIPTION_H
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -98,10 +99,35 @@ struct ParaxialData {
     double exit_pupil_z = 0, exit_pupil_mm = 0;
     double stop_z = 0, stop_mm = 0;
     double f_number = 0;          // efl / entrance pupil diameter (infinity focus)
+    // The aperture whose images the pupils are: the stop, or (paraxial_data with an image
+    // distance) the aperture that limits the axial beam (axial_limit); its index, z and diameter.
+    int aperture_surface = -1;
+    double aperture_z = 0, aperture_mm = 0;
+    // The largest stop diameter at which the stop still limits that axial beam (infinity
+    // without an image distance, or when no rim ever limits it).
+    double largest_stop_mm = INFINITY;
 };
 
-// The paraxial data with the stop's diameter replaced by stop_mm (> 0), or as written (0).
-ParaxialData paraxial_data(const Prescription& lens, double stop_mm = 0);
+// The paraxial data with the stop's diameter replaced by stop_mm (> 0), or as written (0). The
+// pupils are the stop's images; with image_distance_mm (finite, the distance from the rear vertex
+// to the axial image point: the array, or the sensor), they are the images of the aperture that
+// limits the axial beam converging there (axial_limit), and f_number is the effective focal length
+// over that entrance pupil.
+ParaxialData paraxial_data(const Prescription& lens, double stop_mm = 0, double image_distance_mm = NAN);
+
+// The aperture that limits the axial beam (first order): the one whose opening the paraxial
+// marginal ray from the axial point image_distance_mm behind the rear vertex fills first, i.e.
+// the smallest ratio of opening radius to marginal-ray height (of all apertures, the one whose
+// paraxial image subtends the smallest angle from that point). The stop is preferred: a rim limits
+// only when its ratio is smaller than the stop's by more than kApertureTolerance (relative).
+const double kApertureTolerance = 0.005;
+struct AxialLimit {
+    bool valid = false;
+    int surface = -1;              // the limiting aperture (the stop's index when the stop limits)
+    int rim = -1;                  // the surface (not the stop) whose ratio is smallest; -1: none
+    double largest_stop_mm = INFINITY;  // stop diameter at which `rim` takes over (first order)
+};
+AxialLimit axial_limit(const Prescription& lens, double image_distance_mm);
 
 // Paraxial image of the plane at distance object_mm in front of the front vertex (> 0; infinity
 // for an object at infinity): the distance from the rear vertex to its image (positive: behind
@@ -152,8 +178,11 @@ private:
     std::vector<double> z_, before_, after_;
 };
 
-// Stop diameter (mm) giving the paraxial f-number N (efl / entrance pupil diameter).
+// Stop diameter (mm) giving the paraxial f-number N (efl / the stop's entrance pupil diameter).
 double stop_diameter_for_f_number(const Prescription& lens, double f_number);
+
+// The f-number (efl / entrance pupil) of the stop at diameter stop_mm.
+double f_number_for_stop_diameter(const Prescription& lens, double stop_mm);
 
 } // namespace plenoptic
 

@@ -23,7 +23,16 @@ std::string check_white_image(const WhiteImageRequest& request, const CameraPara
         return "white_image: f_numbers needs a main lens with an aperture (thin_lens, thick_lens, lens_file or "
                "prescription { }); this camera has " +
                std::string(type == MainLensType::Pinhole ? "a pinhole main lens" : "no main lens");
-    for (double n : request.f_numbers) {
+    return check_white_image_f_numbers(request, params);
+}
+
+std::string check_white_image_f_numbers(const WhiteImageRequest& request, const CameraParams& params)
+{
+    const std::string repeated = repeated_white_f_number(request);
+    if (!repeated.empty())
+        return repeated;
+    for (size_t k = 0; k < request.f_numbers.size(); ++k) {
+        const double n = request.f_numbers[k];
         const std::string message = check_f_number(n);
         if (!message.empty())
             return "white_image f_numbers: " + message;
@@ -31,6 +40,17 @@ std::string check_white_image(const WhiteImageRequest& request, const CameraPara
         if (!camera.empty())
             return "white_image f_numbers " + format_number(n) + ": " + camera;
     }
+    return "";
+}
+
+std::string repeated_white_f_number(const WhiteImageRequest& request)
+{
+    for (size_t k = 0; k < request.f_numbers.size(); ++k)
+        for (size_t j = 0; j < k; ++j)
+            if (request.f_numbers[j] == request.f_numbers[k])
+                return "white_image f_numbers lists " + format_number(request.f_numbers[k]) + " twice (values " +
+                       std::to_string(j + 1) + " and " + std::to_string(k + 1) + "); each f-number names its own file (" +
+                       white_image_suffix(request, int(k)) + "): list each once";
     return "";
 }
 

@@ -27,8 +27,16 @@ struct WhiteImageRequest {
 const int kMaxWhiteImages = 16;
 
 // "" when the request suits the camera (f_numbers need a main lens with an aperture: thin_lens,
-// thick_lens or a prescription), else the message.
+// thick_lens or a prescription), else the message. Ends with check_white_image_f_numbers.
 std::string check_white_image(const WhiteImageRequest& request, const CameraParams& params);
+
+// The part of check_white_image about the values: each f-number listed once (each names its own
+// file), and each one the camera can be given (as `f_number N` would be checked: a real lens must
+// be able to deliver it with its stop limiting the axial beam).
+std::string check_white_image_f_numbers(const WhiteImageRequest& request, const CameraParams& params);
+
+// "" unless an f-number is listed twice (then the message: a refusal, since each names its file).
+std::string repeated_white_f_number(const WhiteImageRequest& request);
 
 // The camera's parameters with the main lens at f-number N (aperture from N, as `f_number N`).
 CameraParams at_f_number(const CameraParams& params, double f_number);

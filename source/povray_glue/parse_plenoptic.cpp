@@ -250,9 +250,17 @@ void Parser::Parse_Plenoptic_Main_Lens(plenoptic::CameraParams& params)
 	lens = plenoptic::MainLensParams();
 	lens.given = true;
 
+	// Where f_number or aperture was written: a real lens that cannot deliver it is refused there.
+	pov_base::ITextStream::FilePos stop_position = Token.Token_File_Pos;
+	int stop_column = -1;
 	Parse_Begin();
 	for (Get_Token(); Word_Of(Token) != Word::CloseBlock; Get_Token())
 	{
+		if (Word_Of(Token) == Word::FNumber || Word_Of(Token) == Word::Aperture)
+		{
+			stop_position = Token.Token_File_Pos;
+			stop_column = Token.Token_Col_No;
+		}
 		switch (Word_Of(Token))
 		{
 			case Word::ThinLens:
@@ -326,8 +334,12 @@ void Parser::Parse_Plenoptic_Main_Lens(plenoptic::CameraParams& params)
 	// A real lens without thin_lens, pinhole or thick_lens is traced surface by surface.
 	if (lens.type == plenoptic::MainLensType::None && lens.has_prescription)
 		lens.type = plenoptic::MainLensType::Prescription;
-	// The closing brace is current: cross-field errors point at the end of the block.
-	Plenoptic_Check(plenoptic::check_main_lens(lens, params.mm_per_unit));
+	// The closing brace is current: cross-field errors point at the end of the block; a stop the
+	// lens cannot deliver, at its f_number or aperture.
+	const std::string lens_message = plenoptic::check_main_lens(lens, params.mm_per_unit);
+	if (!lens_message.empty() && stop_column >= 0 && lens_message == plenoptic::check_aperture_reach(lens, params.mm_per_unit))
+		Plenoptic_Check_At(lens_message, stop_position, stop_column);
+	Plenoptic_Check(lens_message);
 	UNGET
 	Parse_End();
 }
@@ -698,9 +710,10 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 				continue;
 			case Word::WhiteImage:
 			{
-				// white_image [on | off] [f_numbers N | f_numbers <N1, ..., N5>] [noise_free]
+				// white_image [on | off] [f_numbers N | f_numbers <N1, ..., N16>] [noise_free]
 				plenoptic::WhiteImageRequest& white = setup->white_image;
 				white = plenoptic::WhiteImageRequest();
+				setup->white_f_numbers = plenoptic::CameraSetup::KeywordSource();
 				white.given = Plenoptic_Keyword_Follows() || ((int)Allow_Float(1.0) != 0);
 				for (;;)
 				{
@@ -741,6 +754,13 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 							                   "white_image f_numbers: " + plenoptic::check_f_number(values[k]), position, column);
 							white.f_numbers.push_back(values[k]);
 						}
+						// A value listed twice is refused here; one the camera cannot take is found at the
+						// camera's brace, and reported here too.
+						Plenoptic_Check_At(plenoptic::repeated_white_f_number(white), position, column);
+						setup->white_f_numbers.keyword = "f_numbers";
+						setup->white_f_numbers.line = position.lineno;
+						setup->white_f_numbers.column = column;
+						setup->white_f_numbers.offset = position.offset;
 					}
 					else if (Word_Of(Token) == Word::NoiseFree)
 						white.noise_free = true;
@@ -818,7 +838,19 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 	// The camera's closing brace is current for the checks across blocks.
 	Plenoptic_Check(plenoptic::check_camera(params));
 	if (setup->white_image.given)
-		Plenoptic_Check(plenoptic::check_white_image(setup->white_image, params));
+	{
+		// An f-number the camera cannot take is refused at the f_numbers keyword; the rest here.
+		const std::string white = plenoptic::check_white_image(setup->white_image, params);
+		if (!white.empty() && !setup->white_f_numbers.keyword.empty() &&
+		    white == plenoptic::check_white_image_f_numbers(setup->white_image, params))
+		{
+			pov_base::ITextStream::FilePos position;
+			position.lineno = setup->white_f_numbers.line;
+			position.offset = setup->white_f_numbers.offset;
+			Plenoptic_Check_At(white, position, (int)setup->white_f_numbers.column);
+		}
+		Plenoptic_Check(white);
+	}
 	Plenoptic_Check(plenoptic::check_diffraction(params.diffraction, params));
 	{
 		// A traced lens's tables cost a fixed number of traces, each linear in its surfaces: a lens of

@@ -33,6 +33,9 @@ struct CameraSetup {
         long long offset = 0;
     };
     KeywordSource last_placement;
+    // Where white_image's f_numbers was written (keyword empty: not written): a value the camera
+    // cannot take is refused there.
+    KeywordSource white_f_numbers;
 };
 
 } // namespace plenoptic

@@ -311,8 +311,10 @@ void read_main_lens(const Json& root, CameraParams* params)
         m.type = type == "thick_lens" ? MainLensType::ThickLens : MainLensType::Prescription;
         read_prescription(object_member(main, parent, "prescription"), parent + ".prescription", &m);
         const double f_number = positive_number(member(main, parent, "f_number"), parent + ".f_number");
-        check_close(parent + ".f_number", f_number, paraxial_data(effective_prescription(m)).f_number, f_number,
-                    "the surfaces of main_lens.prescription");
+        // The f-number of the aperture that limits the axial beam to the array (or sensor) at D.
+        const double D = positive_number(member(main, parent, "distance_mm"), parent + ".distance_mm");
+        check_close(parent + ".f_number", f_number, paraxial_data(effective_prescription(m), 0, D).f_number, f_number,
+                    "the surfaces of main_lens.prescription and main_lens.distance_mm");
     } else {
         refuse(parent + ".type", "\"thin_lens\", \"pinhole\", \"thick_lens\", \"prescription\" or \"none\"",
                member(main, parent, "type"));
