@@ -877,9 +877,6 @@ void Parser::Parse_Plenoptic_Camera(Camera& New)
 			Plenoptic_Check(plenoptic::check_diffraction_size(
 				plenoptic::make_model(plenoptic::at_f_number(params, setup->white_image.f_numbers[k])), params.diffraction));
 	}
-	for (size_t k = 0; k < setup->white_image.f_numbers.size() && params.diffraction.given; k++)
-		Plenoptic_Check(plenoptic::check_diffraction_size(
-			plenoptic::make_model(plenoptic::at_f_number(params, setup->white_image.f_numbers[k])), params.diffraction));
 	UNGET
 	std::vector<std::string> warnings = plenoptic::warnings(setup->model);
 	const std::string dark = plenoptic::dark_image_warning(setup->model);
