@@ -41,25 +41,18 @@ def default_slopes(lf, count=9, reach_lenses=2.0):
 
 
 def distance_to_slope(lf, distance):
-    """Inverse of LightField.slope_to_distance (thin main lens only; None otherwise)."""
-    meta = lf.meta
-    if meta.main_lens_type != "thin_lens":
-        return None
-    z = distance * meta.mm_per_unit
-    F, D, d = meta.focal_length_mm, meta.main_distance_mm, meta.array_distance_mm
-    if not z > F:
-        return None
-    b = z * F / (z - F)
-    return lf.slope_from_kappa((D / b - 1) * (D + d) / d)
+    """Inverse of LightField.slope_to_distance (a main lens that forms an image; None otherwise)."""
+    kappa = lf.meta.distance_to_kappa(distance)
+    return None if kappa is None else lf.slope_from_kappa(kappa)
 
 
 def slopes_from_depth_map(lf, count=9):
     """A sweep covering the scene's depths, when the render wrote a depth map (metadata field
-    'depth_map', beside the metadata file) and the main lens is thin: from the 2nd to the 98th
+    'depth_map', beside the metadata file) and the main lens forms an image: from the 2nd to the 98th
     percentile of the finite depths, widened by a quarter of the span on each side and always
     including slope 0. None when there is no usable depth map."""
     path = lf.meta.sidecar_path("depth_map")
-    if path is None or lf.meta.main_lens_type != "thin_lens":
+    if path is None or lf.meta.focal_length_mm is None:
         return None
     depth = read_depth_map(path)
     if depth is None:

@@ -17,6 +17,10 @@ D / pitch view pixels, and a disparity of
 view pixels per view step, positive in front of the focus plane, as the toolkit's depth2disp
 computes it from parameters.cfg. A point at (x, y) in the centre view lies at
 (x - disp * (j - c), y - disp * (i - c)) in view (i, j) (row i, column j, centre c).
+
+A thick_lens (a prescription's paraxial equivalent) is the same ideal lens between its principal
+planes with the exit pupil as its aperture: its views are pinhole cameras on the entrance pupil's
+plane (HciGeometry). A traced prescription is refused: its views are not pinhole cameras.
 """
 
 import configparser
@@ -47,9 +51,15 @@ def check_hci_camera(meta):
     benchmark's camera grid exactly: a thin main lens without distortion, one kind of thin
     microlens with d = f, an array aligned with the sensor (not turned, not tilted), square pixels."""
     raw = meta.raw
-    if meta.main_lens_type != "thin_lens":
-        raise DecodeError("--hci needs a thin_lens main lens (its views are then an exact camera grid); this "
-                          "render's main lens is %s" % meta.main_lens_type)
+    if meta.main_lens_type == "prescription":
+        raise DecodeError("--hci's disparity ground truth assumes an ideal lens, whose sub-aperture views are "
+                          "pinhole cameras on one grid; this render's main lens is a traced prescription, whose "
+                          "distortion and pupil aberration bend each view's rays differently, so no single "
+                          "disparity per pixel exists. Render the same camera with thick_lens (its paraxial "
+                          "equivalent) for an HCI export")
+    if meta.main_lens_type not in ("thin_lens", "thick_lens"):
+        raise DecodeError("--hci needs a thin_lens or thick_lens main lens (its views are then an exact camera "
+                          "grid); this render's main lens is %s" % meta.main_lens_type)
     if isinstance(raw.get("main_lens"), dict) and raw["main_lens"].get("distortion") is not None:
         raise DecodeError("--hci needs a thin_lens without distortion: a distorted lens's views are not "
                           "pinhole cameras, so no single disparity per pixel exists")
@@ -74,55 +84,82 @@ def check_hci_camera(meta):
         raise DecodeError("--hci needs square pixels (one baseline for both axes); pixel_size is %g x %g mm"
                           % (px, py))
     F = meta.focal_length_mm
-    D = meta.main_distance_mm
+    D = meta.rear_principal_z + meta.main_distance_mm
     if not D > F:
-        raise DecodeError("--hci needs the array beyond the focal length (D = %g mm, F = %g mm): otherwise "
-                          "nothing is in focus in front of the lens" % (D, F))
+        raise DecodeError("--hci needs the array beyond the focal length (D = %g mm from the %s, F = %g mm): "
+                          "otherwise nothing is in focus in front of the lens"
+                          % (D, "lens" if meta.main_lens_type == "thin_lens" else "rear principal plane", F))
+    if not HciGeometry(meta, 1.0).pupil_magnification > 0:
+        raise DecodeError("--hci needs a lens whose exit pupil is an upright image of its entrance pupil; this "
+                          "thick lens's pupil magnification is negative, which turns its camera grid over")
 
 
 class HciGeometry:
-    """The camera grid the views form (all lengths mm): F, D, d, pitch, pixel, step; z0 the
-    distance in focus; baseline between neighbouring views; focal_px = D / pitch."""
+    """The camera grid the views form (all lengths mm): F, D (main lens to array), d, pitch,
+    pixel, step; z0 the distance in focus and baseline between neighbouring views, both at the
+    views' centres of projection; focal_px the views' focal length in view pixels.
+
+    A thin lens is its own pupils and principal planes. A thick_lens (the paraxial equivalent of
+    a prescription) is the same ideal lens between its principal planes, with the exit pupil as
+    its aperture: a pixel du off its microimage centre sees through the exit pupil's plane at
+    du pixel D'/d (D': exit pupil to array), whose conjugate is the point of the entrance pupil's
+    plane 1/m as far from the axis (m: the pupils' magnification). The views are pinhole cameras
+    there, looking at the array's conjugate plane: baseline pixel step D'/(d m), focal length
+    z0 s_i/(s_o pitch) view pixels (s_o, s_i: that plane's and the array's distances from the
+    principal planes; z0: the plane's from the entrance pupil). For a thin lens these are
+    pixel step D/d and D/pitch."""
 
     def __init__(self, meta, step):
-        self.F = meta.focal_length_mm
+        self.F = F = meta.focal_length_mm
         self.D = meta.main_distance_mm
         self.d = meta.array_distance_mm
         self.pitch = meta.pitch_mm
         self.pixel = meta.pixel_size_mm[0]
         self.step = float(step)
-        self.z0 = self.F * self.D / (self.D - self.F)
-        self.baseline = self.pixel * self.step * self.D / self.d
-        self.focal_px = self.D / self.pitch
+        self.pupil_distance = meta.pupil_distance_mm  # exit pupil -> array (D')
+        self.image_distance = s_i = meta.rear_principal_z + meta.main_distance_mm  # rear principal plane -> array
+        self.object_distance = s_o = s_i * F / (s_i - F)  # front principal plane -> the plane in focus
+        # Entrance pupil -> exit pupil through the ideal lens: lateral magnification 1 / (1 - s / F),
+        # s the entrance pupil's distance in front of the front principal plane.
+        self.pupil_magnification = 1.0 / (1.0 - (meta.entrance_pupil_z - meta.front_principal_z) / F)
+        self.pupil_z = meta.entrance_pupil_z  # the views' centres of projection lie in this plane
+        self.front_principal_z = meta.front_principal_z
+        self.z0 = meta.front_principal_z + s_o - meta.entrance_pupil_z
+        self.baseline = self.pixel * self.step * self.pupil_distance / self.d / self.pupil_magnification
+        self.focal_mm = self.z0 * s_i / s_o  # D for a thin lens
+        self.focal_px = self.focal_mm / self.pitch
 
     def disparity(self, depth_mm):
-        """View pixels per view step of points at depth Z (mm): +inf depth gives the finite
-        disparity of infinity; NaN stays NaN."""
+        """View pixels per view step of points at depth Z (mm from the entrance pupil's plane):
+        +inf depth gives the finite disparity of infinity; NaN stays NaN."""
         with np.errstate(divide="ignore"):
             inverse = np.where(np.isinf(depth_mm), 0.0, 1.0 / depth_mm)
         return self.baseline * self.focal_px * (inverse - 1.0 / self.z0)
 
 
 def planar_depth_mm(meta, geometry, distance_units, pixel_u, pixel_v, centre_u, centre_v):
-    """Depth along the optical axis (mm, from the main lens) of the surface the chief ray of raw
-    pixel (pixel_u, pixel_v) meets at the depth map's distance (scene units), for a pixel of the
-    microimage centred at (centre_u, centre_v). The chief ray runs from the main lens point
-    x_a = c + (c - x) D / d (x: the pixel, c: its lens centre, c = m D / (D + d) for the microimage
-    centre m) to the lens centre's conjugate C' = -m z0 / (D + d) on the plane z0 in focus.
+    """Depth along the optical axis (mm, from the entrance pupil's plane; a thin lens's own) of the
+    surface the chief ray of raw pixel (pixel_u, pixel_v) meets at the depth map's distance (scene
+    units, from where the ray leaves the lens: a thin lens's plane, a thick lens's front principal
+    plane), for a pixel of the microimage centred at (centre_u, centre_v). The chief ray's image
+    side runs through the pixel x and its lens centre c = m D'/(D' + d) (m: the microimage centre)
+    to the exit pupil's plane at x' = c + (c - x) D'/d; its scene side from x' / m_p on the
+    entrance pupil's plane to the lens centre's conjugate C' = -c s_o / s_i on the plane in focus.
     Positions are taken on the sensor relative to the principal point (a reflection of the optics
     frame, which leaves the ray's length unchanged). +inf stays +inf; -1 (blocked) gives NaN."""
     px, py = meta.pixel_size_mm
     pu, pv = meta.raw["principal_point_px"]
-    D, d, z0 = geometry.D, geometry.d, geometry.z0
+    D, d = geometry.pupil_distance, geometry.d
     x = np.stack([(np.asarray(pixel_u, float) - pu) * px, (np.asarray(pixel_v, float) - pv) * py])
     m = np.stack([(np.asarray(centre_u, float) - pu) * px, (np.asarray(centre_v, float) - pv) * py])
     c = m * D / (D + d)
-    aperture = c + (c - x) * D / d
-    target = -m * z0 / (D + d)
+    aperture = (c + (c - x) * D / d) / geometry.pupil_magnification
+    target = -c * geometry.object_distance / geometry.image_distance
     lateral = target - aperture
+    z0 = geometry.z0
     cosine = z0 / np.sqrt(lateral[0] ** 2 + lateral[1] ** 2 + z0 * z0)
     distance = np.asarray(distance_units, float)
-    depth = distance * meta.mm_per_unit * cosine
+    depth = distance * meta.mm_per_unit * cosine + (geometry.front_principal_z - geometry.pupil_z)
     return np.where(distance < 0, np.nan, depth)
 
 
@@ -183,7 +220,10 @@ def _blender_pose(meta):
     frame = meta.raw["camera_frame"]
     to_blender = np.array([[1, 0, 0], [0, 0, 1], [0, 1, 0]], float)
     scale = meta.mm_per_unit / 1000.0
-    location = to_blender @ np.asarray(frame["location"], float) * scale
+    # The centre view's centre of projection: the entrance pupil's centre (a thin lens's centre).
+    direction = np.asarray(frame["direction"], float)
+    pupil = np.asarray(frame["location"], float) + meta.entrance_pupil_z / meta.mm_per_unit * direction / np.linalg.norm(direction)
+    location = to_blender @ pupil * scale
 
     def unit(v):
         v = to_blender @ np.asarray(v, float)
@@ -216,7 +256,7 @@ def _write_parameters(path, meta, geometry, n, width, height, disp_range, scene)
     config = configparser.ConfigParser()
     config.optionxform = str
     config["intrinsics"] = {
-        "focal_length_mm": repr(geometry.D),
+        "focal_length_mm": repr(geometry.focal_mm),
         "image_resolution_x_px": str(width),
         "image_resolution_y_px": str(height),
         "sensor_size_mm": repr(geometry.pitch * max(width, height)),
@@ -253,6 +293,7 @@ def _write_parameters(path, meta, geometry, n, width, height, disp_range, scene)
         "raw_metadata": os.path.basename(meta.path),
         "grid": meta.grid,
         "angular_step_px": repr(geometry.step),
+        "main_lens": meta.main_lens_type,
         "main_lens_focal_length_mm": repr(geometry.F),
         "main_lens_to_array_mm": repr(geometry.D),
         "array_to_sensor_mm": repr(geometry.d),
@@ -260,7 +301,8 @@ def _write_parameters(path, meta, geometry, n, width, height, disp_range, scene)
         "pixel_size_mm": repr(geometry.pixel),
         "view_rows": "hexagonal rows resampled to square pixels (one pitch apart), linearly; depths nearest"
                      if meta.grid == "hexagonal" else "one lens row per view row",
-        "depth": "metres along the optical axis from the main lens; inf where the ray meets nothing, "
+        "depth": "metres along the optical axis from the main lens (a thick lens: its entrance pupil); inf where "
+                 "the ray meets nothing, "
                  "nan where it was blocked",
     }
     with open(path, "w") as f:

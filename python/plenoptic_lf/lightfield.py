@@ -22,6 +22,7 @@ import numpy as np
 
 from .errors import DecodeError, MetadataError
 from .images import bilinear
+from .microimages import microimage_centre
 from .progress import Progress
 
 
@@ -33,6 +34,9 @@ class LightField:
     mask:     bool [v, u], True where the offset lies inside the usable microimage disc
     A, R:     pixel vectors between neighbouring (s) and (t) grid positions on the sensor
     position: (s, t) -> raw pixel of that grid point: origin + (s0 + s) A + (t0 + t) R
+              (of the metadata lattice; behind a traced prescription each microimage was
+              sampled around its measured centre, which lies off it by up to a pixel or so)
+    dark:     bool [t, s], True at grid points whose lens gets no light (measured centres)
     """
 
     def __init__(self, data, du, dv, mask, A, R, origin_st, meta, step):
@@ -47,6 +51,7 @@ class LightField:
         self.step = step
         self.M = np.column_stack([A, R])
         self.M_inv = np.linalg.inv(self.M)
+        self.dark = np.zeros(data.shape[:2], bool)
 
     @property
     def shape(self):
@@ -236,7 +241,7 @@ class DecodePlan:
         frac = k - k0
 
         def inside(kk, ll):
-            u, v = meta.centre(kk, ll)
+            u, v, _ = microimage_centre(meta, kk, ll)
             return (u - reach >= 0) & (u + reach <= W - 1) & (v - reach >= 0) & (v + reach <= H - 1)
 
         valid = inside(k0, l) & ((frac < 1e-6) | inside(k0 + 1, l))
@@ -312,11 +317,16 @@ def decode(raw, meta, n=None, step=1.0, progress=None):
     data = np.zeros((T, S, n_v, n_u, C), np.float32)
     # A few angular rows at a time: the interpolation's temporaries stay small beside L.
     rows_per_chunk = max(1, (1 << 18) // max(S * n_u, 1))
+    # Each microimage is sampled around its own centre: the metadata lattice where it is exact,
+    # the measured centre behind a traced prescription (microimages.py). A lens that gets no light
+    # (dark in the measured centres) gives zeros, and its grid points are marked in `dark`.
+    dark = np.zeros((T, S), bool)
     for t in range(T):
-        u0, v0 = meta.centre(k0[t], l[t])
-        u1, v1 = meta.centre(k0[t] + 1, l[t])
+        u0, v0, dark0 = microimage_centre(meta, k0[t], l[t])
+        u1, v1, dark1 = microimage_centre(meta, k0[t] + 1, l[t])
         weight_next = frac[t][:, None, None, None]
         shifted = bool(np.any(frac[t] > 0))
+        dark[t] = dark0 | ((frac[t] > 0) & dark1)
         for iv0 in range(0, n_v, rows_per_chunk):
             offset_v, offset_u = np.meshgrid(dv[iv0:iv0 + rows_per_chunk], du, indexing="ij")
             x0 = u0[:, None, None] + offset_u[None]
@@ -327,8 +337,14 @@ def decode(raw, meta, n=None, step=1.0, progress=None):
                 y1 = v1[:, None, None] + offset_v[None]
                 chunk += bilinear(raw, x1, y1) * weight_next
             data[t, :, iv0:iv0 + rows_per_chunk] = chunk
+        data[t, dark[t]] = 0
         progress.update(t + 1, T)
-    return LightField(data, du, dv, mask, plan.A, plan.R, plan.origin_st, meta, plan.step)
+    if dark.any():
+        progress.stage("%d of the %d lens positions get no light (dark in the measured microimage centres): "
+                       "left black" % (int(dark.sum()), T * S))
+    lf = LightField(data, du, dv, mask, plan.A, plan.R, plan.origin_st, meta, plan.step)
+    lf.dark = dark
+    return lf
 
 
 def mosaic(lf, gap=2):

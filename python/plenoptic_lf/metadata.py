@@ -81,6 +81,18 @@ def _optional_number(data, path):
     return float(value) if _is_finite_number(value) else None
 
 
+MAIN_LENS_TYPES = ("thin_lens", "thick_lens", "prescription", "pinhole", "none")
+# Real main lenses (docs/real-lenses.md): the paraxial equivalent (thick_lens, whose microimage
+# lattice is exact) and the traced prescription (whose microimage centres leave the lattice).
+REAL_LENS_TYPES = ("thick_lens", "prescription")
+# main_lens.paraxial's members: finite numbers, length_mm not negative, the others positive.
+PARAXIAL_FIELDS = ("back_focal_distance_mm", "front_focal_distance_mm", "front_vertex_z_mm",
+                   "front_principal_plane_z_mm", "rear_principal_plane_z_mm", "entrance_pupil_z_mm",
+                   "exit_pupil_z_mm")
+PARAXIAL_POSITIVE = ("effective_focal_length_mm", "entrance_pupil_diameter_mm",
+                     "exit_pupil_diameter_mm", "f_number", "working_f_number")
+
+
 class Metadata:
     """The fields of a render's metadata that decoding needs, checked.
 
@@ -144,22 +156,81 @@ class Metadata:
         # value here means a wrong file.
         self.mm_per_unit = _checked_number(raw, "mm_per_unit", positive=True)
         self.main_lens_type = _field_at(raw, "main_lens.type")
-        if self.main_lens_type not in ("thin_lens", "pinhole", "none"):
-            raise MetadataError("field 'main_lens.type' must be \"thin_lens\", \"pinhole\" or \"none\", found %s"
-                                % _describe(self.main_lens_type))
+        if self.main_lens_type not in MAIN_LENS_TYPES:
+            raise MetadataError("field 'main_lens.type' must be %s, found %s"
+                                % (", ".join('"%s"' % t for t in MAIN_LENS_TYPES[:-1]) + ' or "%s"' % MAIN_LENS_TYPES[-1],
+                                   _describe(self.main_lens_type)))
         self.focal_length_mm = None
+        self.aperture_mm = None
         main_lens_to_array_mm = 0.0
-        if self.main_lens_type == "thin_lens":
+        if self.main_lens_type in ("thin_lens",) + REAL_LENS_TYPES:
             self.focal_length_mm = _checked_number(raw, "main_lens.focal_length_mm", positive=True)
-            _checked_number(raw, "main_lens.aperture_mm", positive=True)
+            self.aperture_mm = _checked_number(raw, "main_lens.aperture_mm", positive=True)
         if self.main_lens_type != "none":
             main_lens_to_array_mm = _checked_number(raw, "main_lens.distance_mm", positive=True)
+        # The first-order lens in the optics frame (mm, z towards the scene): principal planes, pupils
+        # and front vertex. A thin lens is all of them at z = 0 with its aperture as both pupils; a
+        # real lens (thick_lens, prescription) has them in main_lens.paraxial, z from its rear vertex.
+        self.front_principal_z = self.rear_principal_z = 0.0
+        self.entrance_pupil_z = self.exit_pupil_z = self.front_vertex_z = 0.0
+        self.entrance_pupil_mm = self.exit_pupil_mm = self.aperture_mm
+        if self.main_lens_type in REAL_LENS_TYPES:
+            self._read_real_lens(raw)
+        self.pitch_mm = _checked_number(raw, "microlens_array.pitch_mm", positive=True)
         self.pitch_mm = _checked_number(raw, "microlens_array.pitch_mm", positive=True)
         array_to_sensor_mm = _checked_number(raw, "microlens_array.distance_mm", positive=True)
         array_shift_z_mm = _checked_numbers(raw, "microlens_array.translate_mm", 3)[2]
         # Distances at the array centre, including the array's z translation.
         self.main_distance_mm = main_lens_to_array_mm - array_shift_z_mm
         self.array_distance_mm = array_to_sensor_mm + array_shift_z_mm
+
+    def _read_real_lens(self, raw):
+        """main_lens.f_number, .prescription and .paraxial of a thick_lens or prescription, checked
+        like the rest and against each other (the renderer writes them from one lens)."""
+        _checked_number(raw, "main_lens.f_number", positive=True)
+        prescription = _field_at(raw, "main_lens.prescription")
+        surfaces = prescription.get("surfaces") if isinstance(prescription, dict) else None
+        if not isinstance(surfaces, list) or not surfaces:
+            raise MetadataError("field 'main_lens.prescription' must be an object whose 'surfaces' lists the lens's "
+                                "rows, found %s" % _describe(prescription if not isinstance(prescription, dict)
+                                                               else surfaces))
+        paraxial = _field_at(raw, "main_lens.paraxial")
+        if not isinstance(paraxial, dict):
+            raise MetadataError("field 'main_lens.paraxial' must be an object, found %s" % _describe(paraxial))
+        values = {}
+        for name in PARAXIAL_FIELDS:
+            values[name] = _checked_number(raw, "main_lens.paraxial." + name)
+        for name in PARAXIAL_POSITIVE:
+            values[name] = _checked_number(raw, "main_lens.paraxial." + name, positive=True)
+        values["length_mm"] = length = _checked_number(raw, "main_lens.paraxial.length_mm")
+        if length < 0:
+            raise MetadataError("field 'main_lens.paraxial.length_mm' must not be negative, found %r" % length)
+        efl = values["effective_focal_length_mm"]
+        for path, value, expected in (
+                ("main_lens.focal_length_mm", self.focal_length_mm, efl),
+                ("main_lens.paraxial.front_vertex_z_mm", values["front_vertex_z_mm"], length)):
+            if not math.isclose(value, expected, rel_tol=1e-9, abs_tol=1e-9):
+                raise MetadataError("field '%s' is %r but the lens's paraxial data give %r: the file was edited"
+                                    % (path, value, expected))
+        self.front_vertex_z = length
+        self.front_principal_z = values["front_principal_plane_z_mm"]
+        self.rear_principal_z = values["rear_principal_plane_z_mm"]
+        self.entrance_pupil_z = values["entrance_pupil_z_mm"]
+        self.exit_pupil_z = values["exit_pupil_z_mm"]
+        self.entrance_pupil_mm = values["entrance_pupil_diameter_mm"]
+        self.exit_pupil_mm = values["exit_pupil_diameter_mm"]
+
+    @property
+    def pupil_distance_mm(self):
+        """Exit pupil (a thin lens: the lens) to the array at its centre, mm: the D of the
+        microimage lattice, which projects the lens centres from the exit pupil's centre."""
+        return self.exit_pupil_z + self.main_distance_mm
+
+    @property
+    def lattice_is_exact(self):
+        """True when the microimage centres are the metadata lattice (every main lens but a
+        traced prescription, whose pupil aberration and vignetting move them)."""
+        return self.main_lens_type != "prescription"
 
     def sidecar_path(self, field):
         """The file a top-level field names (depth_map, virtual_depth_map, ...), beside the
@@ -203,20 +274,43 @@ class Metadata:
 
     def slope_to_distance(self, kappa):
         """Scene distance (in front of the main lens, scene units) in focus for a refocus shift of
-        kappa microimage-centre pixels per pixel of angular offset, from the thin-lens equations
-        with the chief-ray geometry of plenoptic 1.0; inf beyond infinity; None when the
-        metadata has no thin main lens."""
-        if self.main_lens_type != "thin_lens":
+        kappa microimage-centre pixels per pixel of angular offset; inf beyond infinity; None when
+        the main lens forms no image (pinhole, none).
+
+        The chief-ray geometry of plenoptic 1.0 about the exit pupil (a pixel du off its
+        microimage centre sees through the exit pupil's plane at -du s_x D'/d, D' = exit pupil to
+        array), then the paraxial lens: the image point's distance behind the rear principal
+        plane, the thin-lens equation with the effective focal length, the object's distance in
+        front of the front principal plane. A thin lens has pupils and principal planes at its
+        centre; a real lens (thick_lens, prescription) its paraxial ones, and the distance is
+        measured from its front vertex (as focus_distance and the depth map are)."""
+        if self.focal_length_mm is None:
             return None
-        # docs/ground-truth.md's notation: D main lens to array, d array to sensor, F focal length.
-        D, d, F = self.main_distance_mm, self.array_distance_mm, self.focal_length_mm
+        F, D, d = self.focal_length_mm, self.pupil_distance_mm, self.array_distance_mm
         denominator = 1.0 + kappa * d / (D + d)
         if denominator <= 0:
             return math.inf
-        b = D / denominator  # where the main lens images the plane in focus
-        if b <= F:
+        b = D / denominator  # exit pupil -> the plane imaged onto the array at this slope
+        image = self.rear_principal_z - (self.exit_pupil_z - b)  # rear principal plane -> that plane
+        if image <= F:
             return math.inf
-        return b * F / (b - F) / self.mm_per_unit
+        obj = image * F / (image - F)  # front principal plane -> the object plane
+        return (self.front_principal_z + obj - self.front_vertex_z) / self.mm_per_unit
+
+    def distance_to_kappa(self, distance):
+        """The inverse of slope_to_distance: kappa for a scene distance (scene units in front of
+        the main lens; of a real lens's front vertex); None when no real image exists."""
+        if self.focal_length_mm is None:
+            return None
+        F, D, d = self.focal_length_mm, self.pupil_distance_mm, self.array_distance_mm
+        obj = distance * self.mm_per_unit + self.front_vertex_z - self.front_principal_z
+        if not obj > F:
+            return None
+        image = obj * F / (obj - F)
+        b = self.exit_pupil_z - (self.rear_principal_z - image)
+        if b == 0:
+            return None
+        return (D / b - 1.0) * (D + d) / d
 
 
 def _unique_keys(pairs):

@@ -89,6 +89,10 @@ def write_outputs(raw, lf, outdir, slopes, gif=True, npy=True, progress=None, ti
         "grid_t_vector_px": lf.R.tolist(),
         "grid_origin_index": [float(lf.origin_st[0]), float(lf.origin_st[1])],
         "grid_position_rule": "raw pixel of data[t, s] = microimage_lattice.origin_px + (s0 + s) A + (t0 + t) R",
+        "microimage_centres": ("the metadata's microimage_lattice" if lf.meta.lattice_is_exact else
+                               "measured, per lens (%s); the lattice fit for lenses it does not list"
+                               % (lf.meta.raw.get("microimages") or {}).get("file")),
+        "dark_mask": lf.dark.astype(int).tolist(),
         "slopes": [float(s) for s in slopes],
         "slope_unit": "lenses along s per angular step (0 = plane imaged onto the array)",
         "slope_distances": [lf.slope_to_distance(s) if lf.slope_to_distance(s) is None or

@@ -2,7 +2,10 @@
 """The total-focus (all-in-focus) image of a focused (2.0) plenoptic raw, from the virtual depth
 the render wrote (<stem>.virtual_depth.exr) or one given (docs/total-focus.md).
 
-Geometry (thin main lens, array parallel to the sensor). A point of the array plane q = c + delta
+Geometry (thin main lens, array parallel to the sensor; a thick_lens, a prescription's paraxial
+equivalent, is the same with O the exit pupil's centre, D its distance to the array and the exit
+pupil as the aperture, and gives the picture of a pinhole at the entrance pupil's centre).
+A point of the array plane q = c + delta
 (c: the centre of the lens whose cell holds it) looks, from the main lens's centre O, at the
 scene point whose main-lens image X' lies on the line O -> q at virtual depth v (X' is v d
 behind the array, v = -a / d). The line from X' through the lens centre c meets the sensor at
@@ -27,11 +30,18 @@ from .images import bilinear, read_depth_map
 
 
 def check_total_focus_camera(meta):
-    """DecodeError unless the render is a focused camera behind a thin main lens, array parallel
-    to the sensor."""
+    """DecodeError unless the render is a focused camera behind a thin or thick main lens, array
+    parallel to the sensor."""
     raw = meta.raw
-    if meta.main_lens_type != "thin_lens":
-        raise DecodeError("--total-focus needs a thin_lens main lens; this render's is %s" % meta.main_lens_type)
+    if meta.main_lens_type == "prescription":
+        raise DecodeError("--total-focus reads each point from the microimages where an ideal lens's straight chief "
+                          "ray through the exit pupil's centre puts it; this render's main lens is a traced "
+                          "prescription, whose distortion and pupil aberration put it elsewhere, so the picture would "
+                          "be wrong. Render the same camera with thick_lens (its paraxial equivalent) for a total "
+                          "focus")
+    if meta.main_lens_type not in ("thin_lens", "thick_lens"):
+        raise DecodeError("--total-focus needs a thin_lens or thick_lens main lens; this render's is %s"
+                          % meta.main_lens_type)
     array = raw["microlens_array"]
     focal = array.get("focal_lengths_mm") or []
     if array.get("lens") != "thin_lens" or all(math.isclose(f, meta.array_distance_mm, rel_tol=1e-9) for f in focal):
@@ -82,7 +92,7 @@ def default_step(meta, virtual):
     """Output sample spacing (pixels of the picture) that reads the raw about one pixel apart at
     the scene's typical virtual depth: (1 + d/D) / k, k the median over the map of |1/v + d/D|
     (the scale from picture to raw at v)."""
-    D, d = meta.main_distance_mm, meta.array_distance_mm
+    D, d = meta.pupil_distance_mm, meta.array_distance_mm
     values = np.asarray(virtual, dtype=np.float64).ravel()
     values = values[np.isfinite(values) & (np.abs(values) >= 1e-3)]
     scale = float(np.median(np.abs(1 / values + d / D))) if values.size else abs(0.5 + d / D)
@@ -93,7 +103,9 @@ def total_focus(raw, meta, virtual=None, step=None, iterations=4):
     """raw (H, W, C) linear; virtual: the virtual depth map (H, W) or a number. Returns the image
     (rows, columns, C) and the step used (picture pixels between samples)."""
     check_total_focus_camera(meta)
-    D, d = meta.main_distance_mm, meta.array_distance_mm
+    # D: the exit pupil's centre (a thin lens's centre) to the array, from which the microimage
+    # lattice projects the lens centres; the aperture below is the exit pupil's diameter.
+    D, d = meta.pupil_distance_mm, meta.array_distance_mm
     constant = np.ndim(virtual) == 0
     if step is None:
         step = default_step(meta, virtual)
@@ -138,7 +150,7 @@ def total_focus(raw, meta, virtual=None, step=None, iterations=4):
     # |P - M(c)| pixel / (1 + d/D) from q. Those lenses are averaged; where none is wholly lit
     # (a small cone), the nearest lens (whose cell holds q) is read.
     safe_v = np.where(np.isnan(v), 1e9, v)
-    aperture = float(meta.raw["main_lens"]["aperture_mm"])
+    aperture = meta.exit_pupil_mm
     pixel = float(np.mean(meta.pixel_size_mm))
     circumradius = meta.pitch_mm / (math.sqrt(3) if meta.grid == "hexagonal" else math.sqrt(2))
     a = -safe_v * d

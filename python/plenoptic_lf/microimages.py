@@ -1,0 +1,181 @@
+# SPDX-License-Identifier: AGPL-3.0-or-later
+"""The render's measured microimage centres, <stem>.microimages.csv (docs/metadata.md,
+"Microimage centres"), for decoding renders behind a traced prescription, whose microimages
+leave the metadata's paraxial lattice (pupil aberration, vignetting; docs/real-lenses.md).
+
+The file has one line per lens whose lattice centre lies in the picture: k, l (row form), u, v
+(the centroid of a white scene's light, pixels; empty for a lens that gets no light), then
+lit_fraction and the residuals. Lenses are looked up by skew index (k_s, l) as the metadata's
+lattice numbers them: k_s = k - floor(l / 2) on a hexagonal grid, k_s = k on a rectangular one.
+"""
+
+import math
+import os
+
+import numpy as np
+
+from .errors import DecodeError
+
+COLUMNS = ("k", "l", "u", "v")
+# The lookup's status of a lens.
+UNLISTED, LIT, DARK = 0, 1, 2
+
+
+def _lattice_fit(meta):
+    """(origin, a, b) of the metadata's microimages.lattice_fit, or None when it has none (fewer
+    than three lit lenses) or it is malformed."""
+    fit = (meta.raw.get("microimages") or {}).get("lattice_fit")
+    if not isinstance(fit, dict):
+        return None
+    try:
+        origin = np.array(fit["origin_px"], dtype=float)
+        basis = np.array(fit["basis_px"], dtype=float)
+    except (KeyError, TypeError, ValueError):
+        return None
+    if origin.shape != (2,) or basis.shape != (2, 2) or not (np.isfinite(origin).all() and np.isfinite(basis).all()):
+        return None
+    return origin, basis[0], basis[1]
+
+
+class MeasuredCentres:
+    """Per-lens measured centres: centre(k, l) -> (u, v, dark), skew indices, vectorised.
+
+    A lit lens gives its measured centre; a lens the file lists without a centre (no light) is
+    dark, and gives the lattice fit's position; a lens the file does not list (its lattice centre
+    lies outside the picture) gives the lattice fit's position, or the metadata lattice's when
+    the JSON has no fit."""
+
+    def __init__(self, meta, path):
+        self.path = path
+        self.meta = meta
+        rows = self._read(path)
+        hexagonal = meta.grid == "hexagonal"
+        keys = [(k - (l // 2 if hexagonal else 0), l) for k, l, _, _ in rows]
+        if rows:
+            k_values = [key[0] for key in keys]
+            l_values = [key[1] for key in keys]
+            self.k_min, self.l_min = min(k_values), min(l_values)
+            shape = (max(l_values) - self.l_min + 1, max(k_values) - self.k_min + 1)
+        else:
+            self.k_min = self.l_min = 0
+            shape = (1, 1)
+        if shape[0] * shape[1] > 50_000_000:
+            raise DecodeError("%s: its lenses span %d x %d indices, far more than any picture holds"
+                              % (path, shape[1], shape[0]))
+        self.u = np.full(shape, np.nan)
+        self.v = np.full(shape, np.nan)
+        self.status = np.zeros(shape, np.int8)
+        for (ks, l), (_, _, u, v) in zip(keys, rows):
+            i, j = l - self.l_min, ks - self.k_min
+            self.status[i, j] = DARK if u is None else LIT
+            if u is not None:
+                self.u[i, j], self.v[i, j] = u, v
+        self.lenses = len(rows)
+        self.dark_lenses = int((self.status == DARK).sum())
+        self.fit = _lattice_fit(meta)
+
+    @staticmethod
+    def _read(path):
+        """[(k, l, u or None, v or None)] from the file, checked; DecodeError naming the line."""
+        try:
+            with open(path, "rb") as f:
+                data = f.read()
+        except OSError as e:
+            raise DecodeError("cannot read the microimage centres %s: %s" % (path, e.strerror or e))
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError:
+            raise DecodeError("%s: not UTF-8 text, not a microimage centres file" % path)
+        lines = text.splitlines()
+        if not lines:
+            raise DecodeError("%s is empty: it must start with the header k,l,u,v,..." % path)
+        header = [c.strip() for c in lines[0].split(",")]
+        if tuple(header[:4]) != COLUMNS:
+            raise DecodeError("%s, line 1: the header must start with k,l,u,v, found %r" % (path, lines[0][:80]))
+        rows = []
+        seen = set()
+        for number, line in enumerate(lines[1:], start=2):
+            if not line.strip():
+                continue
+            cells = [c.strip() for c in line.split(",")]
+            if len(cells) != len(header):
+                raise DecodeError("%s, line %d: %d values where the header names %d" % (path, number, len(cells), len(header)))
+            try:
+                k, l = int(cells[0]), int(cells[1])
+            except ValueError:
+                raise DecodeError("%s, line %d: the lens index k, l must be whole numbers, found %r, %r"
+                                  % (path, number, cells[0], cells[1]))
+            if (k, l) in seen:
+                raise DecodeError("%s, line %d: lens (%d, %d) is listed twice" % (path, number, k, l))
+            seen.add((k, l))
+            if cells[2] == "" and cells[3] == "":
+                rows.append((k, l, None, None))
+                continue
+            try:
+                u, v = float(cells[2]), float(cells[3])
+            except ValueError:
+                u = v = math.nan
+            if not (math.isfinite(u) and math.isfinite(v)):
+                raise DecodeError("%s, line %d: the centre u, v must be two finite numbers (or both empty for a lens "
+                                  "that gets no light), found %r, %r" % (path, number, cells[2], cells[3]))
+            rows.append((k, l, u, v))
+        return rows
+
+    def _fallback(self, k, l):
+        if self.fit is None:
+            return self.meta.centre(k, l)
+        origin, a, b = self.fit
+        return origin[0] + k * a[0] + l * b[0], origin[1] + k * a[1] + l * b[1]
+
+    def centre(self, k, l):
+        """(u, v, dark) for skew indices k, l (arrays of whole numbers as floats)."""
+        k = np.asarray(k, dtype=float)
+        l = np.asarray(l, dtype=float)
+        i = np.rint(l).astype(np.int64) - self.l_min
+        j = np.rint(k).astype(np.int64) - self.k_min
+        listed = (i >= 0) & (i < self.status.shape[0]) & (j >= 0) & (j < self.status.shape[1])
+        ii, jj = np.where(listed, i, 0), np.where(listed, j, 0)
+        status = np.where(listed, self.status[ii, jj], UNLISTED)
+        fallback_u, fallback_v = self._fallback(k, l)
+        lit = status == LIT
+        u = np.where(lit, self.u[ii, jj], fallback_u)
+        v = np.where(lit, self.v[ii, jj], fallback_v)
+        return u, v, status == DARK
+
+
+def measured_centres(meta):
+    """The MeasuredCentres of a render whose microimages leave the metadata lattice (a traced
+    prescription), None when the lattice is exact. DecodeError, saying why and how to get the
+    file, when the render wrote none or it is missing."""
+    if meta.lattice_is_exact:
+        return None
+    cached = getattr(meta, "_measured_centres", None)
+    if cached is not None:
+        return cached
+    why = ("this render's main lens is a traced prescription, whose microimage centres leave the metadata's "
+           "paraxial lattice (pupil aberration and vignetting move them by up to a pixel and more at the edge of "
+           "the field), so the decoder samples each microimage around its measured centre from "
+           "<image>.microimages.csv")
+    entry = meta.raw.get("microimages")
+    name = entry.get("file") if isinstance(entry, dict) else None
+    if not isinstance(name, str) or not name:
+        raise DecodeError("%s; this render wrote none (its metadata's 'microimages' is null: the camera said "
+                          "microimage_centres off). Render it again with microimage_centres (the default behind a "
+                          "prescription)" % why)
+    path = os.path.join(os.path.dirname(os.path.abspath(meta.path)), name)
+    if not os.path.exists(path):
+        raise DecodeError("%s; the metadata names %s, which does not exist (keep it beside the image and its "
+                          "metadata, or render again with microimage_centres)" % (why, path))
+    centres = MeasuredCentres(meta, path)
+    meta._measured_centres = centres
+    return centres
+
+
+def microimage_centre(meta, k, l):
+    """(u, v, dark) of the microimages of skew lens indices (k, l): the metadata lattice where it
+    is exact (dark all False), else the measured centres (measured_centres)."""
+    centres = measured_centres(meta)
+    if centres is None:
+        u, v = meta.centre(k, l)
+        return u, v, np.zeros(np.shape(u), bool)
+    return centres.centre(k, l)
