@@ -25,7 +25,9 @@ from .metadata import load_metadata, metadata_path_for
 from .outputs import write_outputs
 from .progress import Progress
 from .total_focus import check_total_focus_camera, total_focus, virtual_depth_path
-from .sensor import demosaic_bilinear, devignette, dn_to_linear, picture_reading, white_reading
+from .sensor import (check_white_is_not_the_raw, demosaic_bilinear, devignette, dn_to_linear, picture_reading,
+                     white_reading)
+from .contact_sheet import sheet_title
 
 
 SLOPES_FORM = "START:STOP:COUNT (two numbers and a whole number >= 2, e.g. -0.8:0.8:17)"
@@ -83,13 +85,14 @@ def _stored_pixels(path):
 
 
 def read_picture(path, meta, encoding, progress, white=False, raw=False, white_values=None, white_scale=None,
-                 reading=None):
+                 reading=None, announced=False):
     """The picture (H, W, 3) linear. What the file is comes from the options, its name in the
     metadata and its content (sensor.picture_reading, sensor.white_reading): the sensor's raw or
     a white image in DN through dn_to_linear and, for a mosaic, demosaic_bilinear; a linear white
     image as stored times its scale; the render's picture as its encoding says (`encoding`
     other than 'auto' is --encoding, which only a picture takes). `reading`: the decision already
-    made (read_picture's checks without its reading)."""
+    made (read_picture's checks without its reading); announced: its progress line was printed
+    already (only the demosaicing is then reported)."""
     if reading is None:
         reading = (white_reading(meta, path, png_layout(path), white_values, white_scale) if white
                    else picture_reading(meta, path, png_layout(path), raw, encoding != "auto"))
@@ -100,13 +103,16 @@ def read_picture(path, meta, encoding, progress, white=False, raw=False, white_v
         read_out = reading.read_out
         pixels = dn_to_linear(_stored_pixels(path), read_out, path)
         if read_out.get("bayer"):
-            progress.stage("%s: %s, %s mosaic: demosaiced (bilinear)" % (name, reading.why, read_out["bayer"]))
+            progress.stage("%s: %s mosaic: demosaiced (bilinear)" % (name, read_out["bayer"]) if announced else
+                           "%s: %s, %s mosaic: demosaiced (bilinear)" % (name, reading.why, read_out["bayer"]))
             return demosaic_bilinear(pixels[..., 0], read_out["bayer"])
-        progress.stage("%s: %s" % (name, reading.why))
+        if not announced:
+            progress.stage("%s: %s" % (name, reading.why))
         return np.ascontiguousarray(np.repeat(pixels[..., :1], 3, axis=2) if pixels.shape[2] == 1 else pixels[..., :3])
     if reading.kind == "linear":
         # A linear white image: value x 65535 / scale, grey or RGB.
-        progress.stage("%s: %s" % (name, reading.why))
+        if not announced:
+            progress.stage("%s: %s" % (name, reading.why))
         pixels = _stored_pixels(path) * np.float32(reading.scale)
         return np.ascontiguousarray(np.repeat(pixels[..., :1], 3, axis=2) if pixels.shape[2] < 3 else pixels[..., :3])
     return read_raw_image(path, encoding)[0]
@@ -141,6 +147,10 @@ def _argument_parser():
     parser.add_argument("--raw", dest="raw_dn", action="store_true",
                         help="RAW is the sensor's raw in DN (the render's <stem>.raw.png under any name): refused "
                              "unless its content can be (16-bit PNG, the read-out's channels and sBIT)")
+    parser.add_argument("--microimages", default=None, metavar="CSV",
+                        help="behind a traced prescription: the render's measured microimage centres (default: the "
+                             "file the metadata's microimages.file names, beside the metadata, else "
+                             "<metadata stem>.microimages.csv there)")
     parser.add_argument("--white-values", choices=("dn", "linear"), default=None,
                         help="with --white: the white image is in DN (through the metadata's read-out) or linear; "
                              "needed only when neither its name (the metadata's white_images) nor its content says")
@@ -215,8 +225,19 @@ def main(argv=None):
         # Header, metadata and the light field's size first: nothing large is read or allocated
         # for an input that is refused.
         info = inspect_raw(args.raw, encoding)
-        progress.stage("raw image %s: %s" % (os.path.basename(args.raw), info.describe()))
         meta = load_metadata(meta_path, (info.width, info.height))
+        if args.microimages is not None:
+            if meta.lattice_is_exact:
+                return fail("--microimages: this render's main lens is %s, behind which the decoder samples every "
+                            "microimage around the metadata's microimage_lattice; measured centres are used behind "
+                            "a traced prescription only" % meta.main_lens_type)
+            if not os.path.isfile(args.microimages):
+                return fail("--microimages %s: no such file" % args.microimages)
+            meta.microimages_file = args.microimages
+        if args.white:
+            if not os.path.exists(args.white):
+                return fail("%s: the white image does not exist" % args.white)
+            check_white_is_not_the_raw(meta, args.raw, args.white)
         if args.hci:
             check_hci_camera(meta)
             depth_map_path(meta)
@@ -229,10 +250,15 @@ def main(argv=None):
         # What the raw and the white image are (options, names, content), before reading either.
         reading = picture_reading(meta, args.raw, png_layout(args.raw), args.raw_dn, encoding != "auto")
         if args.white:
-            if not os.path.exists(args.white):
-                return fail("%s: the white image does not exist" % args.white)
             white_read = white_reading(meta, args.white, png_layout(args.white), args.white_values, args.white_scale)
-        raw = read_picture(args.raw, meta, encoding, progress, reading=reading)
+        # What the file is read as: a picture in its colour encoding, or values (DN, a linear white
+        # image's) to which the file's encoding does not apply.
+        if reading.kind == "picture":
+            progress.stage("raw image %s: %s" % (os.path.basename(args.raw), info.describe()))
+        else:
+            progress.stage("raw image %s: %s, read as %s; the file's colour encoding is not used"
+                           % (os.path.basename(args.raw), info.describe(encoding=False), reading.why))
+        raw = read_picture(args.raw, meta, encoding, progress, reading=reading, announced=True)
         if args.white:
             white = read_picture(args.white, meta, encoding, progress, white=True, reading=white_read)
             raw = devignette(raw, white)
@@ -271,9 +297,7 @@ def main(argv=None):
             if reach < 0.25:
                 progress.stage("note: the sweep moves the outermost views by at most %.2f lens; this scene's "
                                "depths hardly refocus (deep depth of field)" % reach)
-        title = "%s: %s %s plenoptic render, %d x %d px" % (
-            os.path.basename(args.raw), meta.grid, meta.raw.get("microlens_array", {}).get("lens", ""),
-            meta.width, meta.height)
+        title = sheet_title(os.path.basename(args.raw), meta)
         sheet = write_outputs(raw, lf, outdir, slopes, gif=not args.no_gif, npy=not args.no_npy,
                               progress=progress, title=title)
         if args.contact_sheet:

@@ -7,6 +7,73 @@ import os
 import numpy as np
 
 from .images import scaled_pil_image, to_8bit
+from .microimages import measured_centres, microimage_centre
+
+
+def _main_lens_phrase(meta):
+    """What is in front of the array: 'behind a traced prescription (lens.dat)', 'behind a thin
+    main lens (f = 50 mm, f/2)', ..."""
+    lens = meta.raw.get("main_lens") if isinstance(meta.raw.get("main_lens"), dict) else {}
+    kind = meta.main_lens_type
+    if kind in ("prescription", "thick_lens"):
+        prescription = lens.get("prescription") if isinstance(lens.get("prescription"), dict) else {}
+        name = prescription.get("lens_file")
+        surfaces = prescription.get("surfaces")
+        source = (name if isinstance(name, str) and name else
+                  "an inline prescription of %d surfaces" % len(surfaces) if isinstance(surfaces, list) else
+                  "an inline prescription")
+        if kind == "prescription":
+            return "behind a traced prescription (%s)" % source
+        return "behind a thick lens, the paraxial equivalent of %s" % source
+    if kind == "thin_lens":
+        f_number = lens.get("f_number")
+        return "behind a thin main lens (f = %g mm%s)" % (
+            meta.focal_length_mm, ", f/%g" % f_number if isinstance(f_number, (int, float)) else "")
+    if kind == "pinhole":
+        return "behind a pinhole main lens"
+    return "with no main lens"
+
+
+def sheet_title(name, meta):
+    """The contact sheet's title: the file, the array and its microlenses, the main lens, the size,
+    e.g. 'r.raw.png: hexagonal array of thin-lens microlenses behind a traced prescription
+    (lens.dat), 640 x 480 px'."""
+    array = meta.raw.get("microlens_array") if isinstance(meta.raw.get("microlens_array"), dict) else {}
+    lens = array.get("lens")
+    focal_lengths = array.get("focal_lengths_mm")
+    if lens == "pinhole":
+        micro = "pinhole microlenses"
+    elif isinstance(focal_lengths, list) and len(focal_lengths) > 1:
+        micro = "thin-lens microlenses of %d focal lengths" % len(focal_lengths)
+    else:
+        micro = "thin-lens microlenses"
+    return "%s: %s array of %s %s, %d x %d px" % (name, meta.grid, micro, _main_lens_phrase(meta),
+                                                  meta.width, meta.height)
+
+
+def crop_marks(meta, x0, y0, crop_w, crop_h):
+    """The microimage centres to mark in the raw crop [x0, x0 + crop_w) x [y0, y0 + crop_h) and
+    what they are: (u, v, caption words). The centres the decoder sampled around: the metadata's
+    lattice where it is exact, the measured centres of the render's microimages file behind a
+    traced prescription (lenses that get no light are not marked)."""
+    k, l, u, v = meta.all_centres()
+    measured = measured_centres(meta)
+    if measured is None:
+        what = "microimage centres (metadata lattice)"
+    else:
+        u, v, dark = microimage_centre(meta, k, l)
+        u, v = u[~dark], v[~dark]
+        what = "measured centres (%s)" % os.path.basename(measured.path)
+    keep = (u >= x0 - 0.5) & (u <= x0 + crop_w - 0.5) & (v >= y0 - 0.5) & (v <= y0 + crop_h - 0.5)
+    return u[keep], v[keep], what
+
+
+def _fitting(draw, texts, font, width):
+    """The first of `texts` that is at most `width` pixels wide in `font` (else the last)."""
+    for text in texts:
+        if draw.textlength(text, font=font) <= width:
+            return text
+    return texts[-1]
 
 
 def _font(size):
@@ -32,8 +99,8 @@ def _distance_label(distance):
 
 
 def contact_sheet(raw, lf, slopes, refocused, near, far, epi_row, title=""):
-    """One picture that shows the plenoptic effect: raw crop with the metadata lattice, centre
-    view, views from opposite sides of the aperture, an EPI, near and far refocus.
+    """One picture that shows the plenoptic effect: raw crop with the microimage centres the
+    decoder sampled around (crop_marks), centre view, views from opposite sides of the aperture, an EPI, near and far refocus.
 
     raw: the linear raw image; lf: its LightField; refocused[i]: lf refocused at slopes[i];
     near, far: indices into slopes; epi_row: lens row of the EPI. Returns a PIL image."""
@@ -53,13 +120,14 @@ def contact_sheet(raw, lf, slopes, refocused, near, far, epi_row, title=""):
     im = scaled_pil_image(crop, panel_w, panel_h)
     scale = im.size[0] / crop_w
     draw = ImageDraw.Draw(im)
-    _, _, centres_u, centres_v = meta.all_centres()
+    centres_u, centres_v, marked = crop_marks(meta, x0, y0, crop_w, crop_h)
     for u, v in zip(centres_u, centres_v):
-        if x0 - 0.5 <= u <= x0 + crop_w - 0.5 and y0 - 0.5 <= v <= y0 + crop_h - 0.5:
-            px, py = (u - x0 + 0.5) * scale, (v - y0 + 0.5) * scale
-            draw.line([(px - 3, py), (px + 3, py)], fill=(255, 60, 60))
-            draw.line([(px, py - 3), (px, py + 3)], fill=(255, 60, 60))
-    panels.append((im, "Raw lenslet image (crop)", "%d x %d px; + = microimage centres (metadata)" % (crop_w, crop_h)))
+        px, py = (u - x0 + 0.5) * scale, (v - y0 + 0.5) * scale
+        draw.line([(px - 3, py), (px + 3, py)], fill=(255, 60, 60))
+        draw.line([(px, py - 3), (px, py + 3)], fill=(255, 60, 60))
+    caption = _fitting(draw, ["%d x %d px; + = %s" % (crop_w, crop_h, marked), "+ = %s" % marked,
+                              "+ = %s" % marked.split(" (")[0]], small_font, panel_w + pad - 4)
+    panels.append((im, "Raw lenslet image (crop)", caption))
 
     aspect = lf.display_aspect()
     cv, cu = lf.centre_index()
@@ -91,6 +159,11 @@ def contact_sheet(raw, lf, slopes, refocused, near, far, epi_row, title=""):
     sheet = Image.new("RGB", (sheet_w, sheet_h), (24, 24, 28))
     draw = ImageDraw.Draw(sheet)
     if title:
+        # A long title (a lens file's name) in a smaller font rather than past the sheet's edge.
+        for size in (18, 17, 16, 15, 14, 13, 12):
+            title_font = _font(size)
+            if draw.textlength(title, font=title_font) <= sheet_w - 2 * pad:
+                break
         draw.text((pad, 8), title, fill=(240, 240, 240), font=title_font)
     slots = [(0, 0, 1), (1, 0, 1), (2, 0, 1), (3, 0, 1), (0, 1, 2), (2, 1, 1), (3, 1, 1)]  # (column, row, span)
     for (im, label, caption), (column, row, span) in zip(panels, slots):

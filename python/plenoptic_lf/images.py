@@ -101,12 +101,15 @@ class RawInfo:
         return "srgb", ("assumed: the file records no encoding OpenImageIO names (oiio:ColorSpace %r); sRGB is "
                         "POV-Ray's default File_Gamma" % self.colour_space)
 
-    def describe(self):
-        """'96 x 72 PNG, 16-bit integer, encoding linear (the file's own, ...)'."""
-        encoding = self.encoding if isinstance(self.encoding, str) else "gamma %g" % self.encoding
-        return "%d x %d %s, %s, encoding %s (%s)" % (
-            self.width, self.height, _FORMAT_NAMES.get(self.file_format, self.file_format), self.sample,
-            encoding, self.encoding_source)
+    def describe(self, encoding=True):
+        """'96 x 72 PNG, 16-bit integer, encoding linear (the file's own, ...)'; without the
+        encoding (for a file read as DN, whose colour encoding does not apply) when encoding is False."""
+        layout = "%d x %d %s, %s" % (self.width, self.height, _FORMAT_NAMES.get(self.file_format, self.file_format),
+                                     self.sample)
+        if not encoding:
+            return layout
+        told = self.encoding if isinstance(self.encoding, str) else "gamma %g" % self.encoding
+        return "%s, encoding %s (%s)" % (layout, told, self.encoding_source)
 
 
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

@@ -177,12 +177,15 @@ class Metadata:
         if self.main_lens_type in REAL_LENS_TYPES:
             self._read_real_lens(raw)
         self.pitch_mm = _checked_number(raw, "microlens_array.pitch_mm", positive=True)
-        self.pitch_mm = _checked_number(raw, "microlens_array.pitch_mm", positive=True)
         array_to_sensor_mm = _checked_number(raw, "microlens_array.distance_mm", positive=True)
         array_shift_z_mm = _checked_numbers(raw, "microlens_array.translate_mm", 3)[2]
         # Distances at the array centre, including the array's z translation.
         self.main_distance_mm = main_lens_to_array_mm - array_shift_z_mm
         self.array_distance_mm = array_to_sensor_mm + array_shift_z_mm
+        # The measured microimage centres (<image>.microimages.csv) to use behind a traced
+        # prescription: None looks them up beside the metadata (microimages.measured_centres);
+        # plenoptic-decode's --microimages sets a path.
+        self.microimages_file = None
 
     def _read_real_lens(self, raw):
         """main_lens.f_number, .prescription and .paraxial of a thick_lens or prescription, checked

@@ -143,10 +143,75 @@ class MeasuredCentres:
         return u, v, status == DARK
 
 
+# Tolerance, in pixels, of the check that a centres file lists the lenses whose lattice centre lies
+# in the picture (the renderer's rule): lattice centres closer than this to the picture's edge
+# are not checked either way.
+_EDGE_TOLERANCE_PX = 0.01
+
+
+def metadata_stem(meta_path):
+    """'<dir>/shot001' for '<dir>/shot001.plenoptic.json' (any other name: without its extension)."""
+    name = os.path.basename(meta_path)
+    stem = name[:-len(".plenoptic.json")] if name.endswith(".plenoptic.json") else os.path.splitext(name)[0]
+    return os.path.join(os.path.dirname(os.path.abspath(meta_path)), stem)
+
+
+def microimages_candidates(meta):
+    """The files measured_centres looks for, in order, with what each is: the metadata's
+    microimages.file beside the metadata, then <metadata stem>.microimages.csv (the name the
+    renderer would give it, for a render whose files were renamed). Empty when the metadata says
+    the render wrote none."""
+    entry = meta.raw.get("microimages")
+    name = entry.get("file") if isinstance(entry, dict) else None
+    if not isinstance(name, str) or not name:
+        return []
+    candidates = [(os.path.join(os.path.dirname(os.path.abspath(meta.path)), name),
+                   "the metadata's microimages.file")]
+    renamed = metadata_stem(meta.path) + ".microimages.csv"
+    if os.path.normpath(renamed) != os.path.normpath(candidates[0][0]):
+        candidates.append((renamed, "<metadata stem>.microimages.csv"))
+    return candidates
+
+
+def check_centres_belong(meta, centres):
+    """DecodeError when the centres file cannot be this render's: its lens count differs from the
+    metadata's microimages.lenses, or it does not list exactly the lenses whose microimage_lattice
+    centre lies in the picture, as the renderer writes it (docs/metadata.md, "Microimage centres")."""
+    path = centres.path
+    entry = meta.raw.get("microimages")
+    counted = entry.get("lenses") if isinstance(entry, dict) else None
+    if isinstance(counted, int) and not isinstance(counted, bool) and centres.lenses != counted:
+        raise DecodeError("%s lists %d lenses, but this render's metadata counts %d (microimages.lenses): the centres "
+                          "belong to another render, or the file was cut" % (path, centres.lenses, counted))
+    W, H, tol = meta.width, meta.height, _EDGE_TOLERANCE_PX
+    listed = centres.status != UNLISTED
+    ll, kk = np.nonzero(listed)
+    k, l = kk + centres.k_min, ll + centres.l_min
+    u, v = meta.centre(k, l)
+    outside = (u < -0.5 - tol) | (u > W - 0.5 + tol) | (v < -0.5 - tol) | (v > H - 0.5 + tol)
+    if outside.any():
+        i = int(np.argmax(outside))
+        raise DecodeError("%s lists lens (k_s %d, l %d), whose microimage_lattice centre (%.2f, %.2f) lies outside this "
+                          "%d x %d picture: the centres belong to another render" % (path, k[i], l[i], u[i], v[i], W, H))
+    k_all, l_all, _, _ = meta.all_centres(margin=-0.5 + tol)
+    i = l_all - centres.l_min
+    j = k_all - centres.k_min
+    inside = (i >= 0) & (i < centres.status.shape[0]) & (j >= 0) & (j < centres.status.shape[1])
+    missing = ~inside.copy()
+    missing[inside] = centres.status[i[inside], j[inside]] == UNLISTED
+    if missing.any():
+        n = int(np.argmax(missing))
+        raise DecodeError("%s does not list lens (k_s %d, l %d), whose microimage_lattice centre lies in this %d x %d "
+                          "picture (%d such lenses missing): the centres belong to another render, or the file was cut"
+                          % (path, k_all[n], l_all[n], W, H, int(missing.sum())))
+
+
 def measured_centres(meta):
     """The MeasuredCentres of a render whose microimages leave the metadata lattice (a traced
-    prescription), None when the lattice is exact. DecodeError, saying why and how to get the
-    file, when the render wrote none or it is missing."""
+    prescription), None when the lattice is exact. The file is meta.microimages_file
+    (plenoptic-decode --microimages) when set, else the first of microimages_candidates that
+    exists; it must belong to this render (check_centres_belong). DecodeError, saying why, what
+    was tried and how to give the file, when there is none."""
     if meta.lattice_is_exact:
         return None
     cached = getattr(meta, "_measured_centres", None)
@@ -154,19 +219,27 @@ def measured_centres(meta):
         return cached
     why = ("this render's main lens is a traced prescription, whose microimage centres leave the metadata's "
            "paraxial lattice (pupil aberration and vignetting move them by up to a pixel and more at the edge of "
-           "the field), so the decoder samples each microimage around its measured centre from "
+           "the field), so the decoder samples each microimage around its measured centre from the render's "
            "<image>.microimages.csv")
-    entry = meta.raw.get("microimages")
-    name = entry.get("file") if isinstance(entry, dict) else None
-    if not isinstance(name, str) or not name:
-        raise DecodeError("%s; this render wrote none (its metadata's 'microimages' is null: the camera said "
-                          "microimage_centres off). Render it again with microimage_centres (the default behind a "
-                          "prescription)" % why)
-    path = os.path.join(os.path.dirname(os.path.abspath(meta.path)), name)
-    if not os.path.exists(path):
-        raise DecodeError("%s; the metadata names %s, which does not exist (keep it beside the image and its "
-                          "metadata, or render again with microimage_centres)" % (why, path))
+    path = getattr(meta, "microimages_file", None)
+    if path is not None:
+        if not os.path.isfile(path):
+            raise DecodeError("--microimages %s: no such file" % path)
+    else:
+        candidates = microimages_candidates(meta)
+        if not candidates:
+            raise DecodeError("%s; this render wrote none (its metadata's 'microimages' is null: the camera said "
+                              "microimage_centres off). Render it again with microimage_centres (the default behind "
+                              "a prescription), or give measured centres with --microimages CSV" % why)
+        found = [p for p, _ in candidates if os.path.isfile(p)]
+        if not found:
+            raise DecodeError("%s; tried %s, and %s: give the file with --microimages CSV (or render again "
+                              "with microimage_centres)"
+                              % (why, " and ".join("%s (%s)" % c for c in candidates),
+                                 "neither exists" if len(candidates) > 1 else "it does not exist"))
+        path = found[0]
     centres = MeasuredCentres(meta, path)
+    check_centres_belong(meta, centres)
     meta._measured_centres = centres
     return centres
 

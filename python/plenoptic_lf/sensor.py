@@ -235,6 +235,35 @@ def white_reading(meta, path, layout, values=None, scale=None):
     return Reading("linear", "a linear white image, scale %g, %s" % (scale, source), scale=scale)
 
 
+def _same_file(a, b):
+    """Whether two paths name one file: the same real path, or (hard links) the same inode."""
+    import os
+    if os.path.realpath(a) == os.path.realpath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def check_white_is_not_the_raw(meta, raw_path, white_path):
+    """DecodeError when --white names the decoder's own input or the file the metadata names as the
+    sensor's raw (sensor.read_out.raw_file, beside the metadata): a raw has a white image's layout,
+    and dividing a picture by its own raw gives a light field of about 1, not the scene."""
+    import os
+    if _same_file(white_path, raw_path):
+        raise DecodeError("--white %s is the input itself: give the camera's white image (the render's "
+                          "<stem>.white.png), not the image being decoded" % white_path)
+    read_out = _metadata_read_out(meta)
+    name = read_out.get("raw_file") if read_out else None
+    if isinstance(name, str) and name:
+        raw_file = os.path.join(os.path.dirname(os.path.abspath(meta.path)), name)
+        if os.path.exists(raw_file) and _same_file(white_path, raw_file):
+            raise DecodeError("--white %s is the sensor's raw (the file the metadata names in sensor.read_out.raw_file), "
+                              "not a white image: give the camera's white image (the render's <stem>.white.png)"
+                              % white_path)
+
+
 def check_dn_range(path, dn, read_out):
     """DecodeError when a value read as DN exceeds the read-out's largest, 2^B - 1."""
     largest = (1 << read_out_bit_depth(read_out)) - 1

@@ -349,6 +349,119 @@ def test_prescription_refusals_name_the_reason(args):
     assert run.returncode == 2 and "microimage_centres" in run.stderr and "wrote none" in run.stderr, run.stderr
 
 
+def test_renamed_prescription_render_finds_its_microimages(args):
+    """Data sets rename renders: shot001.raw.png, shot001.plenoptic.json, shot001.microimages.csv
+    while the metadata still names the renderer's files. The decoder looks for the metadata's
+    microimages.file, then <metadata stem>.microimages.csv, takes --microimages CSV, and refuses a
+    centres file that is not this render's (its lens count, or lenses off this picture)."""
+    png, stem, _ = prescription_render(args)
+    folder = os.path.join(args.work, "real_lens_renamed")
+    shutil.rmtree(folder, ignore_errors=True)
+    os.makedirs(folder)
+    out = os.path.join(folder, "out")
+
+    def decoded(raw, *options):
+        run = run_decode(args, raw, "-q", "--no-gif", "-o", out, *options)
+        lf = np.load(os.path.join(out, "lightfield.npy")) if run.returncode == 0 else None
+        shutil.rmtree(out, ignore_errors=True)
+        return run, lf
+
+    run, original = decoded(stem + ".raw.png")
+    assert run.returncode == 0, run.stderr
+    shot = os.path.join(folder, "shot001")
+    for suffix in (".raw.png", ".plenoptic.json", ".microimages.csv"):
+        shutil.copy(stem + suffix, shot + suffix)
+    run, lf = decoded(shot + ".raw.png")
+    assert run.returncode == 0, "the renamed render decodes with shot001.microimages.csv: %s" % run.stderr
+    assert np.array_equal(lf, original)
+    # Elsewhere: the refusal lists what was tried and names the option, which then finds it.
+    centres = os.path.join(folder, "centres.csv")
+    os.rename(shot + ".microimages.csv", centres)
+    run, _ = decoded(shot + ".raw.png")
+    lines = run.stderr.strip().splitlines()
+    assert run.returncode == 2 and len(lines) == 1, run.stderr
+    for words in ("real_lens_prescription.microimages.csv", "shot001.microimages.csv", "--microimages CSV"):
+        assert words in lines[0], (words, lines[0])
+    assert not os.path.exists(out)
+    run, lf = decoded(shot + ".raw.png", "--microimages", centres)
+    assert run.returncode == 0, run.stderr
+    assert np.array_equal(lf, original)
+    # Centres that cannot be this render's: one lens fewer; every lens one column over (the
+    # same count, lenses off the picture); a missing file.
+    rows = open(centres).read().splitlines()
+    cut = os.path.join(folder, "cut.csv")
+    with open(cut, "w") as f:
+        f.write("\n".join(rows[:-1]) + "\n")
+    moved = os.path.join(folder, "moved.csv")
+    with open(moved, "w") as f:
+        f.write("\n".join([rows[0]] + [",".join([str(int(r.split(",")[0]) + 1)] + r.split(",")[1:]) for r in rows[1:]])
+                + "\n")
+    for csv, words in ((cut, ("lists %d lenses" % (len(rows) - 2), "counts %d" % (len(rows) - 1), "microimages.lenses")),
+                       (moved, ("lies outside this %d x %d picture" % (W, H), "another render")),
+                       (os.path.join(folder, "nowhere.csv"), ("--microimages", "no such file"))):
+        run, _ = decoded(shot + ".raw.png", "--microimages", csv)
+        lines = run.stderr.strip().splitlines()
+        assert run.returncode == 2 and len(lines) == 1 and all(w in lines[0] for w in words), (csv, run.stderr)
+        assert not os.path.exists(out)
+    # A lattice that is exact takes no measured centres: the option is refused with the reason.
+    thick = json.load(open(shot + ".plenoptic.json"))
+    thick["main_lens"]["type"] = "thick_lens"
+    with open(os.path.join(folder, "thick.plenoptic.json"), "w") as f:
+        json.dump(thick, f)
+    run = run_decode(args, shot + ".raw.png", os.path.join(folder, "thick.plenoptic.json"), "-q", "-o", out,
+                     "--microimages", centres)
+    assert run.returncode == 2 and "thick_lens" in run.stderr and "microimage_lattice" in run.stderr, run.stderr
+
+
+def test_contact_sheet_says_which_lens_and_marks_the_centres_it_used(args):
+    """The title names the microlenses and the main lens apart (not 'hexagonal thin_lens plenoptic
+    render' for a traced prescription); the raw crop marks the centres the decoder sampled around:
+    the CSV's measured centres behind a prescription, the lattice where it is exact."""
+    import plenoptic_lf as plf
+    from plenoptic_lf.contact_sheet import crop_marks, sheet_title
+    png, stem, optics = prescription_render(args)
+    meta = plf.load_metadata(stem + ".plenoptic.json", (W, H))
+    title = sheet_title("r.raw.png", meta)
+    print(title)
+    assert title == ("r.raw.png: rectangular array of thin-lens microlenses behind a traced prescription (%s), %d x %d px"
+                     % (LENS_NAME, W, H)), title
+    variants = {"thick_lens": "behind a thick lens, the paraxial equivalent of %s" % LENS_NAME,
+                "thin_lens": "behind a thin main lens (f = %g mm, f/%g)" % (meta.focal_length_mm, F_NUMBER),
+                "pinhole": "behind a pinhole main lens"}
+    for lens_type, words in variants.items():
+        raw = json.load(open(stem + ".plenoptic.json"))
+        raw["main_lens"]["type"] = lens_type
+        title = sheet_title("r.raw.png", plf.metadata.Metadata(raw, stem + ".plenoptic.json"))
+        assert words in title and "thin-lens microlenses" in title, (lens_type, title)
+    # The marks: the CSV's centres of the lit lenses in the crop (within 1e-9 px), which here lie
+    # up to about a pixel off the lattice at the edge of the field (the crop: all but a 5 px border).
+    csv = np.genfromtxt(stem + ".microimages.csv", delimiter=",", names=True)
+    x0, y0, cw, ch = 5, 5, W - 10, H - 10
+    u, v, what = crop_marks(meta, x0, y0, cw, ch)
+    assert "measured" in what and os.path.basename(stem) + ".microimages.csv" in what, what
+    lit = np.isfinite(csv["u"])
+    inside = lit & (csv["u"] >= x0 - 0.5) & (csv["u"] <= x0 + cw - 0.5) & (csv["v"] >= y0 - 0.5) & (csv["v"] <= y0 + ch - 0.5)
+    expected = np.column_stack([csv["u"][inside], csv["v"][inside]])
+    got = np.column_stack([u, v])
+    assert len(got) == len(expected) >= 300, (len(got), len(expected))
+    worst = max(np.hypot(*(expected - p).T).min() for p in got)
+    lattice = json.load(open(stem + ".plenoptic.json"))["microimage_lattice"]
+    o, a, b = (np.array(lattice["origin_px"]), np.array(lattice["basis_px"][0]), np.array(lattice["basis_px"][1]))
+    off = np.hypot(*(expected - (o + np.outer(csv["k"][inside], a) + np.outer(csv["l"][inside], b))).T).max()
+    print("contact sheet: %d centres marked in the crop, within %.2g px of the CSV's (which lie up to %.2f px off the "
+          "lattice)" % (len(got), worst, off))
+    assert worst < 1e-9 and off > 0.1, (worst, off)
+    # Where the lattice is exact (the same metadata as a thick lens), the lattice is marked.
+    raw = json.load(open(stem + ".plenoptic.json"))
+    raw["main_lens"]["type"] = "thick_lens"
+    thick = plf.metadata.Metadata(raw, stem + ".plenoptic.json")
+    u, v, what = crop_marks(thick, x0, y0, cw, ch)
+    assert "lattice" in what and "measured" not in what, what
+    k, l, lu, lv = thick.all_centres()
+    keep = (lu >= x0 - 0.5) & (lu <= x0 + cw - 0.5) & (lv >= y0 - 0.5) & (lv <= y0 + ch - 0.5)
+    assert np.allclose(np.sort(u), np.sort(lu[keep])) and np.allclose(np.sort(v), np.sort(lv[keep]))
+
+
 def test_metadata_reader_accepts_real_lenses_and_checks_their_fields(args):
     import plenoptic_lf as plf
     from plenoptic_lf.errors import MetadataError

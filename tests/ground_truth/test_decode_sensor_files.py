@@ -262,3 +262,56 @@ def test_options_that_contradict_are_refused(args):
         assert status == 2 and all(w in err for w in words), (options, err)
         assert [line for line in err.splitlines() if "error" in line] == [err.strip().splitlines()[-1]], err
         assert not os.path.exists(out)
+
+
+def test_the_raw_is_refused_as_a_white_image(args):
+    """A raw has a white image in DN's layout, so by content alone it would pass as one; the picture
+    divided by its own raw decodes to about 1 everywhere. --white naming the input or the metadata's
+    raw (sensor.read_out.raw_file; real paths compared: a symbolic link too) is refused."""
+    stem = rendered(args, "dn12")
+    meta = stem + ".plenoptic.json"
+    link = os.path.join(args.work, "white_link.png")
+    if os.path.lexists(link):
+        os.remove(link)
+    os.symlink(stem + ".raw.png", link)
+    cases = [
+        (stem + ".png", stem + ".raw.png", ["is the sensor's raw", "sensor.read_out.raw_file"]),
+        (stem + ".png", link, ["is the sensor's raw", "sensor.read_out.raw_file"]),
+        (stem + ".raw.png", stem + ".raw.png", ["is the input itself"]),
+        (copy(stem + ".raw.png", args.work, "frame_0003.png"), os.path.join(args.work, "frame_0003.png"),
+         ["is the input itself"]),
+    ]
+    out = os.path.join(args.work, "self_white")
+    for raw, white, words in cases:
+        status, err, lf = decode(args, raw, meta, out, "--white", white)
+        if lf is not None:
+            print("%s --white %s decoded: centre view mean %.4f" % (raw, white, centre_mean(lf)))
+        assert status == 2 and all(w in err for w in words), (raw, white, status, err)
+        assert len(err.strip().splitlines()) == 1, err
+        assert not os.path.exists(out)
+    # The camera's own white image still devignettes.
+    status, err, _ = decode(args, stem + ".raw.png", meta, out, "--white", stem + ".white.png")
+    assert status == 0, err
+
+
+def test_the_first_line_says_what_the_input_is_read_as(args):
+    """The raw in DN is not read in a colour encoding: the decoder's line about the input says what it is
+    read as and claims no encoding; a picture's line names its encoding."""
+    stem = rendered(args, "dn12")
+    meta = stem + ".plenoptic.json"
+    status, err, _ = decode(args, stem + ".raw.png", meta, os.path.join(args.work, "first_raw"))
+    assert status == 0, err
+    first = err.splitlines()[0]
+    print(first)
+    assert "read as the sensor's raw in DN" in first and "colour encoding is not used" in first, first
+    assert "encoding srgb" not in err and "encoding linear" not in err and "the file's own" not in err, err
+    renamed = copy(stem + ".raw.png", args.work, "frame_0004.png")
+    status, err, _ = decode(args, renamed, meta, os.path.join(args.work, "first_renamed"))
+    assert status == 0, err
+    assert "read as the sensor's raw in DN, recognised by its content" in err.splitlines()[0], err
+    assert "the file's own" not in err, err
+    status, err, _ = decode(args, stem + ".png", meta, os.path.join(args.work, "first_picture"))
+    assert status == 0, err
+    first = err.splitlines()[0]
+    print(first)
+    assert "16-bit integer, encoding " in first and "read as" not in first, first
