@@ -154,10 +154,10 @@ def real_lens_report(L, results):
     if f:
         L.append("**Lytro-class raw through the real lens** (`--only fullsize_real_lens`): the full-size section's"
                  " camera (%dx%d pixels of 1.4 um, hexagonal 20 um f/2 microlenses, benchmark scene) at %d samples,"
-                 " the main lens at f/2; one run each, interleaved. *Whole process*: povray on the clock, start-up,"
+                 " the main lens at f/%g; one run each, interleaved. *Whole process*: povray on the clock, start-up,"
                  " parsing, trace and what the camera writes after the trace (metadata; behind the traced lens also"
                  " `<image>.microimages.csv`, the microimage centres of every lens in the picture).\n"
-                 % (f["size"][0], f["size"][1], f["samples"]))
+                 % (f["size"][0], f["size"][1], f["samples"], f["rows"][0]["f_number"] if f["rows"] else 0))
         L.append("| main lens | EFL, mm | trace time, s | ratio to thin | CPU time, s | whole process, s | peak RSS, MiB |"
                  "\n|---|---|---|---|---|---|---|")
         for r in f["rows"]:
