@@ -448,9 +448,10 @@ PrescriptionError check_prescription(const Prescription& lens)
     }
     if (S.c > 0) {
         std::ostringstream msg;
-        msg << "the lens diverges: its effective focal length is " << mm(-1 / S.c)
-            << " (paraxial, from its surfaces); a plenoptic camera's main lens must form a real image of the scene on "
-               "or near its microlens array, which needs a positive focal length";
+        msg << "the lens has a negative focal length: its effective focal length is " << mm(-1 / S.c)
+            << " (paraxial, from its surfaces), a diverging lens, or a system that forms an intermediate image "
+               "(a relay); the camera's f-number, pupils, focus and metadata need a main lens with a positive "
+               "focal length, so such a lens is not supported";
         return PrescriptionError{msg.str(), 0};
     }
     return PrescriptionError{"", 0};

@@ -74,7 +74,8 @@ ParsedPrescription parse_lens_file(const std::string& text);
 // sphere (aperture > 2 |radius|; a surface of radius 0, possible only inline, is flat), a negative thickness;
 // a length beyond kPrescriptionMaxLengthMm (a radius there must have been made flat by the parser);
 // two consecutive rows that cross inside the smaller of their clear apertures; a lens that
-// diverges (negative effective focal length: no real image for a plenoptic camera's array).
+// has a negative effective focal length (a diverging lens, or a relay with an intermediate image:
+// not supported as a main lens).
 PrescriptionError check_prescription(const Prescription& lens);
 
 // The iris's turn reduced by its symmetry: degrees modulo 360 / blades (360 without an iris),

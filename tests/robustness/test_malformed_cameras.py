@@ -357,7 +357,7 @@ REAL_LENS_CASES = [
     # (n - 1) t / (n R1 R2)] gives f = -29.67 mm.
     ("diverging lens", camera(main=main_with("prescription {", STOP, "  surface { radius -30 thickness 2 ior 1.5 aperture 20 }",
                                              "  surface { radius 30 thickness 0 ior 1 aperture 20 }", "}  " + MARK, "distance 50")),
-     ["prescription", "diverges", "effective focal length is -29.67", "positive focal length"],
+     ["prescription", "negative focal length", "effective focal length is -29.67", "relay", "positive focal length"],
      "a plenoptic main lens must form a real image"),
     # R = +-30 over 20 mm: each sag at the rim is 30 - sqrt(800) = 1.72 mm, so a 0.5 mm thick
     # element crosses itself where 30 - sqrt(900 - h^2) = 0.25: h = 3.865 mm.

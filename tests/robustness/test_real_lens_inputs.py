@@ -171,13 +171,14 @@ def test_long_lens_setup_reports_progress_and_stops_on_sigint(args):
     finally:
         if proc.poll() is None:
             proc.kill()
-    took = time.time() - sent
+    took = time.time() - sent  # printed only
     reader.join(timeout=5)
     progress = [l for l in lines if "setting up a lens" in l]
     print("progress lines before SIGINT: %s; stopped %.2f s after it, exit %s" % (progress, took, proc.returncode))
     assert progress[0].startswith("plenoptic camera: setting up a lens of 2001 surfaces: pupil bounds 0 %"), progress
-    # Promptly: a part of the setup (one field radius) takes a few tenths of a second here; the
-    # whole setup tens of seconds.
-    assert took < 10, "SIGINT during the setup took %.1f s to stop the program" % took
+    # Promptly, without timing it: the program stops inside the setup, so no step it had left
+    # reports 100 % (a program that finished the setup first and only then looked at the signal
+    # would print the lit-area table's 100 % line: the setup reports every tenth of each step).
+    assert not any(l.endswith("lit-area table 100 %") for l in progress), progress
     assert proc.returncode != 0
     assert not os.path.exists(png), "an image was written after SIGINT"
