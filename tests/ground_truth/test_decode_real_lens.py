@@ -520,21 +520,10 @@ def thick_render(args):
     return _THICK["png"], _THICK["stem"], _THICK["optics"]
 
 
-def shift_rows(image, shift):
-    S = image.shape[1]
-    x = np.arange(S) - shift
-    x0 = np.floor(x).astype(int)
-    f = x - x0
-    ok = (x0 >= 0) & (x0 + 1 <= S - 1)
-    out = np.full(image.shape, np.nan)
-    out[:, ok] = image[:, x0[ok]] * (1 - f[ok]) + image[:, x0[ok] + 1] * f[ok]
-    return out
-
-
 def match_shift(left, right, lo=-6.0, hi=6.0, step=0.01):
     best, best_cost = None, np.inf
     for ds in np.arange(lo, hi + step / 2, step):
-        moved = shift_rows(left, ds)
+        moved = pt.shift_rows(left, ds)
         diff = (right - moved)[:, ~np.isnan(moved[0])]
         if diff.shape[1] < 0.4 * right.shape[1]:
             continue

@@ -56,24 +56,12 @@ def predicted_slope(z_mm):
     return (D / b - 1) * D * PIXEL / (MICRO_F * PITCH)
 
 
-def shift_rows(image, shift):
-    """image (T, S) sampled at s - shift, linear interpolation; NaN outside."""
-    S = image.shape[1]
-    x = np.arange(S) - shift
-    x0 = np.floor(x).astype(int)
-    f = x - x0
-    ok = (x0 >= 0) & (x0 + 1 <= S - 1)
-    out = np.full(image.shape, np.nan)
-    out[:, ok] = image[:, x0[ok]] * (1 - f[ok]) + image[:, x0[ok] + 1] * f[ok]
-    return out
-
-
 def match_shift(left, right, lo=-7.0, hi=7.0, step=0.01):
     """The shift ds minimising the mean squared difference right(s) - left(s - ds)."""
     best, best_cost = None, np.inf
     costs = []
     for ds in np.arange(lo, hi + step / 2, step):
-        moved = shift_rows(left, ds)
+        moved = pt.shift_rows(left, ds)
         diff = (right - moved)[:, ~np.isnan(moved[0])]
         if diff.shape[1] < 0.4 * right.shape[1]:
             costs.append(np.inf)

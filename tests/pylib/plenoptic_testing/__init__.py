@@ -618,6 +618,18 @@ def blobs(image, threshold):
             for c in component_centroids(image, labels, count)]
 
 
+def shift_rows(image, shift):
+    """image (T, S) sampled at s - shift along its rows, linear interpolation; NaN outside."""
+    S = image.shape[1]
+    x = np.arange(S) - shift
+    x0 = np.floor(x).astype(int)
+    f = x - x0
+    ok = (x0 >= 0) & (x0 + 1 <= S - 1)
+    out = np.full(image.shape, np.nan)
+    out[:, ok] = image[:, x0[ok]] * (1 - f[ok]) + image[:, x0[ok] + 1] * f[ok]
+    return out
+
+
 def box_blur(img, k):
     """Mean over k x k neighbourhoods, 'valid' region only (shape reduced by k - 1), any number
     of channels."""
