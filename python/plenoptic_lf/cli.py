@@ -161,8 +161,8 @@ def _argument_parser():
                         help="write the HCI 4D light-field benchmark's layout to DIR instead of the usual outputs: "
                              "N x N views input_CamNNN.png, parameters.cfg, and the centre view's ground-truth "
                              "gt_depth_lowres.pfm and gt_disp_lowres.pfm from the render's depth map (plenoptic 1.0, "
-                             "thin or thick_lens main lens; docs/hci-export.md). --angular N sets N (default: the largest square "
-                             "that fits the microimage)")
+                             "thin or thick_lens main lens; docs/hci-export.md). --angular N sets N (default: the "
+                             "largest square that fits the microimage)")
     parser.add_argument("--hci-all-views", action="store_true",
                         help="with --hci: also write gt_depth_lowres_CamNNN.pfm and gt_disp_lowres_CamNNN.pfm for "
                              "every view")
