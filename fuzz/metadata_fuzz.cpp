@@ -20,10 +20,10 @@
 #include <cstdlib>
 #include <string>
 
-#include "plenoptic_metadata.h"
+#include "plenoptic/truth/metadata.h"
 #include "plenoptic_metadata_reader.h"
-#include "plenoptic_optics.h"
-#include "plenoptic_params.h"
+#include "plenoptic/optics.h"
+#include "plenoptic/camera/params.h"
 
 namespace {
 

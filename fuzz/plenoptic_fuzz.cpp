@@ -33,13 +33,13 @@
 #include <limits>
 #include <string>
 
-#include "plenoptic_diffraction.h"
-#include "plenoptic_metadata.h"
-#include "plenoptic_optics.h"
-#include "plenoptic_params.h"
-#include "plenoptic_pixel.h"
-#include "plenoptic_sampling.h"
-#include "plenoptic_sensor_chain.h"
+#include "plenoptic/sensor/diffraction.h"
+#include "plenoptic/truth/metadata.h"
+#include "plenoptic/optics.h"
+#include "plenoptic/camera/params.h"
+#include "plenoptic/camera/pixel.h"
+#include "plenoptic/core/sampling.h"
+#include "plenoptic/sensor/sensor_chain.h"
 
 namespace {
 
@@ -360,7 +360,7 @@ void check_ray(const Model& m, const OpticsRay& r, const char* what, int i, int 
     FUZZ_ASSERT(is_finite(o) && is_finite(d), "%s of pixel (%d, %d): origin (%g, %g, %g) dir (%g, %g, %g)", what, i, j,
                 o.x, o.y, o.z, d.x, d.y, d.z);
     FUZZ_ASSERT(std::fabs(length(d) - 1) <= 1e-12, "%s of pixel (%d, %d): |dir| = %.17g", what, i, j, length(d));
-    // Into the scene: +z (plenoptic_optics.h). A z component that rounds to zero (sensors 1e300 times
+    // Into the scene: +z (optics.h). A z component that rounds to zero (sensors 1e300 times
     // wider than the lens distance) is rounding, not a backward ray.
     FUZZ_ASSERT(d.z > -1e-9, "%s of pixel (%d, %d): direction (%.17g, %.17g, %.17g) points back into the camera",
                 what, i, j, d.x, d.y, d.z);

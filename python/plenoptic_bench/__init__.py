@@ -23,6 +23,6 @@ the machine is doing, unlike the wall clock (+-15 % between runs on a shared 2-c
 #   callgrind  instruction counts of a render (valgrind's callgrind)
 #   overhead, lenses, trade, dark, threads, fullsize, build   the sections (--only NAME)
 #   real_lens  sections real_lens and fullsize_real_lens: a prescription main lens (issue 13),
-#              with the pass-fraction counts of source/plenoptic/plenoptic_pass_fractions.cpp
+#              with the pass-fraction counts of source/bench/pass_fractions.cpp
 #   report     BENCHMARKS.md from results.json; plots
 #   cli        the command line (main)

@@ -23,7 +23,7 @@ def section_build(results):
     clean = time.perf_counter() - t0
     rebuilds = []
     for r in range(3):
-        os.utime(os.path.join(ROOT, "source", "plenoptic", "plenoptic_rays.cpp"))
+        os.utime(os.path.join(ROOT, "source", "plenoptic", "camera/rays.cpp"))
         t0 = time.perf_counter()
         subprocess.run(["cmake", "--build", tmp, "-j%d" % os.cpu_count()], env=env, check=True, stdout=subprocess.DEVNULL)
         rebuilds.append(time.perf_counter() - t0)

@@ -5,7 +5,7 @@ import statistics
 from .util import LOCATION, log
 
 
-# kVignettingProbesPerSample in source/plenoptic/plenoptic_pixel.h.
+# kVignettingProbesPerSample in source/plenoptic/camera/pixel.h.
 VIGNETTING_PROBES_PER_SAMPLE = 4
 
 

@@ -46,7 +46,7 @@ LYTRO_PIXEL = 0.0014
 
 def pass_fractions_program(povray):
     """plenoptic_pass_fractions in the build tree of the povray binary."""
-    return os.path.join(os.path.dirname(povray), "source", "plenoptic", "plenoptic_pass_fractions")
+    return os.path.join(os.path.dirname(povray), "source", "bench", "plenoptic_pass_fractions")
 
 
 def count_passes(program, lens_file, f_number, sensor, samples, array=None, thick=False):

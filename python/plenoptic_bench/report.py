@@ -80,7 +80,7 @@ def real_lens_report(L, results):
                  " between microimages, so the patch is the figure). *Without bounds*: the same aperture samples"
                  " spread uniformly over the rear element's clear aperture (pbrt's RealisticCamera before its"
                  " exit-pupil bounds) instead of over the pupil-bounds disc. The wasted fraction is 1 minus the"
-                 " pass fraction. From `source/plenoptic/plenoptic_pass_fractions.cpp`.\n" % e["count_samples"])
+                 " pass fraction. From `source/bench/pass_fractions.cpp`.\n" % e["count_samples"])
         L.append("| camera | f-number | samples per pixel | place | field radius, mm | pixel: passes | patch |"
                  " patch: passes | patch: wasted | patch without bounds: passes | patch without bounds: wasted |"
                  "\n|---|---|---|---|---|---|---|---|---|---|---|")
@@ -184,7 +184,7 @@ def write_report(results, path, plots, results_path):
         L.append("`tools/bench --only build` (ccache off, Ninja, 2 jobs):\n")
         L.append("| what | seconds |\n|---|---|")
         L.append("| clean build of POV-Ray and the camera | %.0f |" % b["clean_s"])
-        L.append("| rebuild after touching `source/plenoptic/plenoptic_rays.cpp` (median of 3) | %.1f |" % b["rebuild_after_touch_s"])
+        L.append("| rebuild after touching `source/plenoptic/camera/rays.cpp` (median of 3) | %.1f |" % b["rebuild_after_touch_s"])
         L.append("")
     if "overhead" in results:
         o = results["overhead"]

@@ -23,10 +23,10 @@
 #include "backend/parser/parse.h"
 #include "backend/scene/camera.h"
 #include "backend/support/fileutil.h"
-#include "plenoptic/plenoptic_diffraction.h"
-#include "plenoptic/plenoptic_light_check.h"
-#include "plenoptic/plenoptic_radiometry.h"
-#include "plenoptic/plenoptic_setup_progress.h"
+#include "plenoptic/sensor/diffraction.h"
+#include "plenoptic/camera/light_check.h"
+#include "plenoptic/camera/radiometry.h"
+#include "plenoptic/core/setup_progress.h"
 #include "povray_glue/plenoptic_setup.h"
 
 #include "base/povdebug.h"
@@ -308,7 +308,7 @@ void Parser::Parse_Plenoptic_Main_Lens(plenoptic::CameraParams& params)
 				lens.has_distance = true;
 				break;
 			case Word::Distortion:
-				// distortion { radial <k1, k2, k3> tangential <p1, p2> } (plenoptic_distortion.h); either may be left out.
+				// distortion { radial <k1, k2, k3> tangential <p1, p2> } (lens/distortion.h); either may be left out.
 				if (lens.has_distortion)
 					Error("plenoptic camera: main_lens takes one distortion { }, not several.");
 				lens.has_distortion = true;
@@ -344,7 +344,7 @@ void Parser::Parse_Plenoptic_Main_Lens(plenoptic::CameraParams& params)
 	Parse_End();
 }
 
-// lens_file "name": pbrt's lens-file format (plenoptic_prescription.h), found as POV-Ray finds a
+// lens_file "name": pbrt's lens-file format (lens/prescription.h), found as POV-Ray finds a
 // file the scene reads (beside the scene, then the library paths), and else in the lenses/
 // folder installed with the program. Errors name the file and its row.
 void Parser::Parse_Plenoptic_Lens_File(plenoptic::MainLensParams& lens)

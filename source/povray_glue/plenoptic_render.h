@@ -10,8 +10,8 @@
 #include <utility>
 #include <vector>
 
-#include "plenoptic/plenoptic_depth_map.h"
-#include "plenoptic/plenoptic_metadata.h"
+#include "plenoptic/truth/depth_map.h"
+#include "plenoptic/truth/metadata.h"
 #include "povray_glue/plenoptic_setup.h"
 
 namespace plenoptic {

@@ -7,9 +7,9 @@
 
 #include <string>
 
-#include "plenoptic/plenoptic_model.h"
-#include "plenoptic/plenoptic_params.h"
-#include "plenoptic/plenoptic_white_image.h"
+#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/params.h"
+#include "plenoptic/sensor/white_image.h"
 
 namespace plenoptic {
 

@@ -6,8 +6,8 @@
 #include "povray_glue/plenoptic_cancel.h"
 #include "povray_glue/plenoptic_raw_png.h"
 #include "povray_glue/plenoptic_render.h"
-#include "plenoptic/plenoptic_diffraction.h"
-#include "plenoptic/plenoptic_virtual_depth.h"
+#include "plenoptic/sensor/diffraction.h"
+#include "plenoptic/truth/virtual_depth.h"
 
 #include <cerrno>
 #include <cmath>

@@ -25,7 +25,7 @@ std::string microimages_path_for(const std::string& image_path);// dir/name.micr
 std::string raw_path_for(const std::string& image_path);        // dir/name.raw.png
 
 // Before the front end writes the image of a plenoptic render: applies what the camera does to
-// the picture as a whole, diffraction (plenoptic_diffraction.h), in linear light (`working_gamma`:
+// the picture as a whole, diffraction (sensor/diffraction.h), in linear light (`working_gamma`:
 // the image's working gamma; nullptr: linear), so the image, its raw and everything read from it
 // carry it. Returns false, with a message on stderr, when it was cancelled (Ctrl-C) or the render
 // was continued (+C: the earlier part was diffracted already): then no image may be written,

@@ -10,7 +10,7 @@
 #include "backend/render/tracepixel.h"
 #include "backend/scene/camera.h"
 #include "backend/support/task.h"
-#include "plenoptic/plenoptic_pixel.h"
+#include "plenoptic/camera/pixel.h"
 #include "povray_glue/plenoptic_setup.h"
 #include "povray_glue/plenoptic_render.h"
 

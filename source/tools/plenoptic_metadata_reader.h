@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "plenoptic_metadata.h"
-#include "plenoptic_model.h"
-#include "plenoptic_optics.h"
-#include "plenoptic_params.h"
+#include "plenoptic/truth/metadata.h"
+#include "plenoptic/camera/model.h"
+#include "plenoptic/optics.h"
+#include "plenoptic/camera/params.h"
 
 namespace plenoptic {
 

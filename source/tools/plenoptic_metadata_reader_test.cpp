@@ -11,9 +11,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include "plenoptic_metadata.h"
+#include "plenoptic/truth/metadata.h"
 #include "plenoptic_metadata_reader.h"
-#include "plenoptic_optics.h"
+#include "plenoptic/optics.h"
 
 namespace plenoptic {
 namespace {

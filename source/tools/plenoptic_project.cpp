@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "plenoptic_metadata_reader.h"
-#include "plenoptic_blur.h"
+#include "plenoptic/truth/blur.h"
 
 namespace {
 

@@ -9,7 +9,7 @@ against answers that do not come from the camera's code:
     microimages peak at 1 (an on-axis pixel lit through its whole cell sees L as L);
   - the metadata's C (projected_solid_angle_sr) is the cell's area times the mean of cos^4 over
     the cell seen from d below its centre, over d^2, summed here on a grid.
-The unit tests (plenoptic_radiometry_test.cpp) check the formulas pixel by pixel.
+The unit tests (camera/radiometry_test.cpp) check the formulas pixel by pixel.
 """
 import math
 import os

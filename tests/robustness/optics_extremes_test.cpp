@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// The optics at the extremes, beyond source/plenoptic/plenoptic_stress_test.cpp (which checks finite
+// The optics at the extremes, beyond source/plenoptic/camera/stress_test.cpp (which checks finite
 // unit directions for a list of singular-looking cases): here every unblocked ray must also start on
 // the plane of the last element it leaves (and inside its aperture), and the rays of one sensor
 // point must meet at its conjugate wherever one exists, computed independently with the thin-lens
@@ -15,10 +15,10 @@
 
 #include <gtest/gtest.h>
 
-#include "plenoptic_optics.h"
-#include "plenoptic_params.h"
-#include "plenoptic_sampling.h"
-#include "plenoptic_test_util.h"
+#include "plenoptic/optics.h"
+#include "plenoptic/camera/params.h"
+#include "plenoptic/core/sampling.h"
+#include "plenoptic/core/test_util.h"
 
 namespace plenoptic {
 namespace {

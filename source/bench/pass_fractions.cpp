@@ -1,0 +1,303 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// plenoptic_pass_fractions: how many of the camera rays generated behind a real main lens pass it
+// (issue 13, benchmark items 3 and 4). A count, not a timing: it builds the camera's Model from
+// parameters as the scene parser would (check_camera, make_model), asks generate_ray for the
+// camera's own samples (make_sample, as shade_pixel does) of the central, an edge and a corner
+// pixel and of a patch of pixels around each, and counts the rays that pass the lens. Without an
+// array it also counts what sampling the whole rear element's clear aperture uniformly (pbrt's
+// RealisticCamera before its exit-pupil bounds) would pass, so that the waste with and without
+// the pupil bounds (lens/pupil_bounds.h) can be compared. Run by `tools/bench --only
+// real_lens`; BENCHMARKS.md has the figures. Prints one JSON object on stdout.
+//
+//   plenoptic_pass_fractions --lens-file FILE --f-number N --focus-distance Z
+//       --sensor W H PIXEL_MM [--array-matched PITCH_MM | --array PITCH_MM F_MM D_MM] [--thick]
+//       [--samples S] [--patch P]
+//
+// --array-matched puts a hexagonal plenoptic 1.0 array at the focused image: thin microlenses of
+// focal length f = PITCH * the lens's working f-number (exit pupil to array over its diameter),
+// the sensor at f behind them (f-number matching); --array gives a hexagonal array's pitch, microlens
+// focal length and array-sensor distance d directly. --thick uses the lens's paraxial equivalent
+// (thick_lens) instead of the exact trace. --samples: samples per pixel (the make_sample count;
+// default 256); --patch: the side of the pixel patches (default 16, or two microlens pitches).
+// Besides the three places, a profile: patches along the centre row from the axis to the edge.
+// light_field_radius_mm is where the pupil bounds find that no light passes any more (-1 for the
+// thick lens, which has no such bounds; the bounds with an array are for points of its plane).
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "plenoptic/lens/main_lens.h"
+#include "plenoptic/camera/model.h"
+#include "plenoptic/optics.h"
+#include "plenoptic/camera/params.h"
+#include "plenoptic/lens/prescription.h"
+#include "plenoptic/core/sampling.h"
+
+namespace {
+
+using namespace plenoptic;
+
+struct Options {
+    std::string lens_file;
+    double f_number = 0;
+    double focus_distance = 0;
+    int width = 0, height = 0;
+    double pixel_mm = 0;
+    double array_pitch_mm = 0;  // 0: no array
+    double array_focal_mm = 0;  // given with --array; 0 with --array-matched (computed)
+    double array_distance_mm = 0;
+    bool thick = false;
+    int samples = 256;
+    int patch = 0;
+};
+
+void usage()
+{
+    std::fprintf(stderr,
+                 "usage: plenoptic_pass_fractions --lens-file FILE --f-number N --focus-distance Z\n"
+                 "         --sensor W H PIXEL_MM [--array-matched PITCH_MM | --array PITCH_MM F_MM D_MM] [--thick]\n"
+                 "         [--samples S] [--patch P]\n");
+}
+
+bool parse(int argc, char** argv, Options* o)
+{
+    for (int a = 1; a < argc; ++a) {
+        const std::string arg = argv[a];
+        const int left = argc - a - 1;
+        if (arg == "--lens-file" && left >= 1)
+            o->lens_file = argv[++a];
+        else if (arg == "--f-number" && left >= 1)
+            o->f_number = std::atof(argv[++a]);
+        else if (arg == "--focus-distance" && left >= 1)
+            o->focus_distance = std::atof(argv[++a]);
+        else if (arg == "--sensor" && left >= 3) {
+            o->width = std::atoi(argv[++a]);
+            o->height = std::atoi(argv[++a]);
+            o->pixel_mm = std::atof(argv[++a]);
+        } else if (arg == "--array-matched" && left >= 1)
+            o->array_pitch_mm = std::atof(argv[++a]);
+        else if (arg == "--array" && left >= 3) {
+            o->array_pitch_mm = std::atof(argv[++a]);
+            o->array_focal_mm = std::atof(argv[++a]);
+            o->array_distance_mm = std::atof(argv[++a]);
+        }
+        else if (arg == "--thick")
+            o->thick = true;
+        else if (arg == "--samples" && left >= 1)
+            o->samples = std::atoi(argv[++a]);
+        else if (arg == "--patch" && left >= 1)
+            o->patch = std::atoi(argv[++a]);
+        else
+            return false;
+    }
+    if (o->array_focal_mm > 0 && !(o->array_distance_mm > 0))
+        return false;
+    return !o->lens_file.empty() && o->f_number > 0 && o->focus_distance > 0 && o->width > 0 && o->height > 0 &&
+           o->pixel_mm > 0 && o->samples >= 2 && o->patch >= 0 && o->array_pitch_mm >= 0;
+}
+
+// The camera a scene with these keywords would give (main_lens { lens_file f_number
+// focus_distance [thick_lens] }, sensor { pixel_size }, optionally the matched array).
+CameraParams camera(const Options& o, const Prescription& lens, double array_focal_mm, double array_distance_mm)
+{
+    CameraParams p;
+    p.main.given = true;
+    p.main.type = o.thick ? MainLensType::ThickLens : MainLensType::Prescription;
+    p.main.has_prescription = true;
+    p.main.prescription = lens;
+    p.main.lens_file = o.lens_file;
+    p.main.has_f_number = true;
+    p.main.f_number = o.f_number;
+    p.main.has_focus_distance = true;
+    p.main.focus_distance_units = o.focus_distance;
+    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = o.pixel_mm;
+    if (array_focal_mm > 0) {
+        p.array.given = true;
+        p.array.grid = GridType::Hexagonal;
+        p.array.has_pitch = true;
+        p.array.pitch_mm = o.array_pitch_mm;
+        p.array.has_lens = true;
+        p.array.lens = MicrolensType::ThinLens;
+        p.array.focal_length_count = 1;
+        p.array.focal_lengths_mm[0] = array_focal_mm;
+        p.array.has_distance = true;
+        p.array.distance_mm = array_distance_mm;
+    }
+    p.sampling.samples = o.samples;
+    return p;
+}
+
+// Image-side f-number: exit pupil to the plane D behind the rear vertex, over the pupil's diameter
+// (the metadata's paraxial.working_f_number).
+double working_f_number(const Model& m)
+{
+    const double exit_pupil_z = m.lens_length_mm - m.paraxial.exit_pupil_z;  // optics frame
+    return (exit_pupil_z + m.distance_mm) / m.paraxial.exit_pupil_mm;
+}
+
+struct Count {
+    long long generated = 0;
+    long long passed = 0;
+    long long unbounded_generated = 0;  // without an array: the rear element sampled uniformly
+    long long unbounded_passed = 0;
+};
+
+// The samples of pixel (i, j) as shade_pixel makes them (fixed count, own lens): sample n of
+// `samples` from make_sample, then generate_ray. Without an array also the pbrt-style sample: the
+// same aperture sample mapped onto the rear element's clear aperture (a disc in the plane of the
+// rear vertex), traced with the lens's own exact trace.
+void count_pixel(const Model& m, int W, int H, int i, int j, int samples, double rear_radius_mm, Count* c)
+{
+    for (int n = 0; n < samples; ++n) {
+        const CameraSample s = make_sample(i, j, n, samples);
+        OpticsRay ray;
+        ++c->generated;
+        if (generate_ray(m, W, H, i, j, s, nullptr, &ray))
+            ++c->passed;
+        if (m.grid == GridType::None && rear_radius_mm > 0) {
+            const Vec3 p = sensor_point(m, W, H, i + s.pixel_u, j + s.pixel_v);
+            const Vec2 d = concentric_disc(s.lens_u, s.lens_v);
+            const Vec3 on_rear{rear_radius_mm * d.x, rear_radius_mm * d.y, 0};
+            ++c->unbounded_generated;
+            if (m.lens->to_scene(p, on_rear - p, true).passed)
+                ++c->unbounded_passed;
+        }
+    }
+}
+
+std::string fraction(long long part, long long whole)
+{
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6f", whole > 0 ? double(part) / double(whole) : 0.0);
+    return text;
+}
+
+std::string counts_json(const Count& c, bool unbounded)
+{
+    std::ostringstream out;
+    out << "{\"generated\": " << c.generated << ", \"passed\": " << c.passed
+        << ", \"pass_fraction\": " << fraction(c.passed, c.generated);
+    if (unbounded)
+        out << ", \"unbounded_generated\": " << c.unbounded_generated << ", \"unbounded_passed\": "
+            << c.unbounded_passed << ", \"unbounded_pass_fraction\": "
+            << fraction(c.unbounded_passed, c.unbounded_generated);
+    out << "}";
+    return out.str();
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    Options o;
+    if (!parse(argc, argv, &o)) {
+        usage();
+        return 2;
+    }
+    std::ifstream file(o.lens_file);
+    if (!file) {
+        std::fprintf(stderr, "plenoptic_pass_fractions: cannot read %s\n", o.lens_file.c_str());
+        return 1;
+    }
+    std::stringstream text;
+    text << file.rdbuf();
+    const ParsedPrescription parsed = parse_lens_file(text.str());
+    if (parsed.error.any()) {
+        std::fprintf(stderr, "plenoptic_pass_fractions: %s, line %d: %s\n", o.lens_file.c_str(), parsed.error.line,
+                     parsed.error.message.c_str());
+        return 1;
+    }
+
+    // The array's focal length depends on D, which the model computes: a first model without it.
+    double array_focal_mm = 0;
+    double working_n = 0;
+    {
+        const CameraParams first = camera(o, parsed.prescription, 0, 0);
+        const std::string error = check_camera(first);
+        if (!error.empty()) {
+            std::fprintf(stderr, "plenoptic_pass_fractions: %s\n", error.c_str());
+            return 1;
+        }
+        const Model m = make_model(first);
+        working_n = working_f_number(m);
+        if (o.array_pitch_mm > 0)
+            array_focal_mm = o.array_focal_mm > 0 ? o.array_focal_mm : o.array_pitch_mm * working_n;
+    }
+    const double array_distance_mm = o.array_focal_mm > 0 ? o.array_distance_mm : array_focal_mm;
+    const CameraParams params = camera(o, parsed.prescription, array_focal_mm, array_distance_mm);
+    const std::string error = check_camera(params);
+    if (!error.empty()) {
+        std::fprintf(stderr, "plenoptic_pass_fractions: %s\n", error.c_str());
+        return 1;
+    }
+    const Model m = make_model(params);
+    const int W = o.width, H = o.height;
+    int patch = o.patch;
+    if (patch == 0)
+        patch = o.array_pitch_mm > 0 ? int(std::ceil(2 * o.array_pitch_mm / o.pixel_mm)) : 16;
+    patch = std::min(patch, std::min(W, H));
+    const double rear_radius = 0.5 * m.prescription.surfaces.back().aperture_mm;
+    const bool unbounded = m.grid == GridType::None && m.main_lens == MainLensType::Prescription;
+
+    struct Place {
+        const char* name;
+        int i, j;    // the pixel
+        int i0, j0;  // the patch's first pixel
+    };
+    const Place places[] = {
+        {"centre", W / 2, H / 2, W / 2 - patch / 2, H / 2 - patch / 2},
+        {"edge", W - 1, H / 2, W - patch, H / 2 - patch / 2},
+        {"corner", W - 1, H - 1, W - patch, H - patch},
+    };
+
+    std::printf("{\n \"lens_file\": \"%s\", \"thick_lens\": %s, \"f_number\": %.9g, \"focus_distance\": %.9g,\n",
+                o.lens_file.c_str(), o.thick ? "true" : "false", m.f_number, o.focus_distance);
+    std::printf(" \"effective_focal_length_mm\": %.9g, \"distance_mm\": %.9g, \"working_f_number\": %.9g,\n",
+                m.focal_length_mm, m.distance_mm, working_n);
+    std::printf(" \"exit_pupil_radius_mm\": %.9g, \"rear_aperture_radius_mm\": %.9g, \"light_field_radius_mm\": %.9g,\n",
+                m.lens->exit_pupil_radius(), rear_radius, m.pupil_bounds ? m.pupil_bounds->field_radius_mm() : -1.0);
+    if (m.grid != GridType::None)
+        std::printf(" \"array\": {\"grid\": \"hexagonal\", \"pitch_mm\": %.9g, \"focal_length_mm\": %.9g, "
+                    "\"distance_mm\": %.9g},\n", m.pitch_mm, m.microlens_focal_mm[0], m.array_distance_mm);
+    else
+        std::printf(" \"array\": null,\n");
+    std::printf(" \"sensor\": {\"width\": %d, \"height\": %d, \"pixel_size_mm\": %.9g}, \"samples\": %d, "
+                "\"patch\": %d,\n \"places\": [\n", W, H, o.pixel_mm, o.samples, patch);
+    for (int k = 0; k < 3; ++k) {
+        const Place& p = places[k];
+        Count pixel, block;
+        count_pixel(m, W, H, p.i, p.j, o.samples, unbounded ? rear_radius : 0, &pixel);
+        for (int j = p.j0; j < p.j0 + patch; ++j)
+            for (int i = p.i0; i < p.i0 + patch; ++i)
+                count_pixel(m, W, H, i, j, o.samples, unbounded ? rear_radius : 0, &block);
+        const Vec3 at = sensor_point(m, W, H, p.i + 0.5, p.j + 0.5);
+        std::printf("  {\"place\": \"%s\", \"pixel\": [%d, %d], \"field_radius_mm\": %.6f,\n", p.name, p.i, p.j,
+                    std::hypot(at.x, at.y));
+        std::printf("   \"pixel_counts\": %s,\n", counts_json(pixel, unbounded).c_str());
+        std::printf("   \"patch_first_pixel\": [%d, %d], \"patch_counts\": %s}%s\n", p.i0, p.j0,
+                    counts_json(block, unbounded).c_str(), k < 2 ? "," : "");
+    }
+    std::printf(" ],\n");
+    // Along the centre row from the axis to the right edge: patches at kProfile field radii.
+    const int kProfile = 12;
+    std::printf(" \"profile\": [\n");
+    for (int k = 0; k <= kProfile; ++k) {
+        const int i0 = W / 2 - patch / 2 + int(std::lround(double(k) / kProfile * (W - W / 2 - (patch - patch / 2))));
+        const int j0 = H / 2 - patch / 2;
+        Count block;
+        for (int j = j0; j < j0 + patch; ++j)
+            for (int i = i0; i < i0 + patch; ++i)
+                count_pixel(m, W, H, i, j, o.samples, unbounded ? rear_radius : 0, &block);
+        const Vec3 at = sensor_point(m, W, H, i0 + 0.5 * patch, j0 + 0.5 * patch);
+        std::printf("  {\"patch_first_pixel\": [%d, %d], \"field_radius_mm\": %.6f, \"patch_counts\": %s}%s\n", i0, j0,
+                    std::hypot(at.x, at.y), counts_json(block, unbounded).c_str(), k < kProfile ? "," : "");
+    }
+    std::printf(" ]\n}\n");
+    return 0;
+}

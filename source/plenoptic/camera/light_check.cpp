@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+#include "plenoptic/camera/light_check.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "plenoptic/optics.h"
+#include "plenoptic/camera/params.h"
+#include "plenoptic/core/sampling.h"
+
+namespace plenoptic {
+
+namespace {
+
+const int kSamplesPerPixel = 16;
+const int kMaxPatchPixels = 64;
+
+} // namespace
+
+double lit_fraction_near_axis(const Model& model)
+{
+    // A patch about three microimages (or, without an array, a few pixels) across, centred on
+    // the pixel where the optical axis meets the sensor.
+    int patch = 8;
+    if (model.grid != GridType::None) {
+        const double pixel_mm = std::min(model.pixel_size_mm[0], model.pixel_size_mm[1]);
+        const double across = 3 * model.pitch_mm / pixel_mm;
+        patch = int(std::min<double>(kMaxPatchPixels, std::max(8.0, std::ceil(across))));
+    }
+    const int W = patch, H = patch;
+    const Vec2 axis = principal_point_px(model, W, H);
+    if (!std::isfinite(axis.x) || !std::isfinite(axis.y))
+        return 0;
+    const int i0 = int(std::floor(axis.x)) - patch / 2, j0 = int(std::floor(axis.y)) - patch / 2;
+    long passing = 0, total = 0;
+    for (int j = j0; j < j0 + patch; ++j)
+        for (int i = i0; i < i0 + patch; ++i)
+            for (int n = 0; n < kSamplesPerPixel; ++n, ++total) {
+                OpticsRay ray;
+                if (generate_ray(model, W, H, i, j, make_sample(i, j, n, kSamplesPerPixel), nullptr, &ray))
+                    ++passing;
+            }
+    return total > 0 ? double(passing) / total : 0;
+}
+
+std::string dark_image_warning(const Model& model)
+{
+    const double fraction = lit_fraction_near_axis(model);
+    if (fraction >= kDarkImageFraction)
+        return "";
+    std::string message = "almost no light reaches the sensor: " + format_number(100 * fraction) +
+                          " % of the camera's sample rays around the optical axis pass the apertures, so the "
+                          "image will be " + (fraction > 0 ? "nearly black" : "black");
+    if (model.main_lens == MainLensType::ThinLens)
+        message += " (main-lens aperture " + format_number(model.aperture_mm) + " mm, f-number " +
+                   format_number(model.f_number) + "; main lens to array or sensor " +
+                   format_number(model.distance_mm) + " mm: a focus distance at the focal length puts it far behind the lens)";
+    return message;
+}
+
+} // namespace plenoptic

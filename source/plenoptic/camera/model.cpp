@@ -1,0 +1,289 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Builds the plenoptic camera model once from checked parameters; warnings for odd but legal ones.
+
+#include "plenoptic/camera/model.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "plenoptic/core/lattice.h"
+#include "plenoptic/camera/radiometry.h"
+#include "plenoptic/core/sampling.h"
+
+namespace plenoptic {
+
+namespace {
+
+const double kPi = 3.14159265358979323846;
+
+// sin and cos of an angle in degrees, exact at multiples of 90 degrees so that an unrotated or
+// quarter-turned array stays exactly axis-aligned.
+void sin_cos_degrees(double degrees, double* s, double* c)
+{
+    const double reduced = std::fmod(degrees, 360.0);  // exact
+    const double quarter = reduced / 90.0;
+    if (quarter == std::floor(quarter)) {
+        static const double sines[4] = {0, 1, 0, -1};
+        const int q = int(((long long)quarter % 4 + 4) % 4);
+        *s = sines[q];
+        *c = sines[(q + 1) % 4];
+        return;
+    }
+    const double radians = reduced * (kPi / 180.0);
+    *s = std::sin(radians);
+    *c = std::cos(radians);
+}
+
+// Everything the overlap bound needs, measured at the array centre (see docs/camera-internals.md).
+struct OverlapGeometry {
+    double magnification;  // k = d / D: microimage-lattice scale is 1 + k
+    double disc_mm;        // radius of the main aperture's image through a lens centre
+    double blur_mm;        // reach of a lens cell's light beyond that, on the sensor
+    double blur_inradius_mm; // same with the cell's inradius (a round lens of diameter p)
+    double cell_mm;        // inradius of a microimage cell on the sensor
+};
+
+OverlapGeometry overlap_geometry(const Model& m)
+{
+    OverlapGeometry g{0, 0, 0, 0, 0};
+    const double main_distance = effective_main_distance_mm(m);
+    const double array_distance = effective_array_distance_mm(m);
+    g.magnification = array_distance / main_distance;
+    if (m.pupil_bounds)
+        g.disc_mm = m.pupil_bounds->reach_mm() * g.magnification;
+    else if (m.lens)
+        g.disc_mm = m.lens->exit_pupil_radius() * g.magnification;
+    if (m.microlens == MicrolensType::ThinLens) {
+        double worst = 0;
+        for (int t = 0; t < m.lens_type_count; ++t)
+            worst = std::max(worst, std::fabs(1 + g.magnification - array_distance / m.microlens_focal_mm[t]));
+        g.blur_mm = m.cell_circumradius_mm * worst;
+        g.blur_inradius_mm = m.cell_inradius_mm * worst;
+    }
+    g.cell_mm = m.cell_inradius_mm * (1 + g.magnification);
+    return g;
+}
+
+} // namespace
+
+Mat3 rotation_from_degrees(const double degrees[3])
+{
+    double sx, cx, sy, cy, sz, cz;
+    sin_cos_degrees(degrees[0], &sx, &cx);
+    sin_cos_degrees(degrees[1], &sy, &cy);
+    sin_cos_degrees(degrees[2], &sz, &cz);
+    // Column-vector forms of POV-Ray's row-vector matrices (its [1][2] = sin x is our [2][1]).
+    const Mat3 rx = {{{1, 0, 0}, {0, cx, -sx}, {0, sx, cx}}};
+    const Mat3 ry = {{{cy, 0, sy}, {0, 1, 0}, {-sy, 0, cy}}};
+    const Mat3 rz = {{{cz, -sz, 0}, {sz, cz, 0}, {0, 0, 1}}};
+    return mul(rz, mul(ry, rx));
+}
+
+double effective_main_distance_mm(const Model& model)
+{
+    return model.lens ? model.lens->exit_pupil_centre().z - model.pose.centre_mm.z : 0.0;
+}
+
+double effective_array_distance_mm(const Model& model)
+{
+    return model.pose.centre_mm.z - model.sensor_z_mm;
+}
+
+Model make_model(const CameraParams& params)
+{
+    Model m = Model();
+    m.mm_per_unit = params.mm_per_unit;
+    m.radiometry = params.radiometry;
+    m.irradiance_k_mm2 = 0;  // set once the geometry is known, below
+    m.angular_exponent = params.sensor.angular_exponent;
+
+    const MainLensParams& main = params.main;
+    m.main_lens = main.given ? main.type : MainLensType::None;
+    m.lens = make_main_lens(main, m.main_lens != MainLensType::None ? main_lens_distance_mm(main, params.mm_per_unit) : 0);
+    m.focal_length_mm = 0;
+    m.aperture_mm = 0;
+    m.f_number = 0;
+    m.distance_mm = 0;
+    m.has_focus_distance = false;
+    m.focus_distance_units = 0;
+    m.lens_length_mm = 0;
+    m.has_distortion = m.main_lens == MainLensType::ThinLens && main.has_distortion;
+    m.distortion = main.distortion;
+    if (m.main_lens == MainLensType::ThinLens) {
+        m.focal_length_mm = main.focal_length_mm;
+        m.aperture_mm = main.has_aperture ? main.aperture_mm : main.focal_length_mm / main.f_number;
+        m.f_number = main.has_f_number ? main.f_number : main.focal_length_mm / main.aperture_mm;
+    }
+    if (is_prescription_type(m.main_lens)) {
+        m.prescription = effective_prescription(main);
+        // Pupils and f-number of the aperture that limits the axial beam to the array (or sensor).
+        m.paraxial = paraxial_data(m.prescription, 0, main_lens_distance_mm(main, params.mm_per_unit));
+        m.lens_file = main.lens_file;
+        m.lens_length_mm = m.paraxial.rear_vertex_z;
+        m.focal_length_mm = m.paraxial.efl_mm;
+        m.aperture_mm = m.paraxial.stop_mm;
+        m.f_number = m.paraxial.f_number;
+    }
+    if (m.main_lens != MainLensType::None) {
+        m.distance_mm = main_lens_distance_mm(main, params.mm_per_unit);
+        m.has_focus_distance = main.has_focus_distance && m.main_lens != MainLensType::Pinhole;
+        m.focus_distance_units = m.has_focus_distance ? main.focus_distance_units : 0;
+    }
+
+    const ArrayParams& array = params.array;
+    m.grid = array.given ? array.grid : GridType::None;
+    m.pitch_mm = 0;
+    m.microlens = MicrolensType::Pinhole;
+    m.lens_type_count = 1;
+    m.microlens_focal_mm[0] = m.microlens_focal_mm[1] = m.microlens_focal_mm[2] = 0;
+    m.array_distance_mm = 0;
+    m.cell_inradius_mm = 0;
+    m.cell_circumradius_mm = 0;
+
+    const double array_z = m.main_lens == MainLensType::None ? 0.0 : -m.distance_mm;
+    const double no_rotation[3] = {0, 0, 0};
+    m.pose.rotation = rotation_from_degrees(m.grid == GridType::None ? no_rotation : array.rotate_deg);
+    m.pose.centre_mm = Vec3{0, 0, array_z};
+    if (m.grid != GridType::None) {
+        m.pitch_mm = array.pitch_mm;
+        m.microlens = array.lens;
+        if (array.lens == MicrolensType::ThinLens) {
+            m.lens_type_count = array.focal_length_count == 3 ? 3 : 1;
+            for (int t = 0; t < 3; ++t)
+                m.microlens_focal_mm[t] = array.focal_lengths_mm[m.lens_type_count == 3 ? t : 0];
+        }
+        m.array_distance_mm = array.distance_mm;
+        m.pose.centre_mm = Vec3{array.translate_mm[0], array.translate_mm[1], array_z + array.translate_mm[2]};
+        m.cell_inradius_mm = cell_inradius(m.grid, m.pitch_mm);
+        m.cell_circumradius_mm = cell_circumradius(m.grid, m.pitch_mm);
+    }
+    m.pose.normal = mul(m.pose.rotation, Vec3{0, 0, 1});
+    m.pose.tilted = !(m.pose.rotation.m[0][2] == 0 && m.pose.rotation.m[1][2] == 0);
+    m.pose.tilt_sine = std::hypot(m.pose.normal.x, m.pose.normal.y);
+
+    if (m.grid == GridType::None)
+        m.sensor_z_mm = -m.distance_mm;
+    else
+        m.sensor_z_mm = array_z - m.array_distance_mm;
+
+    m.irradiance_k_mm2 = irradiance_constant_mm2(m);
+
+    if (m.main_lens == MainLensType::Prescription) {
+        // The round stop holds the iris: bounds from the lens without blades hold the lens with them.
+        Prescription round = m.prescription;
+        round.blades = 0;
+        const std::shared_ptr<const MainLens> traced = make_prescription_lens(round, 0, true, m.distance_mm);
+        m.pupil_bounds = std::make_shared<PupilBounds>(round, *traced, m.grid == GridType::None ? m.sensor_z_mm : m.pose.centre_mm.z);
+        if (m.grid == GridType::None && m.prescription.blades == 0)
+            m.lit_area = std::make_shared<LitAreaTable>(*traced, *m.pupil_bounds, m.irradiance_k_mm2, m.angular_exponent);
+    }
+
+    for (int a = 0; a < 2; ++a) {
+        m.pixel_size_mm[a] = params.sensor.pixel_size_mm[a];
+        m.sensor_offset_mm[a] = params.sensor.offset_mm[a];
+    }
+
+    // Overlap: a bound at the array centre says whether a neighbour's light can reach a
+    // microimage cell at all, and how many rings of neighbours a pixel must consider.
+    m.model_overlap = false;
+    m.overlap_rings = 0;
+    m.overlap_rings_capped = false;
+    if (m.grid != GridType::None && m.main_lens != MainLensType::None) {
+        const OverlapGeometry g = overlap_geometry(m);
+        const double reach = g.disc_mm + g.blur_mm;
+        if (reach > g.cell_mm) {
+            m.model_overlap = true;
+            const double pixel_reach = 0.5 * std::hypot(m.pixel_size_mm[0], m.pixel_size_mm[1]);
+            const double lattice_reach = (reach + pixel_reach) / (1 + g.magnification) + m.cell_circumradius_mm;
+            // Ring r of the lattice is at least r times this far from the own lens.
+            const double ring_step = row_spacing(m.grid, m.pitch_mm);
+            double rings = std::ceil(lattice_reach / ring_step) + (m.pose.tilted ? 1 : 0);
+            if (!(rings >= 1))
+                rings = 1;
+            if (!(rings <= kMaxOverlapRings)) {
+                rings = kMaxOverlapRings;
+                m.overlap_rings_capped = true;
+            }
+            m.overlap_rings = int(rings);
+        }
+    }
+
+    const SamplingParams& sampling = params.sampling;
+    m.adaptive = sampling.adaptive;
+    const int fixed_count = sampling.samples == kSamplesOmitted ? default_samples(params) : sampling.samples;
+    m.samples_min = sampling.adaptive ? sampling.samples_min : fixed_count;
+    m.samples_max = sampling.adaptive ? sampling.samples_max : fixed_count;
+    m.confidence = sampling.confidence;
+    m.variance = sampling.variance;
+    if (m.adaptive)
+        m.thresholds = adaptive_thresholds(m.samples_max, m.confidence, m.variance);
+    return m;
+}
+
+std::string limiting_aperture_warning(const Model& m)
+{
+    if (!is_prescription_type(m.main_lens) || !m.paraxial.valid || m.paraxial.aperture_surface < 0)
+        return "";
+    const std::vector<LensSurface>& rows = m.prescription.surfaces;
+    const LensSurface& limiting = rows[size_t(m.paraxial.aperture_surface)];
+    if (limiting.stop)
+        return "";
+    int stop = 0;
+    while (!rows[size_t(stop)].stop)
+        ++stop;
+    return describe_surface(m.prescription, stop, m.lens_file) + " is written " + format_number(m.paraxial.stop_mm) +
+           " mm wide, wider than the lens can use: " +
+           describe_surface(m.prescription, m.paraxial.aperture_surface, m.lens_file) + ", clear aperture " +
+           format_number(limiting.aperture_mm) + " mm, limits the axial beam, so the lens works at f/" +
+           format_rounded(m.paraxial.f_number, true) + " (the stop alone would give f/" +
+           format_rounded(f_number_for_stop_diameter(m.prescription, m.paraxial.stop_mm), true) +
+           "); the pupils, f-numbers and microimage diameter in the metadata are those of that surface. A stop of at "
+           "most " + format_rounded(m.paraxial.largest_stop_mm, false) + " mm (f_number " +
+           format_rounded(f_number_for_stop_diameter(m.prescription, m.paraxial.largest_stop_mm), true) +
+           " or slower) limits the beam itself";
+}
+
+std::vector<std::string> warnings(const Model& m)
+{
+    std::vector<std::string> out;
+    const std::string aperture = limiting_aperture_warning(m);
+    if (!aperture.empty())
+        out.push_back(aperture);
+    if (m.grid == GridType::None)
+        return out;
+
+    const double magnification = m.main_lens == MainLensType::None
+                                     ? 0.0
+                                     : effective_array_distance_mm(m) / effective_main_distance_mm(m);
+    const double spacing_mm = m.pitch_mm * (1 + magnification);
+    const double spacing_px = spacing_mm / std::max(m.pixel_size_mm[0], m.pixel_size_mm[1]);
+    if (spacing_px < 2)
+        out.push_back("microimages are only " + format_number(spacing_px) +
+                      " pixels apart (lens pitch " + format_number(m.pitch_mm) + " mm, pixel size " +
+                      format_number(std::max(m.pixel_size_mm[0], m.pixel_size_mm[1])) +
+                      " mm): fewer than two pixels across leaves almost no angular resolution");
+
+    if (m.main_lens != MainLensType::None) {
+        const OverlapGeometry g = overlap_geometry(m);
+        // Warn about overlap a round microlens of diameter p would show too; the small spill
+        // through the cell corners of f-number-matched arrays is modelled without a warning.
+        if (g.disc_mm + g.blur_inradius_mm > g.cell_mm * (1 + 1e-9)) {
+            std::string message = "microimages overlap: light through one microlens reaches up to " +
+                                  format_number(g.disc_mm + g.blur_mm) + " mm from its microimage centre, "
+                                  "beyond its microimage cell (inradius " + format_number(g.cell_mm) +
+                                  " mm); the light of neighbouring lenses is added where they meet";
+            const double free_mm = g.cell_mm - g.blur_inradius_mm;
+            if (m.main_lens == MainLensType::ThinLens && free_mm > 0)
+                message += "; a main-lens f_number of at least " +
+                           format_number(m.focal_length_mm / (2 * free_mm / g.magnification)) +
+                           " avoids it";
+            out.push_back(message);
+        }
+    }
+    if (m.overlap_rings_capped)
+        out.push_back("microimages overlap by more than " + std::to_string(kMaxOverlapRings) +
+                      " rings of neighbouring lenses; light through lenses further away is ignored");
+    return out;
+}
+
+} // namespace plenoptic

@@ -1,0 +1,312 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Ray generation through ideal thin lenses and pinholes, chief rays, overlap lenses.
+
+#include "plenoptic/camera/rays.h"
+
+#include <cmath>
+
+#include "plenoptic/camera/radiometry.h"
+#include "plenoptic/camera/rays_internal.h"
+
+namespace plenoptic {
+
+namespace detail {
+
+// Intersection of the line (main-lens centre -> p), or the vertical line through p when there is
+// no main lens, with the array plane; array-local coordinates.
+bool project_to_array(const Model& m, Vec3 p, Vec2* local)
+{
+    const Vec3 n = m.pose.normal;
+    Vec3 q;
+    if (m.main_lens == MainLensType::None) {
+        if (!(n.z > 0))
+            return false;
+        q = Vec3{p.x, p.y, p.z + dot(n, m.pose.centre_mm - p) / n.z};
+    } else {
+        // The line from the exit pupil's centre e through p: q = e + s (p - e).
+        const Vec3 e = m.lens->exit_pupil_centre();
+        const double along = dot(n, p - e);
+        const double s = dot(n, m.pose.centre_mm - e) / along;
+        if (!(s > 0) || !std::isfinite(s))
+            return false;
+        q = e + s * (p - e);
+    }
+    const Vec3 l = to_local(m, q);
+    *local = Vec2{l.x, l.y};
+    return is_finite(*local);
+}
+
+} // namespace detail
+
+namespace {
+
+using detail::microlens_focal;
+using detail::project_to_array;
+using detail::to_local;
+using detail::to_optics;
+
+// The ray into the scene as the renderer takes it; false when it does not pass (blocked, not
+// finite, or bent back towards the camera body: see scene_ray).
+bool emit(const SceneRay& ray, OpticsRay* out)
+{
+    if (!ray.passed)
+        return false;
+    out->origin_mm[0] = ray.origin.x;
+    out->origin_mm[1] = ray.origin.y;
+    out->origin_mm[2] = ray.origin.z;
+    out->dir[0] = ray.dir.x;
+    out->dir[1] = ray.dir.y;
+    out->dir[2] = ray.dir.z;
+    out->weight = 1;
+    return true;
+}
+
+bool finish(Vec3 origin, Vec3 direction, OpticsRay* out) { return emit(scene_ray(origin, direction), out); }
+
+// Ray from sensor point p through the microlens `lens` to the pinhole main lens at the origin.
+// The microlens images the pinhole O to the homogeneous point I = (o, 1 - o_z/f) (lens-relative
+// coordinates); every ray from p aimed at I leaves the lens through O. No division by
+// (1 + D/d - D/f), so near-degenerate set-ups only block rays.
+bool through_pinhole_main(const Model& m, Vec3 p, LensIndex lens, bool check_cell, OpticsRay* out)
+{
+    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+    const double f = microlens_focal(m, lens);
+    const Vec3 o = to_local(m, Vec3{0, 0, 0});
+    const Vec3 s = to_local(m, p);
+    if (!(o.z > 0) || !(s.z < 0))
+        return false;
+    const Vec3 o_rel{o.x - c.x, o.y - c.y, o.z};
+    const Vec3 p_rel{s.x - c.x, s.y - c.y, s.z};
+    const double w = 1 - o_rel.z / f;
+    Vec3 along = o_rel - w * p_rel;  // direction of the line p -> I
+    if (along.z < 0)
+        along = -along;
+    if (!(along.z > 0))
+        return false;
+    const double t = -p_rel.z / along.z;
+    const double hx = p_rel.x + t * along.x;
+    const double hy = p_rel.y + t * along.y;
+    if (check_cell && nearest_lens(m.grid, m.pitch_mm, c.x + hx, c.y + hy) != lens)
+        return false;
+    const Vec3 local_out{along.x / along.z - hx / f, along.y / along.z - hy / f, 1};
+    return finish(Vec3{0, 0, 0}, mul(m.pose.rotation, local_out), out);
+}
+
+// Under irradiance radiometry, weights a passing ray from sensor point s towards aperture point q
+// (on a plane of normal n) by the cos^4 law (camera/radiometry.h); returns `passed`.
+bool weigh(const Model& m, bool passed, Vec3 s, Vec3 q, Vec3 n, OpticsRay* out)
+{
+    if (passed && m.radiometry == Radiometry::Irradiance)
+        out->weight *= irradiance_weight(m.irradiance_k_mm2, m.angular_exponent, s, q, n);
+    return passed;
+}
+
+// The whole camera for one sensor point and one aperture sample (lens_u, lens_v).
+bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double lens_u, double lens_v,
+                        bool check_apertures, OpticsRay* out)
+{
+    if (m.grid == GridType::None && m.pupil_bounds && check_apertures) {
+        // A real lens: towards a point of the region of the exit pupil's plane where light from p
+        // can pass, weighted by that region's area, or by the lit part's when the model has a
+        // lit-area table (see OpticsRay::weight). Chief rays (no
+        // aperture check) aim at the exit pupil's centre, below.
+        const PupilDisc disc = m.pupil_bounds->disc_for(p);
+        if (!(disc.radius > 0))
+            return false;
+        const Vec2 d = concentric_disc(lens_u, lens_v);
+        const Vec3 on_pupil{disc.centre.x + disc.radius * d.x, disc.centre.y + disc.radius * d.y, disc.centre.z};
+        if (!emit(m.lens->to_scene(p, on_pupil - p, true), out))
+            return false;
+        if (m.lit_area) {
+            out->weight = m.lit_area->at(p);  // the table holds the irradiance weighting too
+            return true;
+        }
+        const double ratio = disc.radius / m.lens->exit_pupil_radius();
+        out->weight = ratio * ratio;
+        return weigh(m, true, p, on_pupil, Vec3{0, 0, 1}, out);
+    }
+    if (m.grid == GridType::None) {
+        // The sensor point towards a point of the exit pupil, through the lens.
+        const Vec3 on_pupil = m.lens->exit_pupil_point(lens_u, lens_v);
+        if (m.main_lens == MainLensType::Pinhole)
+            return weigh(m, finish(on_pupil, on_pupil - p, out), p, on_pupil, Vec3{0, 0, 1}, out);
+        return weigh(m, emit(m.lens->to_scene(p, on_pupil - p, false), out), p, on_pupil, Vec3{0, 0, 1}, out);
+    }
+
+    LensIndex lens;
+    if (forced) {
+        lens = *forced;
+    } else {
+        Vec2 q;
+        if (!project_to_array(m, p, &q))
+            return false;
+        lens = nearest_lens(m.grid, m.pitch_mm, q.x, q.y);
+    }
+
+    if (m.microlens == MicrolensType::ThinLens && m.main_lens == MainLensType::Pinhole)
+        return through_pinhole_main(m, p, lens, check_apertures, out);
+
+    const Vec2 c_local = lens_centre(m.grid, m.pitch_mm, lens);
+    Vec3 leave;      // where the ray leaves the array
+    Vec3 direction;  // after the microlens, optics frame, any length
+    if (m.microlens == MicrolensType::Pinhole) {
+        leave = to_optics(m, Vec3{c_local.x, c_local.y, 0});
+        direction = leave - p;
+        if (!(dot(direction, m.pose.normal) > 0))
+            return false;  // the sensor point is not behind the array
+    } else {
+        // A point of the lens cell; refraction in the array's own frame, with the direction
+        // normalised to unit local z: w' = w - (h - c) / f.
+        const Vec2 offset = sample_cell_uniform(m.grid, m.pitch_mm, lens_u, lens_v);
+        leave = to_optics(m, Vec3{c_local.x + offset.x, c_local.y + offset.y, 0});
+        const Vec3 w = mul_transposed(m.pose.rotation, leave - p);
+        if (!(w.z > 0))
+            return false;
+        const double f = microlens_focal(m, lens);
+        const Vec3 refracted{w.x / w.z - offset.x / f, w.y / w.z - offset.y / f, 1};
+        direction = mul(m.pose.rotation, refracted);
+    }
+
+    if (m.main_lens == MainLensType::None)
+        return weigh(m, finish(leave, direction, out), p, leave, m.pose.normal, out);
+    if (m.main_lens == MainLensType::Pinhole)
+        return false;  // pinhole + pinhole: refused at parse time, no ray passes both points
+
+    // A real lens behind an array parallel to the sensor: a ray that crosses the exit pupil's plane
+    // outside the pupil-bounds disc of the point where it leaves the array cannot pass the lens
+    // (PupilBounds holds every point through which light from that point passes, and the bounds
+    // were made for points of this plane), so it is blocked without the surface-by-surface trace:
+    // most of the rays at the rims of microimages and their vignetting probes.
+    if (check_apertures && m.pupil_bounds && !m.pose.tilted && !m.pupil_bounds->may_pass(leave, direction))
+        return false;
+    // On through the main lens (a ray that misses its apertures carries no light).
+    return weigh(m, emit(m.lens->to_scene(leave, direction, check_apertures), out), p, leave, m.pose.normal, out);
+}
+
+// Whether light through `lens` can reach some point of the pixel centred at p. With k = D/d
+// measured at the lens: the chief ray p -> c meets the main-lens plane at m0 = c (1 + k) - p k
+// (exact, tilted or not); a ray from sensor point p' through cell point h arrives at
+// m0 + (h - c) g - (p' - p) k with g = 1 + k - D/f for an array parallel to the sensor, so the
+// lens reaches the pixel iff that region meets the aperture disc. Conservative: circumradius for
+// the cell, half the pixel diagonal for the pixel; for a slightly tilted array the spread terms get
+// a margin that grows with the tilt (validated against brute force in the unit tests).
+bool lens_reaches_pixel(const Model& m, LensIndex lens, Vec3 p)
+{
+    if (!m.lens)
+        return true;
+    const Vec3 c = lens_centre_mm(m, lens);
+    const Vec3 e = m.lens->exit_pupil_centre();
+    const double main_distance = e.z - c.z;
+    const double array_distance = c.z - m.sensor_z_mm;
+    if (!(main_distance > 0) || !(array_distance > 0))
+        return true;
+    const double k = main_distance / array_distance;
+    const double mx = (c.x - e.x) * (1 + k) - (p.x - e.x) * k;
+    const double my = (c.y - e.y) * (1 + k) - (p.y - e.y) * k;
+    double spread = 0.5 * std::hypot(m.pixel_size_mm[0], m.pixel_size_mm[1]) * k;
+    if (m.microlens == MicrolensType::ThinLens)
+        spread += m.cell_circumradius_mm * std::fabs(1 + k - main_distance / microlens_focal(m, lens));
+    if (m.pose.tilted)
+        spread *= 1.25 + 4 * m.pose.tilt_sine;
+    if (m.pupil_bounds) {
+        // A real lens: the region where light from the lens centre passes its apertures.
+        const PupilDisc disc = m.pupil_bounds->disc_for(c);
+        return std::hypot(mx - disc.centre.x, my - disc.centre.y) <= (disc.radius + spread) * (1 + 1e-9);
+    }
+    return std::hypot(mx, my) <= (m.lens->exit_pupil_radius() + spread) * (1 + 1e-9);
+}
+
+} // namespace
+
+Vec3 sensor_point(const Model& m, int W, int H, double pu, double pv)
+{
+    return Vec3{-(pu - 0.5 * W) * m.pixel_size_mm[0] + m.sensor_offset_mm[0],
+                (pv - 0.5 * H) * m.pixel_size_mm[1] + m.sensor_offset_mm[1], m.sensor_z_mm};
+}
+
+bool sensor_to_pixel(const Model& m, int W, int H, double x_mm, double y_mm, double* u, double* v)
+{
+    *u = 0.5 * W - 0.5 - (x_mm - m.sensor_offset_mm[0]) / m.pixel_size_mm[0];
+    *v = 0.5 * H - 0.5 + (y_mm - m.sensor_offset_mm[1]) / m.pixel_size_mm[1];
+    return *u >= -0.5 && *u < W - 0.5 && *v >= -0.5 && *v < H - 0.5;
+}
+
+Vec2 principal_point_px(const Model& m, int W, int H)
+{
+    Vec2 p;
+    sensor_to_pixel(m, W, H, 0, 0, &p.x, &p.y);
+    return p;
+}
+
+Vec3 lens_centre_mm(const Model& m, LensIndex lens)
+{
+    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+    return to_optics(m, Vec3{c.x, c.y, 0});
+}
+
+bool own_lens(const Model& m, Vec3 p, LensIndex* lens)
+{
+    Vec2 q;
+    if (!project_to_array(m, p, &q))
+        return false;
+    *lens = nearest_lens(m.grid, m.pitch_mm, q.x, q.y);
+    return true;
+}
+
+bool generate_ray(const Model& m, int W, int H, int i, int j, const CameraSample& sample, const LensIndex* lens,
+                  OpticsRay* out)
+{
+    const Vec3 p = sensor_point(m, W, H, i + sample.pixel_u, j + sample.pixel_v);
+    return trace_sensor_point(m, p, lens, sample.lens_u, sample.lens_v, true, out);
+}
+
+int overlap_lenses(const Model& m, int W, int H, int i, int j, LensIndex* out, int capacity)
+{
+    if (capacity < 1 || m.grid == GridType::None)
+        return 0;
+    const Vec3 p = sensor_point(m, W, H, i + 0.5, j + 0.5);
+    LensIndex own;
+    if (!own_lens(m, p, &own))
+        return 0;
+    out[0] = own;
+    int count = 1;
+    if (!m.model_overlap)
+        return count;
+    const int rings = m.overlap_rings;
+    const std::int64_t own_skew = skew_k(m.grid, own);
+    const bool hexagonal = m.grid == GridType::Hexagonal;
+    for (int dl = -rings; dl <= rings; ++dl) {
+        for (int dk = -rings; dk <= rings; ++dk) {
+            if (dk == 0 && dl == 0)
+                continue;
+            if (hexagonal && std::abs(dk + dl) > rings)
+                continue;  // hexagonal ring distance in skew indices: max(|dk|, |dl|, |dk + dl|)
+            const LensIndex lens = from_skew(m.grid, own_skew + dk, own.l + dl);
+            if (m.pose.tilt_sine <= kMaxPrunedTiltSine && !lens_reaches_pixel(m, lens, p))
+                continue;
+            if (count >= capacity)
+                return count;
+            out[count++] = lens;
+        }
+    }
+    return count;
+}
+
+bool chief_ray_through(const Model& m, int W, int H, double pu, double pv, const LensIndex* lens, OpticsRay* out)
+{
+    return trace_sensor_point(m, sensor_point(m, W, H, pu, pv), lens, 0.5, 0.5, false, out);
+}
+
+OpticsRay chief_ray(const Model& m, int W, int H, int i, int j)
+{
+    OpticsRay ray;
+    if (chief_ray_through(m, W, H, i + 0.5, j + 0.5, nullptr, &ray))
+        return ray;
+    const Vec3 p = sensor_point(m, W, H, i + 0.5, j + 0.5);
+    const Vec3 e = m.lens ? m.lens->exit_pupil_centre() : Vec3{0, 0, 0};
+    if (!finish(e, e - p, &ray))
+        finish(e, Vec3{0, 0, 1}, &ray);
+    return ray;
+}
+
+} // namespace plenoptic

@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Rays of the plenoptic camera: sensor points, lens lookup, ray generation, chief rays, the lenses
+// whose light can reach a pixel (overlap).
+
+#ifndef PLENOPTIC_RAYS_H
+#define PLENOPTIC_RAYS_H
+
+#include "plenoptic/core/lattice.h"
+#include "plenoptic/camera/model.h"
+#include "plenoptic/core/sampling.h"
+
+namespace plenoptic {
+
+// A ray leaving the last optical element (the main-lens plane z = 0; the array when there is
+// no main lens), in the optics frame, millimetres. The caller converts to scene units.
+struct OpticsRay {
+    double origin_mm[3];
+    double dir[3];  // unit length, towards the scene (+z component)
+    // What the ray's colour counts for in its pixel: 1, except for a real lens without an array,
+    // whose samples cover a region of its exit pupil's plane (PupilBounds) rather than the paraxial
+    // pupil: the region's area over the paraxial pupil's, so that a pixel's value does not depend
+    // on the region sampled. With a lit-area table (Model::lit_area, a round stop): the area of
+    // the region's lit part over the paraxial pupil's, and the pixel averages its passing
+    // samples only (shade_pixel).
+    double weight;
+};
+
+// Point on the sensor (optics frame, mm) at continuous pixel coordinates (pu, pv), where pixel
+// (i, j) spans [i, i+1) x [j, j+1); (i + 0.5, j + 0.5) is its centre:
+//   x = -(pu - W/2) * sx + ox,  y = (pv - H/2) * sy + oy,  z = sensor plane.
+Vec3 sensor_point(const Model& model, int W, int H, double pu, double pv);
+
+// Inverse of sensor_point in the centre convention used by the metadata: pixel (i, j)'s centre is
+// at (u, v) = (i, j). Returns whether the point lies inside the image.
+bool sensor_to_pixel(const Model& model, int W, int H, double x_mm, double y_mm, double* u, double* v);
+
+// Where the optical axis meets the sensor, centre convention.
+Vec2 principal_point_px(const Model& model, int W, int H);
+
+// Centre of a lens in the optics frame (posed array), mm.
+Vec3 lens_centre_mm(const Model& model, LensIndex lens);
+
+// The lens a sensor point belongs to: the lens whose cell contains the intersection of the line
+// (main-lens centre -> point) with the array plane; with no main lens, the lens straight above
+// the point. False when that line misses the array plane (only for extreme tilts).
+bool own_lens(const Model& model, Vec3 sensor_point_mm, LensIndex* lens);
+
+// The ray of one sample of pixel (i, j). `lens` forces the microlens the light passes through
+// (overlap modelling); nullptr uses the own lens of the sample's sensor point. Returns false when
+// an aperture blocks the ray (it then carries no light: black, opaque). No allocation, no
+// search over lenses, no trigonometry except the concentric disc map of a bare main lens.
+bool generate_ray(const Model& model, int W, int H, int i, int j, const CameraSample& sample,
+                  const LensIndex* lens, OpticsRay* out);
+
+// The lenses whose light can reach pixel (i, j) when the model models overlap: the pixel
+// centre's own lens first, then every neighbour within model.overlap_rings rings that passes a
+// conservative reach test (all of them for an array tilted by more than kMaxPrunedTiltSine).
+// Without overlap modelling: the own lens only. Returns the count (0 if the pixel sees no lens),
+// at most `capacity`.
+int overlap_lenses(const Model& model, int W, int H, int i, int j, LensIndex* out, int capacity);
+
+// The chief ray of pixel (i, j): pixel centre -> centre of its microlens (undeviated) -> refracted
+// by the main lens; with no array, pixel centre through the main-lens centre; with a pinhole main
+// lens, the pixel's only ray. Apertures are ignored (depth maps want a ray for every pixel).
+// Falls back to the line from the pixel centre through the main-lens centre when the geometry
+// has no such ray.
+OpticsRay chief_ray(const Model& model, int W, int H, int i, int j);
+
+// The same at continuous pixel coordinates (sensor_point's convention), optionally through a
+// given lens. False when the geometry has no such ray.
+bool chief_ray_through(const Model& model, int W, int H, double pu, double pv, const LensIndex* lens,
+                       OpticsRay* out);
+
+} // namespace plenoptic
+
+#endif

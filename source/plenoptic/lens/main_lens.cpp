@@ -1,0 +1,301 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The pinhole and the ideal thin lens behind the MainLens interface.
+
+#include "plenoptic/lens/main_lens.h"
+
+#include <cmath>
+
+#include "plenoptic/lens/distortion.h"
+#include "plenoptic/lens/prescription.h"
+#include "plenoptic/core/sampling.h"
+
+namespace plenoptic {
+
+namespace {
+
+// Whether (x, y) lies in the disc of this radius about the origin: squares where they cannot
+// overflow (cheaper than hypot: this runs for every ray), hypot for absurdly large apertures.
+bool inside_disc(double x, double y, double radius)
+{
+    if (radius < 1e150)
+        return x * x + y * y <= radius * radius;  // an overflowing x * x is +inf: outside, as it should be
+    return std::hypot(x, y) <= radius;
+}
+
+// Every ray through it passes through the origin.
+class PinholeMainLens : public MainLens {
+public:
+    MainLensType type() const override { return MainLensType::Pinhole; }
+    Vec3 exit_pupil_centre() const override { return Vec3{0, 0, 0}; }
+    double exit_pupil_radius() const override { return 0; }
+    Vec3 exit_pupil_point(double, double) const override { return Vec3{0, 0, 0}; }
+    SceneRay to_scene(Vec3 origin, Vec3 direction, bool) const override
+    {
+        // Only the line through the pinhole passes: the caller aims at it (exit_pupil_point).
+        const Vec3 to_pinhole = -origin;
+        const Vec3 c = cross(to_pinhole, direction);
+        if (dot(c, c) > 1e-24 * dot(to_pinhole, to_pinhole) * dot(direction, direction) || !(dot(to_pinhole, direction) > 0))
+            return SceneRay{origin, direction, false};
+        return scene_ray(Vec3{0, 0, 0}, direction);
+    }
+    ImageRay to_image(Vec3 origin, Vec3 direction, bool) const override
+    {
+        const Vec3 to_pinhole = -origin;
+        const Vec3 c = cross(to_pinhole, direction);
+        if (dot(c, c) > 1e-24 * dot(to_pinhole, to_pinhole) * dot(direction, direction) || !(dot(to_pinhole, direction) > 0))
+            return ImageRay{origin, direction, false};
+        return image_ray(Vec3{0, 0, 0}, direction);
+    }
+    HomogeneousPoint paraxial_image(Vec3 point) const override { return HomogeneousPoint{point, 1}; }
+};
+
+// Ideal thin lens of focal length F in the plane z = 0, aperture disc of diameter A: a ray meeting
+// the plane at m with direction w (unit z component) leaves with w' = w - m / F.
+//
+// With distortion (lens/distortion.h), the image-side ray through m is bent about m so that
+// where the ideal lens's ray would cross the plane z = plane_z (the array, or the sensor) at
+// normalised point u = (x, y) / -plane_z, the real ray crosses it at distort(u): every ray stays
+// straight on both sides, and the object side is the ideal lens's.
+class ThinMainLens : public MainLens {
+public:
+    ThinMainLens(double focal_length_mm, double aperture_mm) : focal_(focal_length_mm), radius_(0.5 * aperture_mm),
+        distorted_(false), distortion_(DistortionParams{{0, 0, 0}, {0, 0}}), plane_z_(0) {}
+    ThinMainLens(double focal_length_mm, double aperture_mm, const DistortionParams& distortion, double plane_z)
+        : focal_(focal_length_mm), radius_(0.5 * aperture_mm), distorted_(!is_identity(distortion) && plane_z < 0),
+          distortion_(distortion), plane_z_(plane_z) {}
+    MainLensType type() const override { return MainLensType::ThinLens; }
+    Vec3 exit_pupil_centre() const override { return Vec3{0, 0, 0}; }
+    double exit_pupil_radius() const override { return radius_; }
+    Vec3 exit_pupil_point(double u, double v) const override
+    {
+        const Vec2 disc = concentric_disc(u, v);
+        return Vec3{radius_ * disc.x, radius_ * disc.y, 0};
+    }
+    SceneRay to_scene(Vec3 origin, Vec3 direction, bool check_apertures) const override
+    {
+        if (!(direction.z > 0) || !(origin.z < 0))
+            return SceneRay{origin, direction, false};
+        const double travel = -origin.z / direction.z;
+        const double mx = origin.x + travel * direction.x;
+        const double my = origin.y + travel * direction.y;
+        if (check_apertures && !inside_disc(mx, my, radius_))
+            return SceneRay{Vec3{mx, my, 0}, direction, false};  // misses the aperture: carries no light
+        double sx = direction.x / direction.z, sy = direction.y / direction.z;  // slopes per unit of z
+        if (distorted_) {
+            // The real ray crosses the plane at h; the ideal ray through m crosses it at h_u.
+            const double scale = -plane_z_;
+            const Vec2 h{mx - scale * sx, my - scale * sy};
+            Vec2 ideal;
+            if (!undistort(distortion_, Vec2{h.x / scale, h.y / scale}, &ideal))
+                return SceneRay{Vec3{mx, my, 0}, direction, false};  // beyond the distortion's reach
+            sx = (mx - scale * ideal.x) / scale;
+            sy = (my - scale * ideal.y) / scale;
+        }
+        const double wx = sx - mx / focal_;
+        const double wy = sy - my / focal_;
+        return scene_ray(Vec3{mx, my, 0}, Vec3{wx, wy, 1});
+    }
+    // The reverse of to_scene: arriving with slope a = direction / |direction.z| at m, the ray
+    // leaves with a - m / F (to_scene's rule read backwards).
+    ImageRay to_image(Vec3 origin, Vec3 direction, bool check_apertures) const override
+    {
+        if (!(direction.z < 0) || !(origin.z > 0))
+            return ImageRay{origin, direction, false};
+        const double travel = -origin.z / direction.z;
+        const double mx = origin.x + travel * direction.x;
+        const double my = origin.y + travel * direction.y;
+        if (check_apertures && !inside_disc(mx, my, radius_))
+            return ImageRay{Vec3{mx, my, 0}, direction, false};
+        double ax = direction.x / -direction.z - mx / focal_;
+        double ay = direction.y / -direction.z - my / focal_;
+        if (distorted_) {
+            const double scale = -plane_z_;
+            const Vec2 real = distort(distortion_, Vec2{(mx + scale * ax) / scale, (my + scale * ay) / scale});
+            ax = (scale * real.x - mx) / scale;
+            ay = (scale * real.y - my) / scale;
+        }
+        return image_ray(Vec3{mx, my, 0}, Vec3{ax, ay, -1});
+    }
+    // X' = X / (1 - z / F), written homogeneously (the ideal image: distortion moves it).
+    HomogeneousPoint paraxial_image(Vec3 point) const override { return HomogeneousPoint{point, 1 - point.z / focal_}; }
+
+private:
+    double focal_;
+    double radius_;
+    bool distorted_;
+    DistortionParams distortion_;
+    double plane_z_;
+};
+
+// The paraxial equivalent of a prescription: principal planes at z = front_h and z = rear_h
+// (optics frame, +z towards the scene, so front_h > rear_h for an ordinary lens), effective focal
+// length F, exit pupil of radius r at z = pupil_z. A ray from the image side meets the rear
+// principal plane at m, is refracted there as by a thin lens (w' = w - m / F) and continues from
+// the same height on the front principal plane; it passes when it crosses the exit pupil's plane
+// inside the pupil.
+class ThickMainLens : public MainLens {
+public:
+    ThickMainLens(double efl, double front_h, double rear_h, double pupil_z, double pupil_radius)
+        : focal_(efl), front_h_(front_h), rear_h_(rear_h), pupil_z_(pupil_z), radius_(pupil_radius) {}
+    MainLensType type() const override { return MainLensType::ThickLens; }
+    Vec3 exit_pupil_centre() const override { return Vec3{0, 0, pupil_z_}; }
+    double exit_pupil_radius() const override { return radius_; }
+    Vec3 exit_pupil_point(double u, double v) const override
+    {
+        const Vec2 disc = concentric_disc(u, v);
+        return Vec3{radius_ * disc.x, radius_ * disc.y, pupil_z_};
+    }
+    SceneRay to_scene(Vec3 origin, Vec3 direction, bool check_apertures) const override
+    {
+        if (!(direction.z > 0) || !(origin.z < rear_h_))
+            return SceneRay{origin, direction, false};
+        if (check_apertures) {
+            const double to_pupil = (pupil_z_ - origin.z) / direction.z;
+            const double px = origin.x + to_pupil * direction.x, py = origin.y + to_pupil * direction.y;
+            if (!inside_disc(px, py, radius_))
+                return SceneRay{Vec3{px, py, pupil_z_}, direction, false};
+        }
+        const double travel = (rear_h_ - origin.z) / direction.z;
+        const double mx = origin.x + travel * direction.x;
+        const double my = origin.y + travel * direction.y;
+        const double wx = direction.x / direction.z - mx / focal_;
+        const double wy = direction.y / direction.z - my / focal_;
+        return scene_ray(Vec3{mx, my, front_h_}, Vec3{wx, wy, 1});
+    }
+    // The reverse: met at height m on the front principal plane, the ray leaves the rear one at
+    // the same height with slope a - m / F, and passes when its line crosses the exit pupil.
+    ImageRay to_image(Vec3 origin, Vec3 direction, bool check_apertures) const override
+    {
+        if (!(direction.z < 0) || !(origin.z > front_h_))
+            return ImageRay{origin, direction, false};
+        const double travel = (front_h_ - origin.z) / direction.z;
+        const double mx = origin.x + travel * direction.x;
+        const double my = origin.y + travel * direction.y;
+        const double ax = direction.x / -direction.z - mx / focal_;
+        const double ay = direction.y / -direction.z - my / focal_;
+        if (check_apertures) {
+            const double to_pupil = rear_h_ - pupil_z_;  // along the outgoing line, per unit of -z
+            if (!inside_disc(mx + to_pupil * ax, my + to_pupil * ay, radius_))
+                return ImageRay{Vec3{mx, my, rear_h_}, direction, false};
+        }
+        return image_ray(Vec3{mx, my, rear_h_}, Vec3{ax, ay, -1});
+    }
+    // The thin-lens conjugate about the principal planes: X - H maps to (X - H) / (1 - s / F)
+    // about H', s the distance of X in front of H.
+    HomogeneousPoint paraxial_image(Vec3 point) const override
+    {
+        const double s = point.z - front_h_;
+        const double w = 1 - s / focal_;
+        return HomogeneousPoint{Vec3{point.x, point.y, s + w * rear_h_}, w};
+    }
+
+private:
+    double focal_, front_h_, rear_h_, pupil_z_, radius_;
+};
+
+// The real lens, traced surface by surface. Lens frame (z from the front vertex towards the
+// image) to optics frame: z_optics = length - z_lens, x and y unchanged (a mirror image, which
+// a lens of revolution does not notice; the iris is turned with it).
+class ExactMainLens : public MainLens {
+public:
+    ExactMainLens(const Prescription& lens, double length, const ThickMainLens& paraxial)
+        : lens_(lens), unbounded_(unbounded(lens)), length_(length), paraxial_(paraxial)
+    {
+    }
+    MainLensType type() const override { return MainLensType::Prescription; }
+    Vec3 exit_pupil_centre() const override { return paraxial_.exit_pupil_centre(); }
+    double exit_pupil_radius() const override { return paraxial_.exit_pupil_radius(); }
+    Vec3 exit_pupil_point(double u, double v) const override { return paraxial_.exit_pupil_point(u, v); }
+    SceneRay to_scene(Vec3 origin, Vec3 direction, bool check_apertures) const override
+    {
+        const LensRay in{Vec3{origin.x, origin.y, length_ - origin.z}, normalized(Vec3{direction.x, direction.y, -direction.z})};
+        const Traced out = (check_apertures ? lens_ : unbounded_).trace_from_image(in);
+        if (out.result != TraceResult::Passed)
+            return SceneRay{origin, direction, false};
+        return scene_ray(Vec3{out.ray.origin.x, out.ray.origin.y, length_ - out.ray.origin.z},
+                         Vec3{out.ray.dir.x, out.ray.dir.y, -out.ray.dir.z});
+    }
+    ImageRay to_image(Vec3 origin, Vec3 direction, bool check_apertures) const override
+    {
+        const LensRay in{Vec3{origin.x, origin.y, length_ - origin.z}, normalized(Vec3{direction.x, direction.y, -direction.z})};
+        const Traced out = (check_apertures ? lens_ : unbounded_).trace_from_object(in);
+        if (out.result != TraceResult::Passed)
+            return ImageRay{origin, direction, false};
+        return image_ray(Vec3{out.ray.origin.x, out.ray.origin.y, length_ - out.ray.origin.z},
+                         Vec3{out.ray.dir.x, out.ray.dir.y, -out.ray.dir.z});
+    }
+    HomogeneousPoint paraxial_image(Vec3 point) const override { return paraxial_.paraxial_image(point); }
+
+private:
+    TracingLens lens_;
+    // Chief rays and depth maps want a ray for every pixel: no clear aperture blocks.
+    static Prescription unbounded(Prescription lens)
+    {
+        for (LensSurface& surface : lens.surfaces)
+            surface.aperture_mm = INFINITY;
+        lens.blades = 0;
+        return lens;
+    }
+    TracingLens unbounded_;  // the same without clear apertures or iris
+    double length_;
+    ThickMainLens paraxial_;
+};
+
+} // namespace
+
+std::shared_ptr<const MainLens> make_prescription_lens(const Prescription& lens, double stop_mm, bool exact,
+                                                       double image_distance_mm)
+{
+    Prescription sized = lens;
+    if (stop_mm > 0)
+        for (LensSurface& surface : sized.surfaces)
+            if (surface.stop)
+                surface.aperture_mm = stop_mm;
+    const ParaxialData p = paraxial_data(sized, 0, image_distance_mm);
+    if (!p.valid)
+        return nullptr;
+    const double length = p.rear_vertex_z;  // front vertex at z_optics = length, rear at 0
+    const ThickMainLens thick(p.efl_mm, length - p.front_principal_z, length - p.rear_principal_z,
+                              length - p.exit_pupil_z, 0.5 * p.exit_pupil_mm);
+    if (!exact)
+        return std::make_shared<ThickMainLens>(thick);
+    return std::make_shared<ExactMainLens>(sized, length, thick);
+}
+
+SceneRay scene_ray(Vec3 origin, Vec3 direction)
+{
+    const Vec3 unit = normalized(direction);
+    const bool ok = is_finite(origin) && is_finite(unit) && unit.z > 0;
+    return SceneRay{origin, unit, ok};
+}
+
+ImageRay image_ray(Vec3 origin, Vec3 direction)
+{
+    const Vec3 unit = normalized(direction);
+    const bool ok = is_finite(origin) && is_finite(unit) && unit.z < 0;
+    return ImageRay{origin, unit, ok};
+}
+
+std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& p, double distance_mm)
+{
+    if (!p.given)
+        return nullptr;
+    switch (p.type) {
+    case MainLensType::Pinhole:
+        return std::make_shared<PinholeMainLens>();
+    case MainLensType::ThinLens: {
+        const double aperture = p.has_aperture ? p.aperture_mm : p.focal_length_mm / p.f_number;
+        if (p.has_distortion)
+            return std::make_shared<ThinMainLens>(p.focal_length_mm, aperture, p.distortion, -distance_mm);
+        return std::make_shared<ThinMainLens>(p.focal_length_mm, aperture);
+    }
+    case MainLensType::ThickLens:
+    case MainLensType::Prescription:
+        return make_prescription_lens(effective_prescription(p), 0, p.type == MainLensType::Prescription, distance_mm);
+    case MainLensType::None:
+        break;
+    }
+    return nullptr;
+}
+
+} // namespace plenoptic

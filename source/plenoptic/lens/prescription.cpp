@@ -1,0 +1,595 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Prescription lenses: reading, checking, paraxial data and the exact trace (see the header).
+
+#include "plenoptic/lens/prescription.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <iomanip>
+#include <sstream>
+
+namespace plenoptic {
+
+namespace {
+
+const double kPi = 3.14159265358979323846;
+
+std::string row_name(const LensSurface& s, int index)
+{
+    std::ostringstream out;
+    out << (s.stop ? "the stop (surface " : "surface ") << index + 1 << (s.stop ? ")" : "");
+    return out.str();
+}
+
+std::string mm(double value)
+{
+    std::ostringstream out;
+    out << std::setprecision(6) << value << " mm";
+    return out.str();
+}
+
+// row_name with the row's line: "surface 3 (line 7)", "the stop (surface 2, line 6)".
+std::string row_at(const LensSurface& s, int index)
+{
+    const std::string line = s.line > 0 ? "line " + std::to_string(s.line) : std::string();
+    if (s.stop)
+        return "the stop (surface " + std::to_string(index + 1) + (line.empty() ? "" : ", " + line) + ")";
+    return row_name(s, index) + (line.empty() ? "" : " (" + line + ")");
+}
+
+// How far a surface's sphere lies from its vertex plane at height h from the axis (+z towards
+// the image), for h within its clear aperture: R - sign(R) sqrt(R^2 - h^2), written without
+// cancellation. 0 for a flat surface and the stop.
+double sag(const LensSurface& s, double h)
+{
+    if (s.stop || s.radius_mm == 0)
+        return 0;
+    const double R = s.radius_mm;
+    const double root = std::sqrt(std::max(0.0, R * R - h * h));
+    return h * h / (R + (R > 0 ? root : -root));
+}
+
+// Consecutive rows i and i + 1 cross when, somewhere within the smaller of their clear
+// apertures, row i + 1 lies in front of row i (towards the object). Their axial gap
+// thickness_i + sag_{i+1}(h) - sag_i(h) is monotonic in h^2 (each sag is, and the difference
+// of two sags of one sign is, since d sag / d(h^2) = 1 / (2 sqrt(R^2 - h^2)) shrinks with |R|),
+// so it is least at the axis or at the rim: if the rim's gap is negative, the crossing height is
+// where the gap is 0, found by bisection.
+std::string crossing(const Prescription& lens, int i)
+{
+    const LensSurface& a = lens.surfaces[i];
+    const LensSurface& b = lens.surfaces[i + 1];
+    const double rim = 0.5 * std::min(a.aperture_mm, b.aperture_mm);
+    const auto gap = [&](double h) { return a.thickness_mm + sag(b, h) - sag(a, h); };
+    const double at_rim = gap(rim);
+    const double tolerance = 1e-9 + 1e-12 * (std::fabs(sag(a, rim)) + std::fabs(sag(b, rim)) + a.thickness_mm);
+    if (!(at_rim < -tolerance))
+        return "";
+    double lo = 0, hi = rim;  // gap(lo) >= 0 > gap(hi)
+    for (int k = 0; k < 200 && hi - lo > 1e-12 * rim; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (gap(mid) >= 0 ? lo : hi) = mid;
+    }
+    std::ostringstream msg;
+    msg << row_at(a, i) << " and " << row_at(b, i + 1) << " cross inside their clear apertures: they meet "
+        << mm(lo) << " from the axis, and at " << mm(rim) << " from it (the smaller clear aperture's rim) "
+        << row_name(b, i + 1) << " lies " << mm(-at_rim) << " in front of " << row_name(a, i)
+        << "; consecutive surfaces may touch but not cross within their clear apertures (a larger thickness on "
+        << row_name(a, i) << ", now " << mm(a.thickness_mm) << ", or smaller apertures)";
+    return msg.str();
+}
+
+bool parse_number(const std::string& token, double* value)
+{
+    errno = 0;
+    char* end = nullptr;
+    const double v = std::strtod(token.c_str(), &end);
+    if (end == token.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(v))
+        return false;
+    *value = v;
+    return true;
+}
+
+// 2x2 paraxial transfer matrix on (height y, reduced angle n u).
+struct Mat2 {
+    double a, b, c, d;  // [[a, b], [c, d]]
+};
+
+Mat2 operator*(const Mat2& x, const Mat2& y)
+{
+    return Mat2{x.a * y.a + x.b * y.c, x.a * y.b + x.b * y.d, x.c * y.a + x.d * y.c, x.c * y.b + x.d * y.d};
+}
+
+const Mat2 kIdentity{1, 0, 0, 1};
+Mat2 refraction(double power) { return Mat2{1, 0, -power, 1}; }
+Mat2 transfer(double thickness, double index) { return Mat2{1, thickness / index, 0, 1}; }
+
+// Index of the medium after surface i (the stop keeps the medium before it).
+double medium_after(const Prescription& lens, int i)
+{
+    double n = 1;
+    for (int k = 0; k <= i; ++k)
+        if (!lens.surfaces[k].stop)
+            n = lens.surfaces[k].ior;
+    return n;
+}
+
+double surface_power(const Prescription& lens, int i)
+{
+    const LensSurface& s = lens.surfaces[i];
+    if (s.stop || s.radius_mm == 0)
+        return 0;
+    const double before = i == 0 ? 1.0 : medium_after(lens, i - 1);
+    return (s.ior - before) / s.radius_mm;
+}
+
+// Matrix from just before surface `from` to just after surface `to` (inclusive), translations
+// between them included.
+Mat2 system_matrix(const Prescription& lens, int from, int to)
+{
+    Mat2 m = kIdentity;
+    for (int i = from; i <= to; ++i) {
+        if (i > from)
+            m = transfer(lens.surfaces[i - 1].thickness_mm, medium_after(lens, i - 1)) * m;
+        m = refraction(surface_power(lens, i)) * m;
+    }
+    return m;
+}
+
+int stop_index(const Prescription& lens)
+{
+    for (size_t i = 0; i < lens.surfaces.size(); ++i)
+        if (lens.surfaces[i].stop)
+            return int(i);
+    return -1;
+}
+
+// Inside the stop's opening: the circle of the stop's diameter, or the iris polygon whose corners
+// lie on that circle.
+bool inside_stop(const Prescription& lens, const LensSurface& stop, double x, double y)
+{
+    const double r = 0.5 * stop.aperture_mm;
+    if (x * x + y * y > r * r)
+        return false;
+    if (lens.blades < 3)
+        return true;
+    const double apothem = r * std::cos(kPi / lens.blades);
+    const double rotation = lens.blade_rotation_deg * kPi / 180;
+    for (int k = 0; k < lens.blades; ++k) {
+        const double angle = rotation + 2 * kPi * k / lens.blades;
+        if (x * std::cos(angle) + y * std::sin(angle) > apothem)
+            return false;
+    }
+    return true;
+}
+
+// Refracts unit direction d at a surface with unit normal `normal` (either orientation) from
+// index n1 into index n2. False on total internal reflection.
+bool refract(Vec3 d, Vec3 normal, double n1, double n2, Vec3* out)
+{
+    Vec3 n = normal;
+    double cos_i = -dot(n, d);
+    if (cos_i < 0) {
+        n = -n;
+        cos_i = -cos_i;
+    }
+    const double eta = n1 / n2;
+    const double k = 1 - eta * eta * (1 - cos_i * cos_i);
+    if (k < 0)
+        return false;
+    *out = normalized(eta * d + (eta * cos_i - std::sqrt(k)) * n);
+    return true;
+}
+
+// Meets surface i (vertex at z) with the ray; false when it misses the surface's sphere, or
+// meets it only behind the ray's origin.
+bool meet_surface(const LensSurface& s, double z, const LensRay& ray, Vec3* hit, Vec3* normal)
+{
+    if (s.stop || s.radius_mm == 0) {
+        if (ray.dir.z == 0)
+            return false;
+        const double t = (z - ray.origin.z) / ray.dir.z;
+        if (!(t > 0))
+            return false;
+        *hit = ray.origin + t * ray.dir;
+        *normal = Vec3{0, 0, -1};
+        return true;
+    }
+    const double R = s.radius_mm;
+    const Vec3 centre{0, 0, z + R};
+    const Vec3 oc = ray.origin - centre;
+    const double b = dot(oc, ray.dir);
+    const double c = dot(oc, oc) - R * R;
+    const double disc = b * b - c;
+    if (!(disc >= 0))
+        return false;
+    const double root = std::sqrt(disc);
+    // Two roots -b -/+ root; the cap around the vertex is met first when the ray travels towards
+    // the centre's side (dir.z > 0 with R > 0, or dir.z < 0 with R < 0), second otherwise.
+    // (Computed as q / a and c / q to keep precision when the roots differ greatly.)
+    const double q = b > 0 ? -b - root : -b + root;
+    double t0 = q, t1 = q != 0 ? c / q : q;
+    if (t0 > t1)
+        std::swap(t0, t1);
+    const bool nearer = (ray.dir.z > 0) == (R > 0);
+    const double t = nearer ? t0 : t1;
+    if (!(t > 0))
+        return false;
+    *hit = ray.origin + t * ray.dir;
+    *normal = (1 / R) * (*hit - centre);
+    return true;
+}
+
+// z[i]: vertex of surface i; before[i], after[i]: the indices on either side of it.
+Traced trace(const Prescription& lens, const double* z, const double* before, const double* after, const LensRay& in,
+             bool from_image)
+{
+    const int count = int(lens.surfaces.size());
+    LensRay ray{in.origin, normalized(in.dir)};
+    for (int step = 0; step < count; ++step) {
+        const int i = from_image ? count - 1 - step : step;
+        const LensSurface& s = lens.surfaces[i];
+        Vec3 hit, normal;
+        if (!meet_surface(s, z[i], ray, &hit, &normal))
+            return Traced{TraceResult::Missed, ray, i};
+        if (s.stop) {
+            if (!inside_stop(lens, s, hit.x, hit.y))
+                return Traced{TraceResult::Stop, LensRay{hit, ray.dir}, i};
+            ray.origin = hit;
+            continue;
+        }
+        const double r = 0.5 * s.aperture_mm;
+        if (hit.x * hit.x + hit.y * hit.y > r * r)
+            return Traced{TraceResult::ClearAperture, LensRay{hit, ray.dir}, i};
+        Vec3 dir;
+        if (!refract(ray.dir, normal, from_image ? after[i] : before[i], from_image ? before[i] : after[i], &dir))
+            return Traced{TraceResult::TotalInternalReflection, LensRay{hit, ray.dir}, i};
+        ray = LensRay{hit, dir};
+    }
+    return Traced{TraceResult::Passed, ray, -1};
+}
+
+// axial_limit with the stop at diameter stop_mm. The paraxial marginal ray through the axial
+// image point at z = rear vertex + D: in front of the lens it is (y0, u0) with
+// (S.a + D S.c) y0 + (S.b + D S.d) u0 = 0 (height 0 on that plane); traced forward, its height at
+// each surface's vertex. Heights scale with the ray, so the ratios of opening radius to height
+// order the apertures whatever ray is taken.
+AxialLimit axial_limit_sized(const Prescription& lens, double stop_mm, double image_distance_mm)
+{
+    AxialLimit limit;
+    const int count = int(lens.surfaces.size());
+    const int k = stop_index(lens);
+    if (count == 0 || k < 0 || !std::isfinite(image_distance_mm))
+        return limit;
+    const Mat2 S = system_matrix(lens, 0, count - 1);
+    const double D = image_distance_mm;
+    const double y0 = S.b + D * S.d, u0 = -(S.a + D * S.c);
+    double y = y0, nu = u0, n = 1;
+    double stop_ratio = INFINITY, stop_height = 0, rim_ratio = INFINITY;
+    for (int i = 0; i < count; ++i) {
+        const LensSurface& s = lens.surfaces[i];
+        if (i > 0)
+            y += lens.surfaces[i - 1].thickness_mm * nu / n;
+        const double radius = 0.5 * (s.stop ? stop_mm : s.aperture_mm);
+        const double ratio = y != 0 ? radius / std::fabs(y) : INFINITY;
+        if (s.stop) {
+            stop_ratio = ratio;
+            stop_height = std::fabs(y);
+            continue;
+        }
+        if (ratio < rim_ratio) {
+            rim_ratio = ratio;
+            limit.rim = i;
+        }
+        if (s.radius_mm != 0)
+            nu -= y * (s.ior - n) / s.radius_mm;
+        n = s.ior;
+    }
+    if (!std::isfinite(y) || !std::isfinite(nu))
+        return limit;
+    limit.valid = true;
+    limit.largest_stop_mm = limit.rim >= 0 ? 2 * stop_height * rim_ratio : INFINITY;
+    limit.surface = limit.rim >= 0 && rim_ratio < stop_ratio * (1 - kApertureTolerance) ? limit.rim : k;
+    return limit;
+}
+
+} // namespace
+
+double flat_radius(double radius_mm)
+{
+    return std::fabs(radius_mm) > kPrescriptionMaxLengthMm ? 0.0 : radius_mm;
+}
+
+double reduced_blade_rotation(double degrees, int blades)
+{
+    if (!std::isfinite(degrees))
+        return degrees;
+    // fmod is exact; the second step's rounding is at most an ulp of 360 degrees.
+    double turn = std::fmod(degrees, 360.0);
+    if (turn < 0)
+        turn += 360.0;
+    if (blades >= 3) {
+        const double period = 360.0 / blades;
+        turn -= std::floor(turn / period) * period;
+        if (!(turn >= 0 && turn < period))
+            turn = 0;  // only a rounding at the period itself lands here
+    } else if (turn >= 360.0) {
+        turn = 0;  // -tiny + 360 rounds to 360
+    }
+    return turn;
+}
+
+ParsedPrescription parse_lens_file(const std::string& file_text)
+{
+    ParsedPrescription parsed = ParsedPrescription();
+    // A UTF-8 byte-order mark (editors on Windows write one) is not part of the first row.
+    const std::string bom = "\xEF\xBB\xBF";
+    const std::string text = file_text.compare(0, bom.size(), bom) == 0 ? file_text.substr(bom.size()) : file_text;
+    std::istringstream lines(text);
+    std::string line;
+    int number = 0;
+    while (std::getline(lines, line)) {
+        ++number;
+        const size_t hash = line.find('#');
+        if (hash != std::string::npos)
+            line.erase(hash);
+        std::istringstream fields(line);
+        std::vector<std::string> tokens;
+        std::string token;
+        while (fields >> token)
+            tokens.push_back(token);
+        if (tokens.empty())
+            continue;
+        if (tokens.size() != 4) {
+            std::ostringstream msg;
+            msg << "a lens file row has four numbers (radius, thickness, index of refraction, aperture "
+                   "diameter, in mm); this one has "
+                << tokens.size();
+            parsed.error = PrescriptionError{msg.str(), number};
+            return parsed;
+        }
+        double v[4];
+        for (int k = 0; k < 4; ++k)
+            if (!parse_number(tokens[k], &v[k])) {
+                parsed.error = PrescriptionError{"'" + tokens[k] + "' is not a finite number", number};
+                return parsed;
+            }
+        const bool stop = v[0] == 0;
+        parsed.prescription.surfaces.push_back(LensSurface{stop ? 0.0 : flat_radius(v[0]), v[1], v[2], v[3], stop, number});
+    }
+    if (parsed.prescription.surfaces.empty()) {
+        const std::string what = file_text.empty()
+            ? "the lens file is empty (0 bytes)"
+            : "the lens file holds no surface row (only " +
+                  std::string(text.find_first_not_of(" \t\r\n\f\v") == std::string::npos ? "blank lines" : "comments and blank lines") +
+                  ")";
+        parsed.error = PrescriptionError{what + "; a lens file has one row per surface, object side first, of four numbers "
+                                                "(radius, thickness, index of refraction, aperture diameter, in mm)", 0};
+        return parsed;
+    }
+    parsed.error = check_prescription(parsed.prescription);
+    return parsed;
+}
+
+PrescriptionError check_prescription(const Prescription& lens)
+{
+    if (lens.surfaces.empty())
+        return PrescriptionError{"a prescription needs at least one surface", 0};
+    int stops = 0, first_stop = -1;
+    for (size_t i = 0; i < lens.surfaces.size(); ++i) {
+        const LensSurface& s = lens.surfaces[i];
+        const std::string name = row_name(s, int(i));
+        if (!std::isfinite(s.radius_mm) || !std::isfinite(s.thickness_mm) || !std::isfinite(s.ior) ||
+            !std::isfinite(s.aperture_mm))
+            return PrescriptionError{name + ": every number must be finite", s.line};
+        const double bound = kPrescriptionMaxLengthMm;
+        if (std::fabs(s.radius_mm) > bound)
+            return PrescriptionError{name + ": the radius " + mm(s.radius_mm) + " lies beyond +-" + mm(bound) +
+                                         " (a lens file or prescription { } reads such a radius as a flat surface, radius 0)",
+                                     s.line};
+        if (s.thickness_mm > bound)
+            return PrescriptionError{name + ": the thickness " + mm(s.thickness_mm) + " exceeds " + mm(bound) +
+                                         ", the bound of every length",
+                                     s.line};
+        if (s.aperture_mm > bound)
+            return PrescriptionError{name + ": the aperture diameter " + mm(s.aperture_mm) + " exceeds " + mm(bound) +
+                                         ", the bound of every length",
+                                     s.line};
+        if (!(s.aperture_mm > 0))
+            return PrescriptionError{name + ": the aperture diameter must be > 0 mm", s.line};
+        if (s.thickness_mm < 0)
+            return PrescriptionError{name + ": the thickness must be >= 0 mm", s.line};
+        if (s.stop) {
+            if (++stops == 2) {
+                std::ostringstream msg;
+                msg << "two aperture stops (rows with radius 0): surfaces " << first_stop + 1 << " and " << i + 1
+                    << "; a lens has exactly one";
+                return PrescriptionError{msg.str(), s.line};
+            }
+            first_stop = int(i);
+            const double before = i == 0 ? 1.0 : medium_after(lens, int(i) - 1);
+            if (s.ior != 0 && s.ior != before)
+                return PrescriptionError{name + ": the stop does not refract; its index must be 0 or that of the "
+                                                "medium it stands in",
+                                         s.line};
+            continue;
+        }
+        if (!(s.ior >= 1))
+            return PrescriptionError{name + ": the index of refraction must be >= 1", s.line};
+        if (s.radius_mm != 0 && s.aperture_mm > 2 * std::fabs(s.radius_mm))
+            return PrescriptionError{name + ": the aperture diameter exceeds the surface's sphere (diameter 2 |radius|)",
+                                     s.line};
+    }
+    if (stops == 0)
+        return PrescriptionError{"the prescription has no aperture stop (a row with radius 0)", 0};
+    if (medium_after(lens, int(lens.surfaces.size()) - 1) != 1)
+        return PrescriptionError{row_name(lens.surfaces.back(), int(lens.surfaces.size()) - 1) +
+                                     ": the last surface must open into air (index 1), where the sensor is",
+                                 lens.surfaces.back().line};
+    for (size_t i = 0; i + 1 < lens.surfaces.size(); ++i) {
+        const std::string message = crossing(lens, int(i));
+        if (!message.empty())
+            return PrescriptionError{message, lens.surfaces[i].line};
+    }
+    // The power, in one pass (system_matrix looks each medium up from the first surface).
+    Mat2 S = kIdentity;
+    double n = 1;
+    for (size_t i = 0; i < lens.surfaces.size(); ++i) {
+        const LensSurface& s = lens.surfaces[i];
+        if (i > 0)
+            S = transfer(lens.surfaces[i - 1].thickness_mm, n) * S;
+        if (s.stop)
+            continue;
+        if (s.radius_mm != 0)
+            S = refraction((s.ior - n) / s.radius_mm) * S;
+        n = s.ior;
+    }
+    if (S.c > 0) {
+        std::ostringstream msg;
+        msg << "the lens has a negative focal length: its effective focal length is " << mm(-1 / S.c)
+            << " (paraxial, from its surfaces), a diverging lens, or a system that forms an intermediate image "
+               "(a relay); the camera's f-number, pupils, focus and metadata need a main lens with a positive "
+               "focal length, so such a lens is not supported";
+        return PrescriptionError{msg.str(), 0};
+    }
+    return PrescriptionError{"", 0};
+}
+
+std::vector<double> vertex_positions(const Prescription& lens)
+{
+    std::vector<double> z(lens.surfaces.size());
+    double at = 0;
+    for (size_t i = 0; i < lens.surfaces.size(); ++i) {
+        z[i] = at;
+        at += lens.surfaces[i].thickness_mm;
+    }
+    return z;
+}
+
+ParaxialData paraxial_data(const Prescription& lens, double stop_mm, double image_distance_mm)
+{
+    ParaxialData p;
+    const int count = int(lens.surfaces.size());
+    const int k = stop_index(lens);
+    if (count == 0 || k < 0)
+        return p;
+    const std::vector<double> z = vertex_positions(lens);
+    const Mat2 S = system_matrix(lens, 0, count - 1);
+    if (S.c == 0)
+        return p;  // afocal
+    p.efl_mm = -1 / S.c;
+    p.rear_vertex_z = z[count - 1];
+    p.bfd_mm = S.a * p.efl_mm;
+    p.ffd_mm = S.d * p.efl_mm;
+    p.rear_focal_z = p.rear_vertex_z + p.bfd_mm;
+    p.front_focal_z = -p.ffd_mm;
+    p.rear_principal_z = p.rear_focal_z - p.efl_mm;
+    p.front_principal_z = p.front_focal_z + p.efl_mm;
+    p.stop_z = z[k];
+    p.stop_mm = stop_mm > 0 ? stop_mm : lens.surfaces[k].aperture_mm;
+    // The aperture the pupils image: the stop, or the one that limits the axial beam.
+    int a = k;
+    double a_mm = p.stop_mm;
+    if (std::isfinite(image_distance_mm)) {
+        const AxialLimit limit = axial_limit_sized(lens, p.stop_mm, image_distance_mm);
+        if (!limit.valid)
+            return p;
+        a = limit.surface;
+        a_mm = a == k ? p.stop_mm : lens.surfaces[a].aperture_mm;
+        p.largest_stop_mm = limit.largest_stop_mm;
+    }
+    p.aperture_surface = a;
+    p.aperture_z = z[a];
+    p.aperture_mm = a_mm;
+    // Entrance pupil: the aperture imaged by the surfaces in front of it, seen from object space
+    // (a rim lies on its own surface, whose refraction leaves it where it is).
+    Mat2 F = kIdentity;
+    if (a > 0)
+        F = transfer(lens.surfaces[a - 1].thickness_mm, medium_after(lens, a - 1)) * system_matrix(lens, 0, a - 1);
+    if (F.a == 0)
+        return p;  // entrance pupil at infinity
+    p.entrance_pupil_z = F.b / F.a;
+    p.entrance_pupil_mm = a_mm / std::fabs(F.a);
+    // Exit pupil: the aperture imaged by the surfaces behind it, seen from image space.
+    Mat2 B = kIdentity;
+    if (a < count - 1)
+        B = system_matrix(lens, a + 1, count - 1) * transfer(lens.surfaces[a].thickness_mm, medium_after(lens, a));
+    if (B.d == 0)
+        return p;  // exit pupil at infinity
+    const double s = -B.b / B.d;
+    p.exit_pupil_z = p.rear_vertex_z + s;
+    p.exit_pupil_mm = a_mm * std::fabs(B.a + s * B.c);
+    p.f_number = p.efl_mm / p.entrance_pupil_mm;
+    p.valid = std::isfinite(p.efl_mm) && std::isfinite(p.entrance_pupil_z) && std::isfinite(p.exit_pupil_z);
+    return p;
+}
+
+ImageDistance paraxial_image_distance(const Prescription& lens, double object_mm)
+{
+    const int count = int(lens.surfaces.size());
+    if (count == 0)
+        return ImageDistance{false, 0};
+    const Mat2 S = system_matrix(lens, 0, count - 1);
+    double s;
+    if (std::isinf(object_mm))
+        s = S.c == 0 ? INFINITY : -S.a / S.c;
+    else {
+        const double denominator = S.c * object_mm + S.d;
+        s = denominator == 0 ? INFINITY : -(S.a * object_mm + S.b) / denominator;
+    }
+    return ImageDistance{std::isfinite(s) && s > 0, s};
+}
+
+TracingLens::TracingLens(const Prescription& lens)
+    : lens_(lens), z_(vertex_positions(lens)), before_(lens.surfaces.size()), after_(lens.surfaces.size())
+{
+    lens_.blade_rotation_deg = reduced_blade_rotation(lens.blade_rotation_deg, lens.blades);
+    double n = 1;
+    for (size_t i = 0; i < lens.surfaces.size(); ++i) {
+        before_[i] = n;
+        if (!lens.surfaces[i].stop)
+            n = lens.surfaces[i].ior;
+        after_[i] = lens.surfaces[i].stop ? before_[i] : lens.surfaces[i].ior;
+    }
+}
+
+Traced TracingLens::trace_from_image(const LensRay& in) const
+{
+    return trace(lens_, z_.data(), before_.data(), after_.data(), in, true);
+}
+
+Traced TracingLens::trace_from_object(const LensRay& in) const
+{
+    return trace(lens_, z_.data(), before_.data(), after_.data(), in, false);
+}
+
+Traced trace_from_image(const Prescription& lens, const LensRay& in) { return TracingLens(lens).trace_from_image(in); }
+Traced trace_from_object(const Prescription& lens, const LensRay& in) { return TracingLens(lens).trace_from_object(in); }
+
+double stop_diameter_for_f_number(const Prescription& lens, double f_number)
+{
+    const ParaxialData full = paraxial_data(lens);
+    if (!full.valid || !(f_number > 0))
+        return NAN;
+    // The entrance pupil scales with the stop: EP = stop / |F.a|.
+    const double ratio = full.entrance_pupil_mm / full.stop_mm;
+    return full.efl_mm / f_number / ratio;
+}
+
+double f_number_for_stop_diameter(const Prescription& lens, double stop_mm)
+{
+    const ParaxialData full = paraxial_data(lens);
+    if (!full.valid || !(stop_mm > 0))
+        return NAN;
+    return full.efl_mm / (stop_mm * full.entrance_pupil_mm / full.stop_mm);
+}
+
+AxialLimit axial_limit(const Prescription& lens, double image_distance_mm)
+{
+    const int k = stop_index(lens);
+    return axial_limit_sized(lens, k >= 0 ? lens.surfaces[size_t(k)].aperture_mm : 0, image_distance_mm);
+}
+
+} // namespace plenoptic

@@ -1,0 +1,191 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Exit-pupil bounds of a real lens per field radius (see the header).
+//
+// For a field point P = (r, 0, plane_z) the rays that pass all pass the rear surface inside its
+// clear aperture, so they cross the exit pupil's plane inside the shadow of that aperture cast from
+// P: a square around it is searched on a grid. The passing grid points give a first centre and
+// radius; the radius is then refined along kAzimuths directions from the centre by bisection on
+// the boundary, which the grid knows only to a cell. The region is close to convex (an
+// intersection of the apertures' images), so the largest boundary distance with a small margin
+// holds it. Points between two bins use a disc holding both bins' discs.
+
+#include "plenoptic/lens/pupil_bounds.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "plenoptic/core/setup_progress.h"
+
+namespace plenoptic {
+
+namespace {
+
+const int kBins = 48;            // field radii sampled from the axis to the edge of the field
+const int kGrid = 48;            // grid points a side over the search square
+const int kAzimuths = 64;        // boundary directions refined by bisection
+const int kBisections = 24;      // steps of each bisection (2^-24 of the grid radius)
+const double kMargin = 1.01;     // radius margin for the bins, and again for points between them
+const int kMaxFieldDoublings = 60;
+
+const double kPi = 3.14159265358979323846;
+
+struct Probe {
+    const MainLens& lens;
+    double plane_z, pupil_z;
+    bool passes(double r, double x, double y) const
+    {
+        const Vec3 from{r, 0, plane_z};
+        return lens.to_scene(from, Vec3{x, y, pupil_z} - from, true).passed;
+    }
+};
+
+// The square of the exit pupil's plane (centre x, half-size) that the rear surface's clear aperture
+// shadows from (r, 0, plane_z): the aperture's rim lies somewhere between the rear vertex's plane
+// and its sag, so both planes' shadows are joined.
+void search_square(const Prescription& lens, double r, double plane_z, double pupil_z, double* centre_x, double* half)
+{
+    const LensSurface& rear = lens.surfaces.back();
+    const double a = 0.5 * rear.aperture_mm;
+    double sag = 0;
+    if (rear.radius_mm != 0 && !rear.stop)
+        sag = std::fabs(rear.radius_mm) - std::sqrt(std::max(0.0, rear.radius_mm * rear.radius_mm - a * a));
+    double lo = INFINITY, hi = -INFINITY;
+    for (double z_rim : {-sag, sag}) {
+        const double t = (pupil_z - plane_z) / (z_rim - plane_z);  // P + t (rim - P) reaches the pupil plane
+        const double c = r + t * (0 - r);
+        lo = std::min(lo, c - std::fabs(t) * a);
+        hi = std::max(hi, c + std::fabs(t) * a);
+    }
+    *centre_x = 0.5 * (lo + hi);
+    *half = 0.5 * (hi - lo);
+}
+
+// Whether any ray from field radius r passes, and then the bin's disc.
+bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* centre_x, double* radius)
+{
+    double sx, half;
+    search_square(lens, r, probe.plane_z, probe.pupil_z, &sx, &half);
+    if (!(std::isfinite(sx) && std::isfinite(half) && half > 0))
+        return false;
+    const double cell = 2 * half / kGrid;
+    double lo = INFINITY, hi = -INFINITY, y_hi = 0;
+    std::vector<Vec2> passing;
+    for (int j = 0; j < kGrid; ++j) {
+        for (int i = 0; i < kGrid; ++i) {
+            const double x = sx - half + (i + 0.5) * cell, y = -half + (j + 0.5) * cell;
+            if (!probe.passes(r, x, y))
+                continue;
+            passing.push_back(Vec2{x, y});
+            lo = std::min(lo, x);
+            hi = std::max(hi, x);
+            y_hi = std::max(y_hi, std::fabs(y));
+        }
+    }
+    if (passing.empty())
+        return false;
+    const double cx = 0.5 * (lo + hi);
+    double grid_radius = 0;
+    for (const Vec2& p : passing)
+        grid_radius = std::max(grid_radius, std::hypot(p.x - cx, p.y));
+    grid_radius += 2 * cell;  // a passing point lies within a cell diagonal of a passing grid point
+    double refined = 0;
+    if (probe.passes(r, cx, 0)) {
+        for (int k = 0; k < kAzimuths; ++k) {
+            const double angle = 2 * kPi * k / kAzimuths;
+            const double dx = std::cos(angle), dy = std::sin(angle);
+            double inside = 0, outside = grid_radius;
+            for (int s = 0; s < kBisections; ++s) {
+                const double mid = 0.5 * (inside + outside);
+                if (probe.passes(r, cx + mid * dx, mid * dy))
+                    inside = mid;
+                else
+                    outside = mid;
+            }
+            refined = std::max(refined, outside);
+        }
+        // Between two of the directions a convex region's boundary reaches at most 1 / cos(pi / n)
+        // times farther; and a region the bisection misread must still hold the grid's points.
+        refined /= std::cos(kPi / kAzimuths);
+        for (const Vec2& p : passing)
+            refined = std::max(refined, std::hypot(p.x - cx, p.y));
+    } else {
+        refined = grid_radius;  // not star-shaped about its centre: keep the grid's bound
+    }
+    *centre_x = cx;
+    *radius = std::min(grid_radius, refined * kMargin);
+    return true;
+}
+
+// The smallest disc holding two discs centred on the x axis.
+void enclose(double c1, double r1, double c2, double r2, double* c, double* r)
+{
+    const double lo = std::min(c1 - r1, c2 - r2), hi = std::max(c1 + r1, c2 + r2);
+    *c = 0.5 * (lo + hi);
+    *r = 0.5 * (hi - lo);
+}
+
+} // namespace
+
+PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, double plane_z)
+    : plane_z_(plane_z), pupil_z_(traced.exit_pupil_centre().z), step_mm_(0), field_radius_mm_(0), reach_mm_(0)
+{
+    const Probe probe{traced, plane_z, pupil_z_};
+    // The edge of the field: double a radius until no light passes, then bins up to it.
+    double cx, radius;
+    double edge = 0.5 * lens.surfaces.back().aperture_mm;
+    for (int k = 0; k < kMaxFieldDoublings && bin_disc(lens, probe, edge, &cx, &radius); ++k) {
+        edge *= 2;
+        report_setup("pupil bounds", 0, kBins + 1);
+    }
+    step_mm_ = edge / kBins;
+    std::vector<Bin> bins;
+    for (int i = 0; i <= kBins; ++i) {
+        report_setup("pupil bounds", i, kBins + 1);
+        Bin bin{0, 0};
+        if (bin_disc(lens, probe, i * step_mm_, &cx, &radius))
+            bin = Bin{cx, radius};
+        bins.push_back(bin);
+        if (bin.radius > 0)
+            field_radius_mm_ = (i + 1) * step_mm_;
+    }
+    report_setup("pupil bounds", kBins + 1, kBins + 1);
+    for (int i = 0; i < kBins; ++i) {
+        const Bin& a = bins[i];
+        const Bin& b = bins[i + 1];
+        Bin span{0, 0};
+        if (a.radius > 0 && b.radius > 0)
+            enclose(a.centre_x, a.radius, b.centre_x, b.radius, &span.centre_x, &span.radius);
+        else if (a.radius > 0 || b.radius > 0)
+            span = a.radius > 0 ? a : b;  // the field's edge lies between them: keep the lit one
+        span.radius *= kMargin;
+        spans_.push_back(span);
+        reach_mm_ = std::max(reach_mm_, std::fabs(span.centre_x) + span.radius);
+    }
+}
+
+PupilDisc PupilBounds::disc_for(Vec3 point) const
+{
+    // Not hypot: radii of millimetres neither overflow nor underflow, and this runs per sample.
+    const double r = std::sqrt(point.x * point.x + point.y * point.y);
+    const double at = r / step_mm_;
+    if (!(at < kBins))
+        return PupilDisc{Vec3{0, 0, pupil_z_}, 0};
+    const Bin& span = spans_[size_t(at)];
+    // The bin's +x disc turned to the point's azimuth.
+    const double cx = r > 0 ? span.centre_x * point.x / r : span.centre_x;
+    const double cy = r > 0 ? span.centre_x * point.y / r : 0;
+    return PupilDisc{Vec3{cx, cy, pupil_z_}, span.radius};
+}
+
+bool PupilBounds::may_pass(Vec3 point, Vec3 direction) const
+{
+    const double t = (pupil_z_ - point.z) / direction.z;
+    if (!(t > 0) || !std::isfinite(t))
+        return true;
+    const PupilDisc disc = disc_for(point);
+    const double x = point.x + t * direction.x - disc.centre.x;
+    const double y = point.y + t * direction.y - disc.centre.y;
+    return x * x + y * y <= disc.radius * disc.radius;
+}
+
+} // namespace plenoptic

@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The pupil bounds (lens/pupil_bounds.h) hold every passing ray: a brute-force search over
+// the exit pupil's plane finds no ray that passes the exact lens outside disc_for, and may_pass
+// never refuses one. Ray generation samples these discs (no array) and rejects rays outside them
+// without a trace (with an array), so a ray they missed would be light lost.
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "plenoptic/lens/main_lens.h"
+#include "plenoptic/lens/prescription.h"
+#include "plenoptic/lens/pupil_bounds.h"
+#include "plenoptic/core/test_util.h"
+
+#ifndef PLENOPTIC_LENSES_DIR
+#error "PLENOPTIC_LENSES_DIR must name the lenses/ folder (see CMakeLists.txt)"
+#endif
+
+namespace plenoptic {
+namespace {
+
+using test::vignetting_triplet;
+
+Prescription laikin_wide_angle(double f_number)
+{
+    std::ifstream in(std::string(PLENOPTIC_LENSES_DIR) + "/wide_angle_22mm_laikin_f3.5.dat");
+    std::stringstream text;
+    text << in.rdbuf();
+    ParsedPrescription parsed = parse_lens_file(text.str());
+    EXPECT_FALSE(parsed.error.any()) << parsed.error.message;
+    Prescription lens = parsed.prescription;
+    for (LensSurface& s : lens.surfaces)
+        if (s.stop)
+            s.aperture_mm = stop_diameter_for_f_number(lens, f_number);
+    return lens;
+}
+
+struct Case {
+    const char* name;
+    Prescription lens;
+    double plane_z;  // the sensor (no array) or the array plane
+};
+
+// Every point of a fine grid over the rear element's whole shadow on the exit pupil's plane, from
+// field points on a ray out of the axis (between the bounds' bins as well as on them, and beyond
+// the field's edge): a passing ray lies in the disc, and may_pass agrees.
+void expect_bounds_hold(const Case& c)
+{
+    const std::shared_ptr<const MainLens> traced = make_prescription_lens(c.lens, 0, true);
+    const PupilBounds bounds(c.lens, *traced, c.plane_z);
+    const double pupil_z = traced->exit_pupil_centre().z;
+    const double rear = 0.5 * c.lens.surfaces.back().aperture_mm;
+    const double edge = bounds.field_radius_mm();
+    ASSERT_GT(edge, 0) << c.name;
+    const double azimuth = 0.7;  // radians: the discs turn with the point
+    int passing = 0, outside = 0, refused = 0, beyond = 0;
+    for (int k = 0; k <= 90; ++k) {
+        const double r = 1.15 * edge * k / 90;
+        const Vec3 p{r * std::cos(azimuth), r * std::sin(azimuth), c.plane_z};
+        const PupilDisc disc = bounds.disc_for(p);
+        // The rear opening's shadow on the pupil's plane (both its vertex plane and its rim's
+        // sag lie within 2 rear radii of z = 0), widened.
+        const double scale = (pupil_z - c.plane_z) / (0 - c.plane_z);
+        const double half = 3 * rear * std::fabs(scale) + 1;
+        const Vec3 centre{p.x * (1 - scale), p.y * (1 - scale), pupil_z};
+        const int n = 160;
+        for (int j = 0; j < n; ++j) {
+            for (int i = 0; i < n; ++i) {
+                const Vec3 x{centre.x - half + (i + 0.5) * 2 * half / n, centre.y - half + (j + 0.5) * 2 * half / n, pupil_z};
+                if (!traced->to_scene(p, x - p, true).passed)
+                    continue;
+                ++passing;
+                if (std::hypot(x.x - disc.centre.x, x.y - disc.centre.y) > disc.radius)
+                    ++outside;
+                if (!bounds.may_pass(p, x - p))
+                    ++refused;
+                if (r > edge)
+                    ++beyond;
+            }
+        }
+    }
+    EXPECT_GT(passing, 10000) << c.name;
+    EXPECT_EQ(outside, 0) << c.name;
+    EXPECT_EQ(refused, 0) << c.name;
+    EXPECT_EQ(beyond, 0) << c.name;
+}
+
+TEST(PupilBounds, HoldEveryPassingRayOfTheTriplet)
+{
+    expect_bounds_hold(Case{"triplet, sensor 45 mm behind", vignetting_triplet(), -45});
+    expect_bounds_hold(Case{"triplet, array 37 mm behind", vignetting_triplet(), -37});
+}
+
+TEST(PupilBounds, HoldEveryPassingRayOfTheWideAngle)
+{
+    expect_bounds_hold(Case{"Laikin f/3.5", laikin_wide_angle(3.5), -40});
+    expect_bounds_hold(Case{"Laikin f/2", laikin_wide_angle(2), -40});
+}
+
+TEST(PupilBounds, MayPassRefusesWhatMissesTheDisc)
+{
+    const Prescription lens = vignetting_triplet();
+    const std::shared_ptr<const MainLens> traced = make_prescription_lens(lens, 0, true);
+    const PupilBounds bounds(lens, *traced, -45);
+    const Vec3 p{2, 1, -45};
+    const PupilDisc disc = bounds.disc_for(p);
+    const Vec3 inside{disc.centre.x + 0.5 * disc.radius, disc.centre.y, disc.centre.z};
+    const Vec3 outside{disc.centre.x, disc.centre.y + 1.01 * disc.radius, disc.centre.z};
+    EXPECT_TRUE(bounds.may_pass(p, inside - p));
+    EXPECT_FALSE(bounds.may_pass(p, outside - p));
+    EXPECT_TRUE(bounds.may_pass(p, p - inside));  // heading away from the pupil: the trace decides
+    EXPECT_FALSE(bounds.may_pass(Vec3{2 * bounds.field_radius_mm(), 0, -45}, Vec3{0, 0, 1}));  // beyond the field
+}
+
+} // namespace
+} // namespace plenoptic

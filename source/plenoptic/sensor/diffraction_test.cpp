@@ -1,0 +1,151 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Diffraction (issue 14, item 2): the Airy kernel against the Airy pattern's closed forms (its
+// first dark ring, and the encircled energy 1 - J0(x)^2 - J1(x)^2, Rayleigh's result), the Airy
+// radius of a Lytro-class camera written out from 1.22 lambda N, and the convolution's bookkeeping.
+
+#include <cmath>
+
+#include <boost/math/special_functions/bessel.hpp>
+#include <gtest/gtest.h>
+
+#include "plenoptic/sensor/diffraction.h"
+#include "plenoptic/core/test_util.h"
+
+namespace plenoptic {
+namespace {
+
+double encircled_energy(double x)
+{
+    const double j0 = boost::math::cyl_bessel_j(0, x), j1 = boost::math::cyl_bessel_j(1, x);
+    return 1 - j0 * j0 - j1 * j1;
+}
+
+TEST(Diffraction, AiryPatternIsDarkAtItsRadiusAndOneAtTheCentre)
+{
+    EXPECT_EQ(airy_intensity(0, 2.5), 1);
+    EXPECT_LT(airy_intensity(2.5, 2.5), 1e-12);
+    // Half maximum at 0.5145 lambda N from the centre (the FWHM is 1.029 lambda N), 1.22 lambda N being the radius.
+    EXPECT_NEAR(airy_intensity(2.5 * 0.5145 / 1.22, 2.5), 0.5, 2e-3);
+}
+
+TEST(Diffraction, KernelHoldsTheEncircledEnergyOfThePattern)
+{
+    // An Airy radius of 6 pixels: the pixels whose centres lie within r of the centre hold the
+    // encircled energy at r, over the energy within the window (4 radii; 95.9 %).
+    const double radius = 6;
+    const AiryKernel k = airy_kernel(radius, radius);
+    EXPECT_EQ(k.kx, 24);
+    EXPECT_EQ(k.ky, 24);
+    double total = 0;
+    for (double w : k.weights)
+        total += w;
+    EXPECT_NEAR(total, 1, 1e-12);
+    const double x1 = 3.8317059702075125;
+    const double window = encircled_energy(kAiryKernelRadii * x1);
+    EXPECT_NEAR(window, 0.959, 0.002);
+    for (double r : {1.0, 1.5, 2.0, 3.0}) {
+        double inside = 0;
+        for (int dy = -k.ky; dy <= k.ky; ++dy)
+            for (int dx = -k.kx; dx <= k.kx; ++dx)
+                if (std::hypot(dx, dy) <= r * radius)
+                    inside += k.at(dx, dy);
+        // Pixels straddle the circle: a ring of about 2 pi r pixels half in, half out.
+        EXPECT_NEAR(inside, encircled_energy(r * x1) / window, 0.012) << "within " << r << " Airy radii";
+    }
+    EXPECT_NEAR(encircled_energy(x1), 0.838, 1e-3);  // Rayleigh's 83.8 % inside the first dark ring
+    // Symmetric: the pattern is round.
+    EXPECT_DOUBLE_EQ(k.at(3, -5), k.at(-5, 3));
+    EXPECT_DOUBLE_EQ(k.at(3, -5), k.at(-3, 5));
+}
+
+TEST(Diffraction, LytroClassMicrolensesSpreadLightByAboutAPixel)
+{
+    // 14 um pitch f/2 microlenses focused at d = f = 28 um on 1.4 um pixels: 1.22 * 0.55 um * 2 =
+    // 1.342 um, 0.96 pixels, in green.
+    CameraParams p = test::plenoptic_camera(GridType::Hexagonal, 0.014, 0.028, 0.028, 6.45, 2, 6.5);
+    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.0014;
+    p.diffraction.given = true;
+    ASSERT_EQ(check_diffraction(p.diffraction, p), "");
+    const Model m = make_model(p);
+    const Diffraction d = diffraction_of(m, p.diffraction);
+    ASSERT_TRUE(d.applied);
+    EXPECT_STREQ(d.aperture, "microlens");
+    EXPECT_NEAR(d.airy_radius_mm[1], 1.22 * 550e-6 * 2, 1e-12);
+    EXPECT_NEAR(d.airy_radius_mm[0] / d.airy_radius_mm[2], 610.0 / 465.0, 1e-12);
+    // The main lens's pattern in the array's plane, not applied: 1.22 lambda D / A.
+    EXPECT_NEAR(d.main_lens_airy_radius_at_array_mm[1], 1.22 * 550e-6 * 6.5 / (6.45 / 2), 1e-12);
+}
+
+TEST(Diffraction, WithoutAnArrayTheExitPupilDiffracts)
+{
+    CameraParams p = test::thin_lens_camera(50, 8, 52);
+    p.diffraction.given = true;
+    p.diffraction.wavelengths_nm[1] = 500;
+    const Diffraction d = diffraction_of(make_model(p), p.diffraction);
+    EXPECT_STREQ(d.aperture, "main_lens");
+    EXPECT_NEAR(d.airy_radius_mm[1], 1.22 * 500e-6 * 52 / (50.0 / 8), 1e-12);
+}
+
+TEST(Diffraction, RefusedWhereAnApertureHasNoSize)
+{
+    CameraParams p = test::plenoptic_camera(GridType::Hexagonal, 0.1, 0, 0.4, 16, 4, 16.5);
+    p.diffraction.given = true;
+    EXPECT_NE(check_diffraction(p.diffraction, p).find("pinhole microlenses"), std::string::npos);
+    CameraParams q;
+    q.main.given = true;
+    q.main.type = MainLensType::Pinhole;
+    q.diffraction.given = true;
+    EXPECT_NE(check_diffraction(q.diffraction, q).find("pinhole main lens"), std::string::npos);
+    EXPECT_NE(check_wavelength(50).find("from 100 to 20000"), std::string::npos);
+    EXPECT_NE(check_wavelength(NAN).find("finite"), std::string::npos);
+    EXPECT_EQ(check_wavelength(550), "");
+}
+
+TEST(Diffraction, RefusesAnAiryPatternWiderThanSixteenPixels)
+{
+    // 50 mm f/8 without an array: 1.22 * 0.61 um * 8.3 = 6.2 um, red; on 0.5 um pixels 12 pixels,
+    // on 0.3 um pixels 21 pixels.
+    CameraParams p = test::thin_lens_camera(50, 8, 52);
+    p.diffraction.given = true;
+    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.0005;
+    EXPECT_EQ(check_diffraction_size(make_model(p), p.diffraction), "");
+    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.0003;
+    const std::string message = check_diffraction_size(make_model(p), p.diffraction);
+    EXPECT_NE(message.find("Airy radius of 20.6"), std::string::npos) << message;
+    EXPECT_NE(message.find("more than 16"), std::string::npos) << message;
+    p.diffraction.given = false;
+    EXPECT_EQ(check_diffraction_size(make_model(p), p.diffraction), "");
+}
+
+TEST(Diffraction, ConvolutionSpreadsAPointIntoTheKernelAndKeepsAFlatField)
+{
+    const int W = 41, H = 31;
+    AiryKernel kernels[3] = {airy_kernel(2.2, 2.2), airy_kernel(2.0, 1.5), airy_kernel(1.6, 1.6)};
+    std::vector<float> picture(size_t(W) * H * 3, 0.0f);
+    for (int c = 0; c < 3; ++c)
+        picture[(size_t(15) * W + 20) * 3 + c] = 1.0f;
+    std::vector<float> two = picture;
+    ASSERT_TRUE(convolve_channels(picture, W, H, 3, kernels, nullptr, 1));
+    ASSERT_TRUE(convolve_channels(two, W, H, 3, kernels, nullptr, 2));
+    EXPECT_EQ(picture, two);  // the same bytes with one or two threads
+    for (int c = 0; c < 3; ++c) {
+        double total = 0;
+        for (int j = 0; j < H; ++j)
+            for (int i = 0; i < W; ++i)
+                total += picture[(size_t(j) * W + i) * 3 + c];
+        EXPECT_NEAR(total, 1, 1e-6);  // light is kept
+        EXPECT_NEAR(picture[(size_t(15 + 2) * W + 20 - 1) * 3 + c], kernels[c].at(-1, 2), 1e-7);
+    }
+    // A flat field stays flat away from the edges (outside counts as black).
+    std::vector<float> flat(size_t(W) * H * 3, 0.5f);
+    ASSERT_TRUE(convolve_channels(flat, W, H, 3, kernels, nullptr, 2));
+    EXPECT_NEAR(flat[(size_t(15) * W + 20) * 3 + 1], 0.5, 1e-6);
+    EXPECT_LT(flat[0], 0.45);
+    // Cancelled: unchanged.
+    std::vector<float> again(size_t(W) * H * 3, 0.25f);
+    EXPECT_FALSE(convolve_channels(again, W, H, 3, kernels, [] { return true; }, 2));
+    EXPECT_EQ(again, std::vector<float>(size_t(W) * H * 3, 0.25f));
+}
+
+} // namespace
+} // namespace plenoptic

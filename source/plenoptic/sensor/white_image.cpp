@@ -1,0 +1,108 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// White images (see the header).
+
+#include "plenoptic/sensor/white_image.h"
+
+#include <algorithm>
+#include <atomic>
+#include <thread>
+
+#include "plenoptic/camera/pixel.h"
+
+namespace plenoptic {
+
+std::string check_white_image(const WhiteImageRequest& request, const CameraParams& params)
+{
+    if (request.f_numbers.empty())
+        return "";
+    if (int(request.f_numbers.size()) > kMaxWhiteImages)
+        return "white_image: f_numbers lists at most " + format_number(kMaxWhiteImages) + " f-numbers, got " +
+               format_number(double(request.f_numbers.size()));
+    const MainLensType type = params.main.given ? params.main.type : MainLensType::None;
+    if (!(type == MainLensType::ThinLens || is_prescription_type(type)))
+        return "white_image: f_numbers needs a main lens with an aperture (thin_lens, thick_lens, lens_file or "
+               "prescription { }); this camera has " +
+               std::string(type == MainLensType::Pinhole ? "a pinhole main lens" : "no main lens");
+    return check_white_image_f_numbers(request, params);
+}
+
+std::string check_white_image_f_numbers(const WhiteImageRequest& request, const CameraParams& params)
+{
+    const std::string repeated = repeated_white_f_number(request);
+    if (!repeated.empty())
+        return repeated;
+    for (size_t k = 0; k < request.f_numbers.size(); ++k) {
+        const double n = request.f_numbers[k];
+        const std::string message = check_f_number(n);
+        if (!message.empty())
+            return "white_image f_numbers: " + message;
+        const std::string camera = check_camera(at_f_number(params, n));
+        if (!camera.empty())
+            return "white_image f_numbers " + format_number(n) + ": " + camera;
+    }
+    return "";
+}
+
+std::string repeated_white_f_number(const WhiteImageRequest& request)
+{
+    for (size_t k = 0; k < request.f_numbers.size(); ++k)
+        for (size_t j = 0; j < k; ++j)
+            if (request.f_numbers[j] == request.f_numbers[k])
+                return "white_image f_numbers lists " + format_number(request.f_numbers[k]) + " twice (values " +
+                       std::to_string(j + 1) + " and " + std::to_string(k + 1) + "); each f-number names its own file (" +
+                       white_image_suffix(request, int(k)) + "): list each once";
+    return "";
+}
+
+CameraParams at_f_number(const CameraParams& params, double f_number)
+{
+    CameraParams p = params;
+    p.main.has_f_number = true;
+    p.main.f_number = f_number;
+    p.main.has_aperture = false;
+    p.main.aperture_mm = 0;
+    return p;
+}
+
+std::vector<float> white_image(const Model& model, int W, int H, const std::function<bool()>& cancelled, int threads)
+{
+    std::vector<float> out(size_t(std::max(0, W)) * std::max(0, H), 0.0f);
+    std::atomic<int> next_row(0);
+    std::atomic<bool> stop(false);
+    auto shade_row = [&](int j) {
+        for (int i = 0; i < W; ++i)
+            out[size_t(j) * W + i] =
+                float(shade_pixel(model, i, j, W, H, [](const OpticsRay&) { return Rgbt{1, 1, 1, 1}; }).r);
+    };
+    auto work = [&]() {
+        for (int j = next_row++; j < H && !stop; j = next_row++)
+            shade_row(j);
+    };
+    const unsigned hardware = std::thread::hardware_concurrency();
+    const int count = threads > 0 ? threads : int(std::max(1u, hardware));
+    std::vector<std::thread> workers;
+    for (int t = 1; t < count && t < H; ++t)
+        workers.push_back(std::thread(work));
+    // The calling thread works too, and looks at `cancelled` between rows.
+    for (int j = next_row++; j < H && !stop; j = next_row++) {
+        if (cancelled && cancelled()) {
+            stop = true;
+            break;
+        }
+        shade_row(j);
+    }
+    for (std::thread& worker : workers)
+        worker.join();
+    if (stop)
+        out.clear();
+    return out;
+}
+
+std::string white_image_suffix(const WhiteImageRequest& request, int k)
+{
+    if (request.f_numbers.empty())
+        return ".white.png";
+    return ".white.f" + format_number(request.f_numbers[size_t(k)]) + ".png";
+}
+
+} // namespace plenoptic

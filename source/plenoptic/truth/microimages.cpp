@@ -1,0 +1,475 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Microimage ground truth: each lens's white-scene microimage, integrated through the renderer's
+// own rays (see the header).
+
+#include "plenoptic/truth/microimages.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <thread>
+
+#include "plenoptic/projection/microimage_lattice.h"
+#include "plenoptic/lens/pupil_bounds.h"
+#include "plenoptic/camera/rays.h"
+#include "plenoptic/camera/rays_internal.h"
+#include "plenoptic/core/sampling.h"
+
+namespace plenoptic {
+
+namespace {
+
+using detail::project_to_array;
+using detail::to_optics;
+
+const double kPi = 3.14159265358979323846;
+const int kCoarseSearch = 24;   // grid points a side when the start point is dark
+const int kMaxDoublings = 8;    // of the bracket, when a boundary lies beyond it
+const int kMaxBisections = 60;
+
+// Area and first moments of light over the sensor, in pixels (corner convention: pixel (i, j)
+// spans [i, i + 1) x [j, j + 1)).
+struct Moments {
+    double area, mu, mv;
+};
+
+// Whether sensor point (u, v) (corner-convention pixels) receives light through the lens at
+// aperture sample (lens_u, lens_v), as the renderer decides it.
+class LensProbe {
+public:
+    LensProbe(const Model& m, int W, int H, LensIndex lens, double lens_u, double lens_v)
+        : m_(m), W_(W), H_(H), lens_(lens), lens_u_(lens_u), lens_v_(lens_v)
+    {
+    }
+
+    bool lit(double u, double v) const
+    {
+        const CameraSample sample{u, v, lens_u_, lens_v_};
+        OpticsRay ray;
+        if (!generate_ray(m_, W_, H_, 0, 0, sample, &lens_, &ray))
+            return false;
+        if (m_.model_overlap)
+            return true;
+        // Without overlap modelling the renderer gives a sensor point the light of its own lens only.
+        LensIndex own;
+        return own_lens(m_, sensor_point(m_, W_, H_, u, v), &own) && own == lens_;
+    }
+
+private:
+    const Model& m_;
+    int W_, H_;
+    LensIndex lens_;
+    double lens_u_, lens_v_;
+};
+
+// A start point inside the lit region: `guess` if lit, else the centroid of the lit points of a
+// coarse grid over the square of half side `reach` around it (or the lit grid point nearest that
+// centroid). False when the grid finds no light.
+bool start_point(const LensProbe& probe, double gu, double gv, double reach, double* su, double* sv)
+{
+    if (probe.lit(gu, gv)) {
+        *su = gu;
+        *sv = gv;
+        return true;
+    }
+    std::vector<Vec2> lit;
+    const double step = 2 * reach / kCoarseSearch;
+    for (int j = 0; j < kCoarseSearch; ++j)
+        for (int i = 0; i < kCoarseSearch; ++i) {
+            const double u = gu - reach + (i + 0.5) * step, v = gv - reach + (j + 0.5) * step;
+            if (probe.lit(u, v))
+                lit.push_back(Vec2{u, v});
+        }
+    if (lit.empty())
+        return false;
+    Vec2 mean{0, 0};
+    for (const Vec2& p : lit)
+        mean = mean + (1.0 / lit.size()) * p;
+    if (probe.lit(mean.x, mean.y)) {
+        *su = mean.x;
+        *sv = mean.y;
+        return true;
+    }
+    const Vec2* nearest = &lit[0];
+    for (const Vec2& p : lit)
+        if (length(p - mean) < length(*nearest - mean))
+            nearest = &p;
+    *su = nearest->x;
+    *sv = nearest->y;
+    return true;
+}
+
+// The lit region star-shaped about a start point: boundary radius per direction by bisection,
+// then area and moments in polar form (trapezoid rule over the periodic angle).
+Moments region_moments(const LensProbe& probe, double gu, double gv, double search, double reach,
+                       const MicroimageOptions& options)
+{
+    double su, sv;
+    if (!start_point(probe, gu, gv, search, &su, &sv))
+        return Moments{0, 0, 0};
+    const double dtheta = 2 * kPi / options.azimuths;
+    double area = 0, mu = 0, mv = 0, previous = 0;
+    for (int a = 0; a < options.azimuths; ++a) {
+        const double c = std::cos(a * dtheta), s = std::sin(a * dtheta);
+        // Bracket [lo lit, hi dark]: near the previous direction's radius when it holds.
+        double lo = 0, hi = reach;
+        if (previous > 0) {
+            const double inner = 0.8 * previous, outer = 1.25 * previous + 0.5;
+            if (probe.lit(su + inner * c, sv + inner * s))
+                lo = inner;
+            if (outer < hi && !probe.lit(su + outer * c, sv + outer * s))
+                hi = outer;
+        }
+        for (int k = 0; k < kMaxDoublings && probe.lit(su + hi * c, sv + hi * s); ++k) {
+            lo = hi;
+            hi *= 2;
+        }
+        for (int k = 0; k < kMaxBisections && hi - lo > options.tolerance_px; ++k) {
+            const double mid = 0.5 * (lo + hi);
+            if (probe.lit(su + mid * c, sv + mid * s))
+                lo = mid;
+            else
+                hi = mid;
+        }
+        const double r = 0.5 * (lo + hi);
+        previous = r;
+        area += 0.5 * r * r * dtheta;
+        mu += r * r * r / 3 * c * dtheta;
+        mv += r * r * r / 3 * s * dtheta;
+    }
+    return Moments{area, area * su + mu, area * sv + mv};
+}
+
+// Sensor pixel (centre convention, unbounded) of an optics-frame point projected from the exit
+// pupil's centre onto the sensor plane.
+bool project_to_sensor_px(const Model& m, int W, int H, Vec3 q, Vec2* px)
+{
+    const Vec3 e = m.lens->exit_pupil_centre();
+    if (!(q.z < e.z))
+        return false;
+    const double t = (m.sensor_z_mm - e.z) / (q.z - e.z);
+    sensor_to_pixel(m, W, H, e.x + t * (q.x - e.x), e.y + t * (q.y - e.y), &px->x, &px->y);
+    return is_finite(*px);
+}
+
+// Area (pixels^2) of the lens's cell projected from the exit pupil's centre onto the sensor.
+double microimage_cell_area_px(const Model& m, int W, int H, LensIndex lens)
+{
+    Vec2 corners[6];
+    const int count = cell_polygon(m.grid, m.pitch_mm, corners);
+    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+    Vec2 px[6];
+    for (int i = 0; i < count; ++i)
+        if (!project_to_sensor_px(m, W, H, to_optics(m, Vec3{c.x + corners[i].x, c.y + corners[i].y, 0}), &px[i]))
+            return 0;
+    double twice = 0;
+    for (int i = 0; i < count; ++i)
+        twice += cross(px[i], px[(i + 1) % count]);
+    return 0.5 * std::fabs(twice);
+}
+
+// Where to look for a lens's microimage at one aperture point: a disc of the sensor (corner-
+// convention pixels) that holds it, or nothing when no light passes.
+struct Guess {
+    bool possible;
+    double u, v, radius_px;
+};
+
+// The disc of the exit pupil's plane through which light from the aperture point h can pass
+// (the pupil bounds of a traced lens; the exit pupil of an ideal one), carried back through the
+// microlens to the sensor: the ray from h towards point q of that plane came from the sensor
+// point h - (h_z - sensor_z) (w' + (h - c) / f), w' = (q - h) / (q_z - h_z) (pinholes: no
+// (h - c) / f). Exact for an array parallel to the sensor, a guess otherwise (the bracket grows
+// where light reaches farther). A pinhole main lens has no pupil disc: the cell's image then.
+Guess guess_region(const Model& m, int W, int H, LensIndex lens, double lens_u, double lens_v, Vec2 lattice_px)
+{
+    const double pixel = std::min(m.pixel_size_mm[0], m.pixel_size_mm[1]);
+    const double behind = effective_array_distance_mm(m);
+    const Vec2 c_local = lens_centre(m.grid, m.pitch_mm, lens);
+    const bool thin = m.microlens == MicrolensType::ThinLens;
+    const Vec2 offset = thin ? sample_cell_uniform(m.grid, m.pitch_mm, lens_u, lens_v) : Vec2{0, 0};
+    const Vec3 h = to_optics(m, Vec3{c_local.x + offset.x, c_local.y + offset.y, 0});
+    PupilDisc disc{m.lens->exit_pupil_centre(), m.lens->exit_pupil_radius()};
+    if (m.pupil_bounds)
+        disc = m.pupil_bounds->disc_for(h);
+    if (m.main_lens == MainLensType::Pinhole || !(disc.radius >= 0)) {
+        const double main = effective_main_distance_mm(m);
+        const double cell = m.cell_circumradius_mm * (main > 0 ? (main + behind) / main : 1);
+        return Guess{true, lattice_px.x + 0.5, lattice_px.y + 0.5, 2 * cell / pixel + 2};
+    }
+    if (disc.radius == 0)
+        return Guess{false, 0, 0, 0};
+    const double along = disc.centre.z - h.z, drop = h.z - m.sensor_z_mm;
+    if (!(along > 0) || !(drop > 0))
+        return Guess{false, 0, 0, 0};
+    double wx = (disc.centre.x - h.x) / along, wy = (disc.centre.y - h.y) / along;
+    if (thin) {
+        const double f = detail::microlens_focal(m, lens);
+        const Vec3 shift = mul(m.pose.rotation, Vec3{offset.x / f, offset.y / f, 0});
+        wx += shift.x;
+        wy += shift.y;
+    }
+    Guess guess{true, 0, 0, disc.radius * drop / along / pixel};
+    sensor_to_pixel(m, W, H, h.x - drop * wx, h.y - drop * wy, &guess.u, &guess.v);
+    guess.u += 0.5;
+    guess.v += 0.5;
+    if (!(std::isfinite(guess.u) && std::isfinite(guess.v) && std::isfinite(guess.radius_px)))
+        return Guess{false, 0, 0, 0};
+    return guess;
+}
+
+// The array-local box (x0, y0, x1, y1) that the picture's corners project to, or false.
+bool picture_on_array(const Model& m, int W, int H, double box[4])
+{
+    box[0] = box[1] = INFINITY;
+    box[2] = box[3] = -INFINITY;
+    const double corners[4][2] = {{0, 0}, {double(W), 0}, {0, double(H)}, {double(W), double(H)}};
+    for (const auto& corner : corners) {
+        Vec2 q;
+        if (!project_to_array(m, sensor_point(m, W, H, corner[0], corner[1]), &q))
+            return false;
+        box[0] = std::min(box[0], q.x);
+        box[1] = std::min(box[1], q.y);
+        box[2] = std::max(box[2], q.x);
+        box[3] = std::max(box[3], q.y);
+    }
+    return true;
+}
+
+} // namespace
+
+MicroimageOptions default_microimage_options()
+{
+    MicroimageOptions options;
+    options.azimuths = 32;
+    options.tolerance_px = 1e-3;
+    options.aperture_points = 3;
+    options.threads = 0;
+    return options;
+}
+
+std::vector<MicroimageTruth> microimage_truth(const Model& m, int W, int H, const MicroimageOptions& options,
+                                              const MicroimageProgress& progress, const MicroimageCancel& cancelled)
+{
+    std::vector<MicroimageTruth> out;
+    if (m.grid == GridType::None || !m.lens || W <= 0 || H <= 0)
+        return out;
+    double box[4];
+    if (!picture_on_array(m, W, H, box))
+        return out;
+    const double p = m.pitch_mm, rows = row_spacing(m.grid, p);
+    // Margins of lenses: a lattice centre in the picture may belong to a lens whose centre
+    // projects just outside the box of the corners (the centres project from the exit pupil).
+    const double l0 = std::floor(box[1] / rows) - 2, l1 = std::ceil(box[3] / rows) + 2;
+    const double k0 = std::floor(box[0] / p) - 3, k1 = std::ceil(box[2] / p) + 3;
+    if (!(l1 - l0 < 1e7 && k1 - k0 < 1e7))
+        return out;
+    std::vector<Vec2> centres;
+    for (std::int64_t l = std::int64_t(l0); l <= std::int64_t(l1); ++l) {
+        for (std::int64_t k = std::int64_t(k0); k <= std::int64_t(k1); ++k) {
+            const LensIndex lens{k, l};
+            double cu, cv;
+            if (!microimage_centre_px(m, W, H, lens, &cu, &cv) || !(cu >= -0.5 && cu < W - 0.5) ||
+                !(cv >= -0.5 && cv < H - 0.5))
+                continue;  // the lattice centre is not in the picture
+            MicroimageTruth truth = MicroimageTruth();
+            truth.lens = lens;
+            out.push_back(truth);
+            centres.push_back(Vec2{cu, cv});
+        }
+    }
+
+    const bool thin = m.microlens == MicrolensType::ThinLens;
+    const int n = thin ? std::max(1, options.aperture_points) : 1;
+    auto measure = [&](std::size_t index) {
+        MicroimageTruth& truth = out[index];
+        Moments total{0, 0, 0};
+        for (int j = 0; j < n; ++j) {
+            for (int i = 0; i < n; ++i) {
+                const double lens_u = thin ? (i + 0.5) / n : 0.5, lens_v = thin ? (j + 0.5) / n : 0.5;
+                const Guess guess = guess_region(m, W, H, truth.lens, lens_u, lens_v, centres[index]);
+                if (!guess.possible)
+                    continue;
+                const LensProbe probe(m, W, H, truth.lens, lens_u, lens_v);
+                // A start point anywhere in the disc is at most its diameter from the boundary.
+                const double search = guess.radius_px + 1, reach = 2.1 * guess.radius_px + 1;
+                const Moments region = region_moments(probe, guess.u, guess.v, search, reach, options);
+                total.area += region.area / (n * n);
+                total.mu += region.mu / (n * n);
+                total.mv += region.mv / (n * n);
+            }
+        }
+        truth.lit = total.area > 0;
+        truth.u_px = truth.lit ? total.mu / total.area - 0.5 : 0;
+        truth.v_px = truth.lit ? total.mv / total.area - 0.5 : 0;
+        const double cell = microimage_cell_area_px(m, W, H, truth.lens);
+        truth.lit_fraction = cell > 0 ? total.area / cell : 0;
+    };
+
+    // Lenses are handed out one at a time to the threads; each result has its own slot, so the
+    // output does not depend on the thread count. The calling thread works too and reports.
+    std::atomic<std::size_t> next(0), done(0);
+    std::atomic<bool> stop(false);
+    auto work = [&]() {
+        for (std::size_t i = next++; i < out.size() && !stop; i = next++) {
+            measure(i);
+            ++done;
+        }
+    };
+    const unsigned hardware = std::thread::hardware_concurrency();
+    const int threads = options.threads > 0 ? options.threads : int(std::max(1u, hardware));
+    std::vector<std::thread> workers;
+    for (int t = 1; t < threads && std::size_t(t) < out.size(); ++t)
+        workers.push_back(std::thread(work));
+    std::size_t reported = 0;
+    for (std::size_t i = next++; i < out.size() && !stop; i = next++) {
+        if (cancelled && cancelled()) {
+            stop = true;
+            break;
+        }
+        measure(i);
+        const std::size_t now = ++done;
+        if (progress && now * 10 / out.size() > reported * 10 / out.size()) {
+            reported = now;
+            progress(now, out.size());
+        }
+    }
+    for (std::thread& worker : workers)
+        worker.join();
+    if (stop)
+        out.clear();
+    return out;
+}
+
+LatticeFit fit_microimage_lattice(const Model& m, const std::vector<MicroimageTruth>& truth)
+{
+    LatticeFit fit = LatticeFit();
+    fit.valid = false;
+    // Least squares on centred indices (k_s - mk, l - ml): the normal equations separate the mean.
+    double mk = 0, ml = 0, mu = 0, mv = 0;
+    std::size_t n = 0;
+    for (const MicroimageTruth& t : truth) {
+        if (!t.lit)
+            continue;
+        mk += double(skew_k(m.grid, t.lens));
+        ml += double(t.lens.l);
+        mu += t.u_px;
+        mv += t.v_px;
+        ++n;
+    }
+    if (n < 3)
+        return fit;
+    mk /= n;
+    ml /= n;
+    mu /= n;
+    mv /= n;
+    double skk = 0, skl = 0, sll = 0, sku = 0, slu = 0, skv = 0, slv = 0;
+    for (const MicroimageTruth& t : truth) {
+        if (!t.lit)
+            continue;
+        const double dk = double(skew_k(m.grid, t.lens)) - mk, dl = double(t.lens.l) - ml;
+        skk += dk * dk;
+        skl += dk * dl;
+        sll += dl * dl;
+        sku += dk * (t.u_px - mu);
+        slu += dl * (t.u_px - mu);
+        skv += dk * (t.v_px - mv);
+        slv += dl * (t.v_px - mv);
+    }
+    const double det = skk * sll - skl * skl;
+    if (!(det > 1e-9 * std::max(1.0, skk * sll)))
+        return fit;  // all lit lenses in one row or one column
+    fit.basis_a_px[0] = (sku * sll - slu * skl) / det;
+    fit.basis_b_px[0] = (slu * skk - sku * skl) / det;
+    fit.basis_a_px[1] = (skv * sll - slv * skl) / det;
+    fit.basis_b_px[1] = (slv * skk - skv * skl) / det;
+    fit.origin_px[0] = mu - fit.basis_a_px[0] * mk - fit.basis_b_px[0] * ml;
+    fit.origin_px[1] = mv - fit.basis_a_px[1] * mk - fit.basis_b_px[1] * ml;
+    fit.valid = true;
+    fit.lenses = n;
+    double sum2 = 0;
+    for (const MicroimageTruth& t : truth) {
+        if (!t.lit)
+            continue;
+        const double r = length(lattice_residual(m, fit, t));
+        sum2 += r * r;
+        if (r >= fit.max_residual_px) {
+            fit.max_residual_px = r;
+            fit.worst = t.lens;
+        }
+    }
+    fit.rms_residual_px = std::sqrt(sum2 / n);
+    return fit;
+}
+
+Vec2 lattice_residual(const Model& m, const LatticeFit& fit, const MicroimageTruth& lens)
+{
+    const double k = double(skew_k(m.grid, lens.lens)), l = double(lens.lens.l);
+    return Vec2{lens.u_px - (fit.origin_px[0] + k * fit.basis_a_px[0] + l * fit.basis_b_px[0]),
+                lens.v_px - (fit.origin_px[1] + k * fit.basis_a_px[1] + l * fit.basis_b_px[1])};
+}
+
+MicroimageSummary summarise_microimages(const Model& m, int W, int H, const std::vector<MicroimageTruth>& truth,
+                                        const MicroimageOptions& options, const std::string& file)
+{
+    MicroimageSummary summary;
+    summary.file = file;
+    summary.lenses = truth.size();
+    summary.lit_lenses = 0;
+    summary.options = options;
+    summary.fit = fit_microimage_lattice(m, truth);
+    double sum2 = 0, largest = 0;
+    for (const MicroimageTruth& t : truth) {
+        double u, v;
+        if (!t.lit || !microimage_centre_px(m, W, H, t.lens, &u, &v))
+            continue;
+        ++summary.lit_lenses;
+        const double r = std::hypot(t.u_px - u, t.v_px - v);
+        sum2 += r * r;
+        largest = std::max(largest, r);
+    }
+    summary.from_lattice_rms_px = summary.lit_lenses > 0 ? std::sqrt(sum2 / summary.lit_lenses) : NAN;
+    summary.from_lattice_max_px = summary.lit_lenses > 0 ? largest : NAN;
+    return summary;
+}
+
+namespace {
+
+// The shortest "%.*g" that reads back to the same double.
+std::string shortest(double value)
+{
+    char buffer[40];
+    for (int digits = 1; digits <= 17; ++digits) {
+        std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
+        if (std::strtod(buffer, nullptr) == value)
+            break;
+    }
+    return buffer;
+}
+
+} // namespace
+
+std::string microimages_csv(const Model& m, const std::vector<MicroimageTruth>& truth, const LatticeFit& fit)
+{
+    std::string out = "k,l,u,v,lit_fraction,residual_u,residual_v\n";
+    for (const MicroimageTruth& t : truth) {
+        out += std::to_string(static_cast<long long>(t.lens.k)) + "," + std::to_string(static_cast<long long>(t.lens.l));
+        if (t.lit) {
+            out += "," + shortest(t.u_px) + "," + shortest(t.v_px) + "," + shortest(t.lit_fraction);
+            if (fit.valid) {
+                const Vec2 r = lattice_residual(m, fit, t);
+                out += "," + shortest(r.x) + "," + shortest(r.y);
+            } else {
+                out += ",,";
+            }
+        } else {
+            out += ",,," + shortest(t.lit_fraction) + ",,";
+        }
+        out += "\n";
+    }
+    return out;
+}
+
+} // namespace plenoptic

@@ -1,0 +1,110 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Ground truth of the microimages (issue 13, `<image>.microimages.csv`): where the light of a
+// white scene falls behind each microlens, computed through the camera's own rays. Behind a real
+// main lens (pupil aberration, vignetting, distortion) the microimages are no longer the
+// projections of the lens centres from the exit pupil's centre: their centres leave the lattice
+// and the corner ones are cut to cat's eyes.
+
+#ifndef PLENOPTIC_MICROIMAGES_H
+#define PLENOPTIC_MICROIMAGES_H
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "plenoptic/core/lattice.h"
+#include "plenoptic/camera/model.h"
+
+namespace plenoptic {
+
+// One lens's microimage in a white scene (the same radiance from every direction).
+struct MicroimageTruth {
+    LensIndex lens;        // row form (k, l)
+    bool lit;              // false: no light through this lens reaches the sensor (u, v unused)
+    double u_px, v_px;     // centroid of that light on the sensor, pixels, centre convention
+    // The light through the lens over the light a fully lit microimage cell would get: the area
+    // integral, over the sensor, of the fraction E(x) of the lens's aperture through which sensor
+    // point x receives light, divided by the area of the lens's microimage cell (the lens's cell
+    // projected from the exit pupil's centre). 1 for a cell lit everywhere; the lit fraction of the
+    // cell for pinhole microlenses; above 1 only where microimages overlap their neighbours.
+    double lit_fraction;
+};
+
+// How finely each microimage is integrated.
+struct MicroimageOptions {
+    // Boundary directions around the start point; the region is integrated in polar form
+    // (area = 1/2 sum r^2 dtheta, moments = 1/3 sum r^3 (cos, sin) dtheta), which the trapezoid
+    // rule integrates spectrally for smooth boundaries.
+    int azimuths;
+    // Bisection on each boundary radius stops when its bracket is this narrow (pixels).
+    double tolerance_px;
+    // Thin microlenses: aperture points of the lens, aperture_points x aperture_points on the
+    // renderer's own uniform map of the cell (pairs symmetric about the centre, so terms linear in
+    // the aperture point cancel); pinhole microlenses use the centre only. Behind a vignetting
+    // lens 3 x 3 lands within 0.01 px of 8 x 8 (the unit tests measure it).
+    int aperture_points;
+    // Threads measuring lenses (0: one per hardware thread); the result does not depend on it.
+    int threads;
+};
+
+// Called now and then (about every tenth of the lenses) with the lenses done and their number.
+typedef std::function<void(std::size_t done, std::size_t total)> MicroimageProgress;
+// Polled between lenses: true stops the work (microimage_truth then returns nothing).
+typedef std::function<bool()> MicroimageCancel;
+
+MicroimageOptions default_microimage_options();
+
+// The lenses whose microimage centres on the metadata's lattice lie in the W x H picture, each
+// with its microimage measured in the model's white scene, row by row (l, then k, increasing).
+// A sensor point receives light through the lens exactly when the renderer's ray from it through
+// that lens passes every aperture (generate_ray with the lens forced) and, when the camera does
+// not model overlapping microimages, when the lens is the point's own lens. Microimages are not
+// cut at the picture's edge. Each microimage is taken star-shaped about its start point (the
+// lattice centre, or the centroid of a coarse search when that point is dark): the region
+// between that point and the first boundary crossing along each direction. Needs a main lens and
+// an array (empty otherwise). Deterministic.
+std::vector<MicroimageTruth> microimage_truth(const Model& model, int W, int H, const MicroimageOptions& options,
+                                              const MicroimageProgress& progress = MicroimageProgress(),
+                                              const MicroimageCancel& cancelled = MicroimageCancel());
+
+// Least-squares lattice through the lit centres: (u, v) = origin + k_s a + l b in skew indices,
+// as the metadata's microimage_lattice, and how far the centres lie from it.
+struct LatticeFit {
+    bool valid;                // at least three lit lenses not in one row
+    double origin_px[2];
+    double basis_a_px[2];
+    double basis_b_px[2];
+    std::size_t lenses;        // lit lenses fitted
+    double rms_residual_px;    // root mean square of |centre - fit|
+    double max_residual_px;
+    LensIndex worst;           // where the largest residual is
+};
+
+LatticeFit fit_microimage_lattice(const Model& model, const std::vector<MicroimageTruth>& truth);
+
+// The fit's residual for one lens (centre - fit), pixels.
+Vec2 lattice_residual(const Model& model, const LatticeFit& fit, const MicroimageTruth& lens);
+
+// What the metadata says about the microimages file (docs/metadata.md, "microimages").
+struct MicroimageSummary {
+    std::string file;              // the CSV's name, beside the image
+    std::size_t lenses, lit_lenses;
+    MicroimageOptions options;
+    LatticeFit fit;
+    // How far the lit centres lie from the metadata's microimage_lattice (the paraxial lattice).
+    double from_lattice_rms_px, from_lattice_max_px;
+};
+
+MicroimageSummary summarise_microimages(const Model& model, int W, int H, const std::vector<MicroimageTruth>& truth,
+                                        const MicroimageOptions& options, const std::string& file);
+
+// The CSV text: a header line "k,l,u,v,lit_fraction,residual_u,residual_v", then one line per
+// lens (row-form indices, centre-convention pixels, the residuals from the fit); u, v and the
+// residuals are empty for a dark lens, the residuals also when the fit is not valid. Numbers in
+// the shortest form that reads back to the same double.
+std::string microimages_csv(const Model& model, const std::vector<MicroimageTruth>& truth, const LatticeFit& fit);
+
+} // namespace plenoptic
+
+#endif

@@ -1,0 +1,249 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Tests of the microimage ground truth: behind an ideal thin lens every microimage is the exit
+// pupil's disc (radius A/2 d/D) about the lattice centre, so the centroid and the lit fraction
+// have closed forms; behind a vignetting prescription the polar integration must agree with a
+// brute-force count of lit sensor points; the lattice fit must recover a lattice it was given.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "plenoptic/projection/microimage_lattice.h"
+#include "plenoptic/truth/microimages.h"
+#include "plenoptic/lens/prescription.h"
+#include "plenoptic/camera/rays.h"
+#include "plenoptic/core/sampling.h"
+#include "plenoptic/core/test_util.h"
+
+namespace plenoptic {
+namespace {
+
+using test::kPi;
+using test::plenoptic_camera;
+
+struct ClosedFormCase {
+    GridType grid;
+    double micro_focal_mm;  // 0: pinholes
+};
+
+TEST(MicroimageTruth, ThinLensMicroimagesAreThePupilDiscAboutTheLatticeCentres)
+{
+    // F = 50 mm at f/8 (A = 6.25 mm), D = 52 mm, d = 2 mm, pitch 0.5 mm, 10 um pixels: discs of
+    // radius A/2 d/D = 0.1202 mm (12 px) inside cells of 0.519 mm on the sensor.
+    const double A = 50.0 / 8, D = 52, d = 2, p = 0.5, pixel = 0.01;
+    for (const ClosedFormCase& c : {ClosedFormCase{GridType::Rectangular, 0}, ClosedFormCase{GridType::Hexagonal, 0},
+                                    ClosedFormCase{GridType::Hexagonal, 2}, ClosedFormCase{GridType::Rectangular, 1.5}}) {
+        CameraParams params = plenoptic_camera(c.grid, p, c.micro_focal_mm, d, 50, 8, D);
+        params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = pixel;
+        const Model m = make_model(params);
+        const int W = 161, H = 121;
+        const std::vector<MicroimageTruth> truth = microimage_truth(m, W, H, default_microimage_options());
+        ASSERT_GE(truth.size(), 6u);
+        const double radius_px = 0.5 * A * d / D / pixel;
+        const double cell_mm = c.grid == GridType::Hexagonal ? std::sqrt(3.0) / 2 * p * p : p * p;
+        const double cell_px = cell_mm * std::pow((D + d) / D, 2) / (pixel * pixel);
+        const double fraction = kPi * radius_px * radius_px / cell_px;
+        for (const MicroimageTruth& t : truth) {
+            double u, v;
+            ASSERT_TRUE(microimage_centre_px(m, W, H, t.lens, &u, &v));
+            ASSERT_TRUE(t.lit);
+            EXPECT_NEAR(t.u_px, u, 1e-3) << t.lens.k << "," << t.lens.l;
+            EXPECT_NEAR(t.v_px, v, 1e-3) << t.lens.k << "," << t.lens.l;
+            EXPECT_NEAR(t.lit_fraction, fraction, 1e-4 * fraction) << t.lens.k << "," << t.lens.l;
+            EXPECT_TRUE(u >= -0.5 && u < W - 0.5 && v >= -0.5 && v < H - 0.5);
+        }
+        // Every lattice centre in the picture is listed: count them independently.
+        int inside = 0;
+        for (int l = -40; l <= 40; ++l)
+            for (int k = -40; k <= 40; ++k) {
+                double u, v;
+                if (microimage_centre_px(m, W, H, LensIndex{k, l}, &u, &v) && u >= -0.5 && u < W - 0.5 && v >= -0.5 &&
+                    v < H - 0.5)
+                    ++inside;
+            }
+        EXPECT_EQ(int(truth.size()), inside);
+        // An ideal lens: the centres are the metadata's lattice.
+        const LatticeFit fit = fit_microimage_lattice(m, truth);
+        ASSERT_TRUE(fit.valid);
+        EXPECT_LT(fit.max_residual_px, 1e-3);
+        const MicroimageLattice lattice = microimage_lattice(m, W, H);
+        for (int i = 0; i < 2; ++i) {
+            EXPECT_NEAR(fit.origin_px[i], lattice.origin_px[i], 1e-3);
+            EXPECT_NEAR(fit.basis_a_px[i], lattice.basis_a_px[i], 1e-4);
+            EXPECT_NEAR(fit.basis_b_px[i], lattice.basis_b_px[i], 1e-4);
+        }
+    }
+}
+
+using test::vignetting_triplet;
+
+TEST(MicroimageTruth, CatsEyesAgreeWithABruteForceCount)
+{
+    const Prescription lens = vignetting_triplet();
+    const ImageDistance focus = paraxial_image_distance(lens, 3000);
+    ASSERT_TRUE(focus.real);
+    CameraParams params = plenoptic_camera(GridType::Rectangular, 2.5, 0, 8.5, 50, 4, focus.mm);
+    params.main.type = MainLensType::Prescription;
+    params.main.has_focal_length = false;
+    params.main.has_f_number = false;
+    params.main.has_prescription = true;
+    params.main.prescription = lens;
+    params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.5;
+    const Model m = make_model(params);
+    ASSERT_EQ(m.main_lens, MainLensType::Prescription);
+    const int W = 120, H = 120;
+    const std::vector<MicroimageTruth> truth = microimage_truth(m, W, H, default_microimage_options());
+    ASSERT_FALSE(truth.empty());
+    // Brute force: every point of a fine grid around a lens's lattice centre, the renderer's ray
+    // through the lens's pinhole (generate_ray takes corner-convention pixels).
+    const LensIndex chosen[] = {{0, 0}, {9, 0}, {-9, 9}, {9, -9}};
+    double areas[4], truth_fraction[4];
+    for (int c = 0; c < 4; ++c) {
+        const LensIndex want = chosen[c];
+        const MicroimageTruth* found = nullptr;
+        for (const MicroimageTruth& t : truth)
+            if (t.lens == want)
+                found = &t;
+        ASSERT_NE(found, nullptr) << want.k << "," << want.l;
+        ASSERT_TRUE(found->lit);
+        double u0, v0;
+        ASSERT_TRUE(microimage_centre_px(m, W, H, want, &u0, &v0));
+        const int n = 600;
+        const double half = 6, step = 2 * half / n;
+        double count = 0, su = 0, sv = 0;
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                const double u = u0 - half + (i + 0.5) * step, v = v0 - half + (j + 0.5) * step;
+                OpticsRay ray;
+                if (!generate_ray(m, W, H, 0, 0, CameraSample{u + 0.5, v + 0.5, 0.5, 0.5}, &want, &ray))
+                    continue;
+                count += 1;
+                su += u;
+                sv += v;
+            }
+        ASSERT_GT(count, 0);
+        EXPECT_NEAR(found->u_px, su / count, 0.01) << want.k << "," << want.l;
+        EXPECT_NEAR(found->v_px, sv / count, 0.01) << want.k << "," << want.l;
+        areas[c] = count * step * step;
+        truth_fraction[c] = found->lit_fraction;
+    }
+    // The lit fraction is the area over the cell's projected area, the same for every lens up to
+    // the projection's small change over the field: compare through the ratio to the centre lens
+    // (grid error about perimeter * step / area).
+    for (int c = 1; c < 4; ++c)
+        EXPECT_NEAR(truth_fraction[c] / truth_fraction[0], areas[c] / areas[0], 0.005) << c;
+    // The corners are cat's eyes: far less light than the centre.
+    EXPECT_LT(areas[2] / areas[0], 0.8);
+    EXPECT_LT(areas[3] / areas[0], 0.8);
+}
+
+TEST(MicroimageTruth, ThinMicrolensesConvergeInApertureAndThreadsDoNotMatter)
+{
+    // The triplet with a hexagonal array of thin microlenses (plenoptic 1.0: d = f).
+    const Prescription lens = vignetting_triplet();
+    const ImageDistance focus = paraxial_image_distance(lens, 3000);
+    ASSERT_TRUE(focus.real);
+    CameraParams params = plenoptic_camera(GridType::Hexagonal, 2.5, 8.5, 8.5, 50, 4, focus.mm);
+    params.main.type = MainLensType::Prescription;
+    params.main.has_focal_length = false;
+    params.main.has_f_number = false;
+    params.main.has_prescription = true;
+    params.main.prescription = lens;
+    params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.5;
+    const Model m = make_model(params);
+    const int W = 120, H = 120;
+    MicroimageOptions coarse = default_microimage_options(), fine = coarse, one_thread = coarse;
+    fine.aperture_points = 8;
+    one_thread.threads = 1;
+    coarse.threads = 3;
+    const std::vector<MicroimageTruth> a = microimage_truth(m, W, H, coarse);
+    const std::vector<MicroimageTruth> b = microimage_truth(m, W, H, fine);
+    const std::vector<MicroimageTruth> c = microimage_truth(m, W, H, one_thread);
+    ASSERT_EQ(a.size(), b.size());
+    ASSERT_EQ(a.size(), c.size());
+    double worst_px = 0, worst_fraction = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        ASSERT_TRUE(a[i].lens == c[i].lens && a[i].lit == c[i].lit);
+        EXPECT_EQ(a[i].u_px, c[i].u_px);  // bit for bit
+        EXPECT_EQ(a[i].lit_fraction, c[i].lit_fraction);
+        if (!a[i].lit || !b[i].lit || b[i].lit_fraction < 0.05)
+            continue;
+        worst_px = std::max(worst_px, std::hypot(a[i].u_px - b[i].u_px, a[i].v_px - b[i].v_px));
+        worst_fraction = std::max(worst_fraction, std::fabs(a[i].lit_fraction - b[i].lit_fraction));
+    }
+    // Seen: 3 x 3 points within 0.0072 px of 8 x 8 (2 x 2: 0.020 px, 1: 0.041 px), fractions within 0.001.
+    EXPECT_LT(worst_px, 0.015);
+    EXPECT_LT(worst_fraction, 0.005);
+}
+
+TEST(MicroimageTruth, LatticeFitRecoversAGivenLattice)
+{
+    const Model m = make_model(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52));
+    // Centres on a known skew lattice, plus a known residual pattern of zero mean that is
+    // orthogonal to (1, k_s, l) over the set: +e on even k_s + l, -e on odd, balanced per row.
+    const double o[2] = {100.25, 80.5}, a[2] = {14.2, 0.3}, b[2] = {7.1, 12.4};
+    std::vector<MicroimageTruth> truth;
+    for (int l = -4; l <= 3; ++l)
+        for (int ks = -5; ks <= 4; ++ks) {
+            const double e = ((ks + l) % 2 == 0) ? 0.05 : -0.05;
+            MicroimageTruth t;
+            t.lens = from_skew(GridType::Hexagonal, ks, l);
+            t.lit = true;
+            t.u_px = o[0] + ks * a[0] + l * b[0] + e;
+            t.v_px = o[1] + ks * a[1] + l * b[1] - e;
+            t.lit_fraction = 1;
+            truth.push_back(t);
+        }
+    MicroimageTruth dark = truth.back();
+    dark.lens = from_skew(GridType::Hexagonal, 50, 50);
+    dark.lit = false;
+    dark.u_px = dark.v_px = 1e9;  // not fitted
+    truth.push_back(dark);
+    const LatticeFit fit = fit_microimage_lattice(m, truth);
+    ASSERT_TRUE(fit.valid);
+    EXPECT_EQ(fit.lenses, truth.size() - 1);
+    for (int i = 0; i < 2; ++i) {
+        EXPECT_NEAR(fit.origin_px[i], o[i], 1e-9);
+        EXPECT_NEAR(fit.basis_a_px[i], a[i], 1e-9);
+        EXPECT_NEAR(fit.basis_b_px[i], b[i], 1e-9);
+    }
+    EXPECT_NEAR(fit.rms_residual_px, 0.05 * std::sqrt(2.0), 1e-9);
+    EXPECT_NEAR(fit.max_residual_px, 0.05 * std::sqrt(2.0), 1e-9);
+    const Vec2 r = lattice_residual(m, fit, truth.front());
+    EXPECT_NEAR(std::fabs(r.x), 0.05, 1e-9);
+    EXPECT_NEAR(r.x, -r.y, 1e-12);
+}
+
+TEST(MicroimageTruth, CancellingStopsAtTheNextLensAndReturnsNothing)
+{
+    CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 8, 52);
+    params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.01;
+    const Model m = make_model(params);
+    MicroimageOptions options = default_microimage_options();
+    options.threads = 2;
+    ASSERT_GT(microimage_truth(m, 401, 301, options).size(), 50u);
+    int polls = 0;
+    std::size_t reports = 0;
+    const std::vector<MicroimageTruth> none = microimage_truth(
+        m, 401, 301, options, [&](std::size_t done, std::size_t) { reports = done; }, [&]() { return ++polls > 5; });
+    EXPECT_TRUE(none.empty());
+    EXPECT_EQ(polls, 6);  // polled before each lens of the calling thread, stopped at the first true
+    EXPECT_LT(reports, 50u);
+}
+
+TEST(MicroimageTruth, NothingWithoutAnArrayOrAMainLens)
+{
+    const Model no_array = make_model(test::thin_lens_camera(50, 4, 52));
+    EXPECT_TRUE(microimage_truth(no_array, 100, 100, default_microimage_options()).empty());
+    CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52);
+    p.main.given = false;
+    p.main.type = MainLensType::None;
+    const Model no_main = make_model(p);
+    EXPECT_TRUE(microimage_truth(no_main, 100, 100, default_microimage_options()).empty());
+}
+
+} // namespace
+} // namespace plenoptic

@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Virtual depth of scene points and of a depth map's pixels (see truth/virtual_depth.h).
+
+#include "plenoptic/truth/virtual_depth.h"
+
+#include <cmath>
+#include <limits>
+
+#include "plenoptic/lens/main_lens.h"
+#include "plenoptic/camera/params.h"
+#include "plenoptic/camera/rays.h"
+
+namespace plenoptic {
+
+bool is_focused_camera(const Model& m)
+{
+    if (m.grid == GridType::None || m.microlens != MicrolensType::ThinLens || !m.lens ||
+        m.main_lens == MainLensType::None || m.main_lens == MainLensType::Pinhole)
+        return false;
+    const double d = effective_array_distance_mm(m);
+    for (int t = 0; t < m.lens_type_count; ++t)
+        if (std::fabs(m.microlens_focal_mm[t] - d) > 1e-9 * d)
+            return true;
+    return false;
+}
+
+double virtual_depth(const Model& m, Vec3 point)
+{
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (!m.lens || m.main_lens == MainLensType::None || m.main_lens == MainLensType::Pinhole || m.grid == GridType::None)
+        return nan;
+    const HomogeneousPoint image = m.lens->paraxial_image(point);
+    if (!(image.w != 0))
+        return nan;
+    const Vec3 x = (1 / image.w) * image.xyz;
+    const double a = dot(m.pose.normal, x - m.pose.centre_mm);
+    const double v = -a / effective_array_distance_mm(m);
+    return std::isfinite(v) ? v : nan;
+}
+
+float pixel_virtual_depth(const Model& m, int W, int H, int i, int j, float distance_units)
+{
+    if (!(distance_units >= 0))
+        return std::numeric_limits<float>::quiet_NaN();
+    const OpticsRay ray = chief_ray(m, W, H, i, j);
+    const Vec3 origin{ray.origin_mm[0], ray.origin_mm[1], ray.origin_mm[2]};
+    const Vec3 dir{ray.dir[0], ray.dir[1], ray.dir[2]};
+    // At infinity: a point as far as a length can be (1e12 mm) images within 1e-10 of the
+    // focal plane, below a float's resolution of v.
+    const double along = std::isinf(distance_units) ? kMaxLengthMm : double(distance_units) * m.mm_per_unit;
+    return float(virtual_depth(m, origin + along * dir));
+}
+
+} // namespace plenoptic
