@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// real_lens_wide_angle.pov: a real main lens (issue 13, docs/real-lenses.md): the 22 mm f/3.5
+// real_lens_wide_angle.pov: a real main lens (docs/real-lenses.md): the 22 mm f/3.5
 // inverted telephoto of lenses/wide_angle_22mm_laikin_f3.5.dat (Laikin, Lens Design, table 8.1),
 // traced surface by surface at f/5.6 on a 28.8 x 19.2 mm sensor (render +W480 +H320), no array:
 // barrel distortion and the mechanical vignetting of the clear apertures towards the corners.

@@ -22,7 +22,7 @@ the machine is doing, unlike the wall clock (+-15 % between runs on a shared 2-c
 #   runner     Bench: renders with POV-Ray's trace time, CPU time and peak memory; scene worlds
 #   callgrind  instruction counts of a render (valgrind's callgrind)
 #   overhead, lenses, trade, dark, threads, fullsize, build   the sections (--only NAME)
-#   real_lens  sections real_lens and fullsize_real_lens: a prescription main lens (issue 13),
+#   real_lens  sections real_lens and fullsize_real_lens: a prescription main lens,
 #              with the pass-fraction counts of source/bench/pass_fractions.cpp
 #   report     BENCHMARKS.md from results.json; plots
 #   cli        the command line (main)

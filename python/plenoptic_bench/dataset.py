@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Section dataset (issue 16): what plenoptic-dataset costs per item, run by itself on this
+"""Section dataset: what plenoptic-dataset costs per item, run by itself on this
 machine and through Slurm (tools/slurm-local's one-node cluster), against the same POV-Ray
 commands run bare one after the other; and a raw split into row bands against one render."""
 import json

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Section real_lens (issue 13): a prescription main lens, traced surface by surface, against the
+"""Section real_lens: a prescription main lens, traced surface by surface, against the
 thin lens of the same effective focal length and f-number and against its paraxial equivalent
 (`thick_lens`).
 

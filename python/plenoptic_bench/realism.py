@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Section realism (issue 14): the cost of irradiance radiometry, diffraction and the sensor's
+"""Section realism: the cost of irradiance radiometry, diffraction and the sensor's
 read-out, each against the plain render of the same camera, on the whole process's clock and CPU
 time (diffraction and the read-out run after the trace, so POV-Ray's trace time misses them)."""
 import statistics

@@ -41,7 +41,7 @@ def realism_report(L, results):
     """Section realism: radiometry, diffraction and the read-out against the plain render."""
     r = results["realism"]
     L.append("## Radiometry, diffraction and the sensor's read-out (`--only realism`)\n")
-    L.append("Issue 14's costs, each against the plain render of the same camera: the benchmark scene through"
+    L.append("The realism options' costs, each against the plain render of the same camera: the benchmark scene through"
              " Lytro-class optics (6.45 mm f/2 thin lens, hexagonal 14 um f/2 microlenses at d = f, 1.4 um pixels),"
              " %dx%d, %d samples, %d interleaved runs each. Diffraction and the read-out run after the trace, so"
              " the times are the whole process's (clock and CPU), not POV-Ray's trace time.\n"
@@ -66,7 +66,7 @@ def real_lens_report(L, results):
     L.append("## Real main lens (`--only real_lens`, `--only fullsize_real_lens`)\n")
     for e in (results.get("real_lens") or {}).get("lenses", []):
         w, h, px = e["sensor"]
-        L.append("`lenses/%s` (issue 13, docs/real-lenses.md) at f/%g, focused at %g m: EFL %.3f mm, working"
+        L.append("`lenses/%s` (docs/real-lenses.md) at f/%g, focused at %g m: EFL %.3f mm, working"
                  " f-number %.3f. Camera: %gx%g mm sensor (%dx%d pixels of %g um), without an array and with a"
                  " plenoptic 1.0 array (hexagonal, pitch %g mm, thin microlenses f = d = %.4f mm, matched to the"
                  " working f-number); the thin lens compared has the same EFL and f-number, `thick_lens` is the"

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """From the sensor's raw back to the picture: DN to linear values, demosaicing, devignetting
-(issue 14, item 6; docs/sensor.md, "Decoding raws").
+(docs/sensor.md, "Decoding raws").
 
 The render's read-out (docs/sensor.md, "The chain") writes DN = K + round(e g), with e the
 electrons, g = (2^B - 1 - K) / E the gain and X electrons for a picture value of 1. So a site's

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""plenoptic-targets: calibration data sets with ground truth (issue 14, item 5; docs/ground-truth.md,
+"""plenoptic-targets: calibration data sets with ground truth (docs/ground-truth.md,
 "Calibration targets").
 
 Renders N views of a calibration target (scenes/calibration_targets.inc: a checkerboard or a

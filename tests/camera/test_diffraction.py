@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Diffraction (issue 14, item 2; docs/sensor.md, "Diffraction").
+"""Diffraction (docs/sensor.md, "Diffraction").
 
 `diffraction` convolves the rendered picture with the Airy pattern of the aperture that forms it,
 one wavelength per channel. Checked in whole renders against the Airy pattern's closed forms,

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Rules of the camera block that a hostile new user found broken (issue 12, items 5 and 6).
+"""Rules of the camera block that a hostile new user found broken.
 
 1. A block given twice replaces the first entirely (docs/camera.md, Repeated keywords): a
    second `sensor { }` brings back the defaults of everything it does not set.

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Irradiance radiometry in renders (issue 14, item 1; docs/camera.md, "Radiometry").
+"""Irradiance radiometry in renders (docs/camera.md, "Radiometry").
 
 `radiometry irradiance` makes a pixel the sensor irradiance over C. Checked in whole renders,
 against answers that do not come from the camera's code:

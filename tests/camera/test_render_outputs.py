@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""What a plenoptic render prints and writes beside its image (issue 12, item 7):
+"""What a plenoptic render prints and writes beside its image:
 
 1. `+O-` sends the image to standard output: no `stdout.plenoptic.json` appears, a message says
    why, and standard output holds the PNG.

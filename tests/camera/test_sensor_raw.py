@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""The sensor's read-out (issue 14, docs/sensor.md): `sensor { bayer ... }` writes <image>.raw.png
+"""The sensor's read-out (docs/sensor.md): `sensor { bayer ... }` writes <image>.raw.png
 beside the noise-free picture.
 
 The camera is a pinhole main lens without an array in front of a uniform background, so every

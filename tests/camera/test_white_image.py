@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""White images (issue 14, docs/sensor.md "White images"): `white_image` writes what the camera
+"""White images (docs/sensor.md "White images"): `white_image` writes what the camera
 records of a uniform white diffuser, computed from the camera alone (no scene ray).
 
 The independent answer is the render itself: the same camera rendering a world whose every

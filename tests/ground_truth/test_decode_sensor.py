@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""The decoder reads the sensor's raw (issue 14, item 6; docs/sensor.md, "Decoding raws").
+"""The decoder reads the sensor's raw (docs/sensor.md, "Decoding raws").
 
 plenoptic-decode takes <stem>.raw.png (DN, a Bayer mosaic or RGB) as well as the rendered
 picture, and devignettes with the camera's white image (--white). Checked against answers that

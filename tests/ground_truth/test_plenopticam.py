@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""PlenoptiCam reads our raws (issue 14, item 6; docs/sensor.md, "PlenoptiCam").
+"""PlenoptiCam reads our raws (docs/sensor.md, "PlenoptiCam").
 
 PlenoptiCam (the Python package plenopticam, by C. Hahne) is installed from PyPI into a virtual
 environment of its own (numpy < 2, scipy < 1.12, without its pinned pyinstaller, which does not

@@ -2,7 +2,7 @@
 """Forward projection (plenoptic-project) against renders in every regime the camera renders.
 
 Small emissive spheres on black, seen by plenoptic cameras in five regimes: plenoptic 1.0 (d = f),
-Keplerian 2.0 (d > f), Galilean 2.0 (d < f), and the two cameras of issue 12 item 1 whose
+Keplerian 2.0 (d > f), Galilean 2.0 (d < f), and two cameras whose
 microimages overlap (a 16 mm f/4 and f/10 main lens over a hexagonal array with d = 2f), with
 spheres in front of, on and behind the focus plane and spheres whose light is split between two
 lenses. The blobs of the render must match the images plenoptic-project predicts one to one.
@@ -24,7 +24,7 @@ of those points' images through it weighted by the part of each point's light th
     images it holds (LIGHT_TOLERANCE_PX when they are all lighter than REQUIRED_ENERGY: a
     partly lit cell's few noisy pixels). In the two overlapping set-ups the bounds are
     OVERLAP_TOLERANCE_PX for a single image and MERGED_TOLERANCE_PX for the merged pair of the
-    sphere at 2.06 m. Until issue 12 the renderer sent sample n of a pixel through lens n mod L of
+    sphere at 2.06 m. An earlier renderer sent sample n of a pixel through lens n mod L of
     its L overlap lenses, and those subsequences of one sample sequence are not uniform over pixel
     and cell: the merged pair rendered 1.3 px from the prediction (the light split 0.60 / 0.40
     where the cell areas say 0.65 / 0.35). Each lens now takes its own whole sample stream; the
@@ -60,7 +60,7 @@ DISC_RINGS = 10  # sample points of a sphere's disc: 1 + 6 + 12 + ... + 60
 F16_FOCUS2 = 16.0 / (1 - 16.0 / 2000.0)
 CONFIGS = [
     {
-        # Issue 12 item 1: microimages overlap (image-side f/4 against d/p = 8).
+        # Overlapping microimages (image-side f/4 against d/p = 8).
         "name": "overlap-f4",
         "main": "thin_lens focal_length 16 f_number 4 focus_distance 2",
         "array": "hexagonal pitch 0.15 focal_length 0.6 distance 1.2",
@@ -71,13 +71,13 @@ CONFIGS = [
                     (2, -3, 0.45, 0.0, 1940.0, 4.0)],
     },
     {
-        # Issue 12 item 1 at f/10: still overlapping through the microlenses' blur (d = 2f).
+        # The same at f/10: still overlapping through the microlenses' blur (d = 2f).
         "name": "overlap-f10",
         "main": "thin_lens focal_length 16 f_number 10 focus_distance 2",
         "array": "hexagonal pitch 0.15 focal_length 0.6 distance 1.2",
         "pitch": 0.15, "D": F16_FOCUS2, "samples": 1600, "overlap": True,
-        # The issue's second example: the point at 2.3 m with its image on a cell border, where
-        # the old code printed nothing.
+        # The point at 2.3 m has its image on a cell border, where an earlier forward projection
+        # printed nothing.
         "spheres": [(-2, 1, 0.5, 0.0, 2300.0, 5.0), (2, -2, 0.1, 0.1, 1800.0, 4.0)],
     },
     {

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Calibration targets with ground truth (issue 14, item 5; docs/ground-truth.md, "Calibration
+"""Calibration targets with ground truth (docs/ground-truth.md, "Calibration
 targets"): plenoptic-targets renders a checkerboard or a circle grid (scenes/calibration_targets.inc)
 at seeded random poses and writes where every feature point images.
 

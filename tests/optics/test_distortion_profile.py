@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""The metadata's distortion profile of a traced prescription (issue 13) against the independent
+"""The metadata's distortion profile of a traced prescription against the independent
 reference tracer of the tests (plenoptic_testing.lens_tracer).
 
 For each row the reference places the object point on the plane that its own paraxial trace

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Unit tests of the reference lens tracer (tests/pylib/plenoptic_testing/lens_tracer.py) that
-the prescription main-lens tests (issue 13) compare the camera with. Each answer here comes
+the prescription main-lens tests compare the camera with. Each answer here comes
 from a closed form of textbook optics, never from the tracer itself: the axis crossing of a
 ray refracted by one sphere, the thick-lens focal length and principal planes, Gaussian
 imaging for pupils and image distances, Snell's law and the critical angle at a flat face,

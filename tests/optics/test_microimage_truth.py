@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Microimage centres through a real main lens (issue 13, `<image>.microimages.csv`) against the
+"""Microimage centres through a real main lens (`<image>.microimages.csv`) against the
 independent reference tracer of the tests (plenoptic_testing.lens_tracer).
 
 With pinhole microlenses a sensor point S receives light through lens (k, l) exactly when the ray

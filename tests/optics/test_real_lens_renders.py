@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Renders through a prescription main lens (issue 13) against the independent reference tracer
+"""Renders through a prescription main lens against the independent reference tracer
 of the tests (plenoptic_testing.lens_tracer: exact tracing and paraxial data written apart from
 the camera's code).
 

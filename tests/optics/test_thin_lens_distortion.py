@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Parametric distortion of the thin main lens (issue 13, item 6):
+"""Parametric distortion of the thin main lens:
 main_lens { thin_lens ... distortion { radial <k1, k2, k3> tangential <p1, p2> } }.
 
 The answer is computed here from the model's definition (docs/real-lenses.md, "Parametric

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Issue 12, item 2: the depth map is computed as the image is rendered.
+"""The depth map is computed as the image is rendered.
 
 Before, with `depth_map` every render thread filled the whole depth map before its first pixel:
 no progress, Ctrl-C ignored for as long as that took, W*H floats allocated up front, every row

@@ -192,7 +192,7 @@ CASES = [
      ["pixel_size", "finite", "inf"], "no infinite value"),
     ("sensor offset NaN", camera(sensor=sensor_with("pixel_size 0.01", "offset <pow(10,400)*0, 0> " + MARK)),
      ["offset", "finite", "nan"], "no NaN"),
-    # ---- sensor: the read-out to the raw (issue 14, docs/sensor.md)
+    # ---- sensor: the read-out to the raw (docs/sensor.md)
     ("bayer unknown pattern", camera(sensor=sensor_with("pixel_size 0.01", "bayer rgbg " + MARK)),
      ["bayer", "rggb, bggr, grbg, gbrg", "rgbg"], "only the four Bayer patterns"),
     ("bayer a string", camera(sensor=sensor_with("pixel_size 0.01", 'bayer "rggb" ' + MARK)),
@@ -288,7 +288,7 @@ CASES = [
      ["translate", "behind the sensor"], "the array must lie between lens and sensor"),
     ("array translated in front of the main lens", camera(array=array_with(*HEX, "translate <0, 0, 30>"), close=CAMERA_BRACE),
      ["translate", "main lens"], "the array must lie between lens and sensor"),
-    # Issue 12, item 3: the adaptive form's variance test needs two samples to start from.
+    # The adaptive form's variance test needs two samples to start from.
     ("adaptive samples with a minimum of 1", camera(extra="  samples 1, 64  " + MARK),
      ["samples", "at least 2", "samples N"], "one sample has no variance: the pixel would stop after one ray"),
     ("camera unterminated", camera(close=None),
@@ -307,7 +307,7 @@ PLACEMENT_CASES = [
      ["rotate"], "no NaN"),
     ("camera translate infinite", camera(extra="  samples 2\n  translate <pow(10,400), 0, 0>  " + MARK),
      ["translate"], "no infinite value"),
-    # Issue 12, item 4: a degenerate frame wrote metadata the project's own reader refused.
+    # A degenerate frame once wrote metadata the project's own reader refused.
     ("right zero", camera(place=["  location <0, 0.4, -2>", "  right 0  " + MARK]),
      ["right", "zero"], "no frame without a right vector"),
     ("up zero", camera(place=["  location <0, 0.4, -2>", "  up 0  " + MARK]),
@@ -322,7 +322,7 @@ PLACEMENT_CASES = [
      ["parallel or lie in one plane", "after 'right'"], "the frame must span 3-D space"),
 ]
 
-# Real main lenses (issue 13): the refusals of a prescription, written inline so the scene is
+# Real main lenses: the refusals of a prescription, written inline so the scene is
 # self-contained (a lens file's rows are refused the same way, naming the file and its row).
 S1 = "  surface { radius 30 thickness 5 ior 1.5 aperture 20 }"
 S2 = "  surface { radius -30 thickness 0 ior 1 aperture 20 }"

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Reference optics of a main lens given by a prescription (issue 13), written for the tests
+"""Reference optics of a main lens given by a prescription, written for the tests
 independently of the camera's code: exact sequential ray tracing through spherical surfaces,
 paraxial data by a y-u paraxial ray trace, and the camera's geometry around the lens.
 
