@@ -45,6 +45,9 @@ namespace {
 
 using namespace plenoptic;
 
+// The kind of a model's main lens, as the metadata names it ("none" without one).
+inline std::string lens_kind(const Model& m) { return m.lens ? m.lens->kind_name() : "none"; }
+
 const double kInf = std::numeric_limits<double>::infinity();
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -341,14 +344,14 @@ void model_is_sane(const Model& m)
     FUZZ_ASSERT(std::isfinite(m.distance_mm), "D = %.17g", m.distance_mm);
     FUZZ_ASSERT(m.samples_min >= 1 && m.samples_min <= m.samples_max && m.samples_max <= kMaxSamples,
                 "model samples %d..%d", m.samples_min, m.samples_max);
-    if (m.main_lens == MainLensType::ThinLens)
+    if (lens_kind(m) == "thin_lens")
         FUZZ_ASSERT(std::isfinite(m.aperture_mm) && m.aperture_mm > 0 && std::isfinite(m.focal_length_mm),
                     "aperture %.17g F %.17g", m.aperture_mm, m.focal_length_mm);
     const Vec3 c = m.pose.centre_mm;
     FUZZ_ASSERT(is_finite(c) && is_finite(m.pose.normal), "array pose not finite");
     if (m.grid != GridType::None) {
         FUZZ_ASSERT(c.z > m.sensor_z_mm, "array at z %.17g not above the sensor %.17g", c.z, m.sensor_z_mm);
-        if (m.main_lens != MainLensType::None)
+        if (lens_kind(m) != "none")
             FUZZ_ASSERT(c.z < 0, "array at z %.17g not behind the main lens", c.z);
     }
 }
@@ -369,10 +372,10 @@ void check_ray(const Model& m, const OpticsRay& r, const char* what, int i, int 
 void check_origin(const Model& m, const OpticsRay& r, int i, int j)
 {
     const Vec3 o{r.origin_mm[0], r.origin_mm[1], r.origin_mm[2]};
-    if (m.main_lens == MainLensType::Pinhole) {
+    if (lens_kind(m) == "pinhole") {
         FUZZ_ASSERT(o.x == 0 && o.y == 0 && o.z == 0, "pixel (%d, %d): origin (%g, %g, %g) is not the pinhole", i, j,
                     o.x, o.y, o.z);
-    } else if (m.main_lens == MainLensType::ThinLens) {
+    } else if (lens_kind(m) == "thin_lens") {
         FUZZ_ASSERT(o.z == 0, "pixel (%d, %d): origin z %.17g off the main-lens plane", i, j, o.z);
         FUZZ_ASSERT(std::hypot(o.x, o.y) <= 0.5 * m.aperture_mm * (1 + 1e-12),
                     "pixel (%d, %d): origin (%g, %g) outside the aperture %.17g", i, j, o.x, o.y, m.aperture_mm);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // plenoptic_pass_fractions: how many of the camera rays generated behind a real main lens pass it
-// (issue 13, benchmark items 3 and 4). A count, not a timing: it builds the camera's Model from
+// (a benchmark figure). A count, not a timing: it builds the camera's Model from
 // parameters as the scene parser would (check_camera, make_model), asks generate_ray for the
 // camera's own samples (make_sample, as shade_pixel does) of the central, an edge and a corner
 // pixel and of a patch of pixels around each, and counts the rays that pass the lens. Without an
@@ -243,7 +243,7 @@ int main(int argc, char** argv)
         patch = o.array_pitch_mm > 0 ? int(std::ceil(2 * o.array_pitch_mm / o.pixel_mm)) : 16;
     patch = std::min(patch, std::min(W, H));
     const double rear_radius = 0.5 * m.prescription.surfaces.back().aperture_mm;
-    const bool unbounded = m.grid == GridType::None && m.main_lens == MainLensType::Prescription;
+    const bool unbounded = m.grid == GridType::None && m.lens && m.lens->traced();
 
     struct Place {
         const char* name;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// The sensor's raw as a 16-bit PNG (issue 14): grey for a Bayer mosaic, RGB otherwise, the values
+// The sensor's raw as a 16-bit PNG: grey for a Bayer mosaic, RGB otherwise, the values
 // the DN themselves (no scaling), with an sBIT chunk giving the sensor's bit depth.
 
 #ifndef POVRAY_GLUE_PLENOPTIC_RAW_PNG_H

@@ -280,7 +280,7 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
     // The microimages of a white scene through this camera (a main lens and an array): by default
     // only where they leave the lattice the metadata gives (docs/real-lenses.md).
     const CameraSetup::MicroimageCentres asked = render->setup().microimage_centres;
-    const bool off_lattice = model.main_lens == MainLensType::Prescription || model.has_distortion;
+    const bool off_lattice = (model.lens && model.lens->traced()) || model.has_distortion;
     std::unique_ptr<MicroimageSummary> microimages;
     if (model.grid != GridType::None && model.lens &&
         (asked == CameraSetup::kWrite || (asked == CameraSetup::kDefault && off_lattice))) {

@@ -51,10 +51,8 @@ std::string dark_image_warning(const Model& model)
     std::string message = "almost no light reaches the sensor: " + format_number(100 * fraction) +
                           " % of the camera's sample rays around the optical axis pass the apertures, so the "
                           "image will be " + (fraction > 0 ? "nearly black" : "black");
-    if (model.main_lens == MainLensType::ThinLens)
-        message += " (main-lens aperture " + format_number(model.aperture_mm) + " mm, f-number " +
-                   format_number(model.f_number) + "; main lens to array or sensor " +
-                   format_number(model.distance_mm) + " mm: a focus distance at the focal length puts it far behind the lens)";
+    if (model.lens)
+        message += model.lens->dark_image_advice(model.distance_mm);
     return message;
 }
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Issue 12, item 6: parameters that leave the image black were silent. The lit fraction is
+// Parameters that leave the image black were silent. The lit fraction is
 // checked against the geometry of an f-number-matched plenoptic 1.0 camera, where the main
 // lens's image through each microlens is a disc of radius (A/2) d/D in a p x p cell.
 

@@ -14,8 +14,6 @@ namespace plenoptic {
 
 namespace {
 
-const double kPi = 3.14159265358979323846;
-
 // sin and cos of an angle in degrees, exact at multiples of 90 degrees so that an unrotated or
 // quarter-turned array stays exactly axis-aligned.
 void sin_cos_degrees(double degrees, double* s, double* c)
@@ -98,36 +96,32 @@ Model make_model(const CameraParams& params)
     m.angular_exponent = params.sensor.angular_exponent;
 
     const MainLensParams& main = params.main;
-    m.main_lens = main.given ? main.type : MainLensType::None;
-    m.lens = make_main_lens(main, m.main_lens != MainLensType::None ? main_lens_distance_mm(main, params.mm_per_unit) : 0);
+    m.distance_mm = main.given ? main_lens_distance_mm(main, params.mm_per_unit) : 0;
+    // A real lens's pupils and f-number are those of the aperture that limits the axial beam to the
+    // array (or sensor), D behind it.
+    m.lens = make_main_lens(main, m.distance_mm);
     m.focal_length_mm = 0;
     m.aperture_mm = 0;
     m.f_number = 0;
-    m.distance_mm = 0;
     m.has_focus_distance = false;
     m.focus_distance_units = 0;
     m.lens_length_mm = 0;
-    m.has_distortion = m.main_lens == MainLensType::ThinLens && main.has_distortion;
+    m.has_distortion = false;
     m.distortion = main.distortion;
-    if (m.main_lens == MainLensType::ThinLens) {
-        m.focal_length_mm = main.focal_length_mm;
-        m.aperture_mm = main.has_aperture ? main.aperture_mm : main.focal_length_mm / main.f_number;
-        m.f_number = main.has_f_number ? main.f_number : main.focal_length_mm / main.aperture_mm;
-    }
-    if (is_prescription_type(m.main_lens)) {
-        m.prescription = effective_prescription(main);
-        // Pupils and f-number of the aperture that limits the axial beam to the array (or sensor).
-        m.paraxial = paraxial_data(m.prescription, 0, main_lens_distance_mm(main, params.mm_per_unit));
-        m.lens_file = main.lens_file;
-        m.lens_length_mm = m.paraxial.rear_vertex_z;
-        m.focal_length_mm = m.paraxial.efl_mm;
-        m.aperture_mm = m.paraxial.stop_mm;
-        m.f_number = m.paraxial.f_number;
-    }
-    if (m.main_lens != MainLensType::None) {
-        m.distance_mm = main_lens_distance_mm(main, params.mm_per_unit);
-        m.has_focus_distance = main.has_focus_distance && m.main_lens != MainLensType::Pinhole;
+    if (m.lens) {
+        m.focal_length_mm = m.lens->focal_length_mm();
+        m.aperture_mm = m.lens->aperture_mm();
+        m.f_number = m.lens->f_number();
+        m.has_focus_distance = main.has_focus_distance && m.lens->forms_image();
         m.focus_distance_units = m.has_focus_distance ? main.focus_distance_units : 0;
+        // Only a thin lens takes a parametric distortion (check_main_lens refuses it elsewhere).
+        m.has_distortion = main.has_distortion;
+        if (const ParaxialData* paraxial = m.lens->paraxial()) {
+            m.prescription = *m.lens->prescription();
+            m.paraxial = *paraxial;
+            m.lens_file = main.lens_file;
+            m.lens_length_mm = m.paraxial.rear_vertex_z;
+        }
     }
 
     const ArrayParams& array = params.array;
@@ -140,7 +134,7 @@ Model make_model(const CameraParams& params)
     m.cell_inradius_mm = 0;
     m.cell_circumradius_mm = 0;
 
-    const double array_z = m.main_lens == MainLensType::None ? 0.0 : -m.distance_mm;
+    const double array_z = m.lens ? -m.distance_mm : 0.0;
     const double no_rotation[3] = {0, 0, 0};
     m.pose.rotation = rotation_from_degrees(m.grid == GridType::None ? no_rotation : array.rotate_deg);
     m.pose.centre_mm = Vec3{0, 0, array_z};
@@ -168,7 +162,7 @@ Model make_model(const CameraParams& params)
 
     m.irradiance_k_mm2 = irradiance_constant_mm2(m);
 
-    if (m.main_lens == MainLensType::Prescription) {
+    if (m.lens && m.lens->traced()) {
         // The round stop holds the iris: bounds from the lens without blades hold the lens with them.
         Prescription round = m.prescription;
         round.blades = 0;
@@ -188,7 +182,7 @@ Model make_model(const CameraParams& params)
     m.model_overlap = false;
     m.overlap_rings = 0;
     m.overlap_rings_capped = false;
-    if (m.grid != GridType::None && m.main_lens != MainLensType::None) {
+    if (m.grid != GridType::None && m.lens) {
         const OverlapGeometry g = overlap_geometry(m);
         const double reach = g.disc_mm + g.blur_mm;
         if (reach > g.cell_mm) {
@@ -222,7 +216,7 @@ Model make_model(const CameraParams& params)
 
 std::string limiting_aperture_warning(const Model& m)
 {
-    if (!is_prescription_type(m.main_lens) || !m.paraxial.valid || m.paraxial.aperture_surface < 0)
+    if (!m.lens || !m.lens->paraxial() || !m.paraxial.valid || m.paraxial.aperture_surface < 0)
         return "";
     const std::vector<LensSurface>& rows = m.prescription.surfaces;
     const LensSurface& limiting = rows[size_t(m.paraxial.aperture_surface)];
@@ -252,9 +246,7 @@ std::vector<std::string> warnings(const Model& m)
     if (m.grid == GridType::None)
         return out;
 
-    const double magnification = m.main_lens == MainLensType::None
-                                     ? 0.0
-                                     : effective_array_distance_mm(m) / effective_main_distance_mm(m);
+    const double magnification = m.lens ? effective_array_distance_mm(m) / effective_main_distance_mm(m) : 0.0;
     const double spacing_mm = m.pitch_mm * (1 + magnification);
     const double spacing_px = spacing_mm / std::max(m.pixel_size_mm[0], m.pixel_size_mm[1]);
     if (spacing_px < 2)
@@ -263,7 +255,7 @@ std::vector<std::string> warnings(const Model& m)
                       format_number(std::max(m.pixel_size_mm[0], m.pixel_size_mm[1])) +
                       " mm): fewer than two pixels across leaves almost no angular resolution");
 
-    if (m.main_lens != MainLensType::None) {
+    if (m.lens) {
         const OverlapGeometry g = overlap_geometry(m);
         // Warn about overlap a round microlens of diameter p would show too; the small spill
         // through the cell corners of f-number-matched arrays is modelled without a warning.
@@ -272,11 +264,7 @@ std::vector<std::string> warnings(const Model& m)
                                   format_number(g.disc_mm + g.blur_mm) + " mm from its microimage centre, "
                                   "beyond its microimage cell (inradius " + format_number(g.cell_mm) +
                                   " mm); the light of neighbouring lenses is added where they meet";
-            const double free_mm = g.cell_mm - g.blur_inradius_mm;
-            if (m.main_lens == MainLensType::ThinLens && free_mm > 0)
-                message += "; a main-lens f_number of at least " +
-                           format_number(m.focal_length_mm / (2 * free_mm / g.magnification)) +
-                           " avoids it";
+            message += m.lens->overlap_advice(g.cell_mm - g.blur_inradius_mm, g.magnification);
             out.push_back(message);
         }
     }

@@ -43,8 +43,8 @@ struct Model {
     double irradiance_k_mm2;
     double angular_exponent;     // sensor angular_response n: each sample also weighs cos^n(incidence)
 
-    MainLensType main_lens;
-    std::shared_ptr<const MainLens> lens;  // the main lens's optics; nullptr without one
+    // The main lens (it answers for its kind: lens/main_lens.h); nullptr without one.
+    std::shared_ptr<const MainLens> lens;
     double focal_length_mm;      // F (a real lens's effective focal length); 0 for pinhole and none
     double aperture_mm;          // A (diameter; a real lens's stop); 0 for pinhole and none
     double f_number;             // F / A (a real lens's: F / entrance-pupil diameter); 0 for pinhole and none

@@ -63,7 +63,7 @@ TEST(Model, PlanesOfEachConfiguration)
     CameraParams bare;
     test::add_array(&bare, GridType::Rectangular, 0.5, 0, 2);
     m = make_model(bare);
-    EXPECT_EQ(m.main_lens, MainLensType::None);
+    EXPECT_EQ(test::lens_kind(m), "none");
     EXPECT_DOUBLE_EQ(m.pose.centre_mm.z, 0);
     EXPECT_DOUBLE_EQ(m.sensor_z_mm, -2);
 

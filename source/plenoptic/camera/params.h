@@ -12,7 +12,7 @@
 
 namespace plenoptic {
 
-// Pinhole and ThinLens are ideal; ThickLens is a prescription's paraxial equivalent (issue 13);
+// Pinhole and ThinLens are ideal; ThickLens is a prescription's paraxial equivalent;
 // Prescription is the real lens, traced surface by surface.
 enum class MainLensType { None, Pinhole, ThinLens, ThickLens, Prescription };
 enum class GridType { None, Rectangular, Hexagonal };
@@ -78,6 +78,14 @@ struct MainLensParams {
 inline bool is_prescription_type(MainLensType type)
 {
     return type == MainLensType::ThickLens || type == MainLensType::Prescription;
+}
+
+// Whether a main lens is given and is a pinhole (no aperture of a size), and whether it has an
+// aperture of a size (a thin lens or a real one).
+inline bool is_pinhole(const MainLensParams& main) { return main.given && main.type == MainLensType::Pinhole; }
+inline bool has_sized_aperture(const MainLensParams& main)
+{
+    return main.given && (main.type == MainLensType::ThinLens || is_prescription_type(main.type));
 }
 
 // A prescription main lens as the camera uses it: its surfaces with the iris applied and the

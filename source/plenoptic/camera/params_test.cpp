@@ -359,7 +359,7 @@ TEST(Params, CameraRefusesDegenerateCombinations)
 }
 
 
-// Issue 12, item 3: `samples 1, N` never took a second ray (one sample has no variance).
+// `samples 1, N` never took a second ray (one sample has no variance).
 TEST(Params, AdaptiveSamplingNeedsAMinimumOfTwo)
 {
     SamplingParams p;
@@ -378,7 +378,7 @@ TEST(Params, AdaptiveSamplingNeedsAMinimumOfTwo)
     EXPECT_EQ(check_sampling(p), "");
 }
 
-// Issue 12, item 4: a degenerate placement wrote metadata the project's own reader refused.
+// A degenerate placement wrote metadata the project's own reader refused.
 TEST(Params, PlacementMustSpanSpace)
 {
     const double x[3] = {1, 0, 0}, y[3] = {0, 1, 0}, z[3] = {0, 0, 1}, zero[3] = {0, 0, 0};

@@ -11,7 +11,6 @@ namespace plenoptic {
 
 namespace {
 
-const double kPi = 3.14159265358979323846;
 // Points a side of the midpoint grid over a microlens cell for its mean cos^4.
 const int kCellGrid = 256;
 // Rings of the midpoint rule over an exit pupil's disc.
@@ -74,7 +73,7 @@ double reference_projected_solid_angle_sr(const Model& m)
     if (m.radiometry != Radiometry::Irradiance)
         return 0;
     if (m.grid == GridType::None)
-        return m.main_lens == MainLensType::Pinhole ? 0 : kPi * std::pow(m.lens->exit_pupil_radius(), 2) / m.irradiance_k_mm2;
+        return !m.lens->forms_image() ? 0 : kPi * std::pow(m.lens->exit_pupil_radius(), 2) / m.irradiance_k_mm2;
     if (m.microlens == MicrolensType::Pinhole)
         return 0;
     return m.pitch_mm * row_spacing(m.grid, m.pitch_mm) / m.irradiance_k_mm2;  // A / K

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Radiometry of the plenoptic camera (issue 14, item 1): what a pixel's value measures.
+// Radiometry of the plenoptic camera: what a pixel's value measures.
 //
 // A pixel's samples are points s of the pixel and points q of a sampled aperture domain of
 // area A (the exit pupil's disc without an array, a microlens cell with one), each weighted by

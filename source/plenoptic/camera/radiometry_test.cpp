@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Irradiance radiometry (issue 14, item 1) against the optics written out here: the cos^4 law of
+// Irradiance radiometry against the optics written out here: the cos^4 law of
 // a pinhole, the view factor of a parallel disc, the cos^4 integral over a microlens cell, and
 // the etendue through an ideal microlens array. A uniform world of radiance 1
 // (every ray returns 1), so a pixel's value is E / C.

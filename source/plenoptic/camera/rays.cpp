@@ -18,7 +18,7 @@ bool project_to_array(const Model& m, Vec3 p, Vec2* local)
 {
     const Vec3 n = m.pose.normal;
     Vec3 q;
-    if (m.main_lens == MainLensType::None) {
+    if (!m.lens) {
         if (!(n.z > 0))
             return false;
         q = Vec3{p.x, p.y, p.z + dot(n, m.pose.centre_mm - p) / n.z};
@@ -128,7 +128,7 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
     if (m.grid == GridType::None) {
         // The sensor point towards a point of the exit pupil, through the lens.
         const Vec3 on_pupil = m.lens->exit_pupil_point(lens_u, lens_v);
-        if (m.main_lens == MainLensType::Pinhole)
+        if (!m.lens->forms_image())
             return weigh(m, finish(on_pupil, on_pupil - p, out), p, on_pupil, Vec3{0, 0, 1}, out);
         return weigh(m, emit(m.lens->to_scene(p, on_pupil - p, false), out), p, on_pupil, Vec3{0, 0, 1}, out);
     }
@@ -143,7 +143,7 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
         lens = nearest_lens(m.grid, m.pitch_mm, q.x, q.y);
     }
 
-    if (m.microlens == MicrolensType::ThinLens && m.main_lens == MainLensType::Pinhole)
+    if (m.microlens == MicrolensType::ThinLens && m.lens && !m.lens->forms_image())
         return through_pinhole_main(m, p, lens, check_apertures, out);
 
     const Vec2 c_local = lens_centre(m.grid, m.pitch_mm, lens);
@@ -167,9 +167,9 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
         direction = mul(m.pose.rotation, refracted);
     }
 
-    if (m.main_lens == MainLensType::None)
+    if (!m.lens)
         return weigh(m, finish(leave, direction, out), p, leave, m.pose.normal, out);
-    if (m.main_lens == MainLensType::Pinhole)
+    if (!m.lens->forms_image())
         return false;  // pinhole + pinhole: refused at parse time, no ray passes both points
 
     // A real lens behind an array parallel to the sensor: a ray that crosses the exit pupil's plane

@@ -241,7 +241,7 @@ Vec3 trace_back(const Model& m, const CameraParams& params, const OpticsRay& ray
     Vec3 at = origin_of(ray);
     Vec3 back;  // direction of travel towards the sensor, unit z magnitude where relevant
     const Vec3 d = dir_of(ray);
-    if (m.main_lens == MainLensType::ThinLens) {
+    if (test::lens_kind(m) == "thin_lens") {
         // Undo w' = w - m/F at the main lens.
         back = -Vec3{d.x / d.z + at.x / m.focal_length_mm, d.y / d.z + at.y / m.focal_length_mm, 1};
     } else {
@@ -253,9 +253,9 @@ Vec3 trace_back(const Model& m, const CameraParams& params, const OpticsRay& ray
     }
     // Meet the posed array plane.
     const Vec3 centre{params.array.translate_mm[0], params.array.translate_mm[1],
-                      (m.main_lens == MainLensType::None ? 0 : -m.distance_mm) + params.array.translate_mm[2]};
+                      (test::lens_kind(m) == "none" ? 0 : -m.distance_mm) + params.array.translate_mm[2]};
     const Vec3 n = test::reference_rotate(deg, Vec3{0, 0, 1});
-    if (m.main_lens != MainLensType::None) {
+    if (test::lens_kind(m) != "none") {
         const double t = dot(n, centre - at) / dot(n, back);
         at = at + t * back;
     }

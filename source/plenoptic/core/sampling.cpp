@@ -15,8 +15,6 @@ namespace plenoptic {
 
 namespace {
 
-const double kPi = 3.14159265358979323846;
-
 // splitmix64's finaliser: a well-mixed 64-bit hash.
 std::uint64_t mix64(std::uint64_t z)
 {

@@ -15,8 +15,6 @@
 namespace plenoptic {
 namespace test {
 
-const double kPi = 3.14159265358979323846;
-
 inline std::string str(Vec3 v)
 {
     std::ostringstream out;
@@ -40,6 +38,9 @@ inline Prescription vignetting_triplet()
     lens.surfaces.push_back(LensSurface{-40, 0, 1, 18, false, 7});
     return lens;
 }
+
+// The kind of a model's main lens, as the metadata names it ("none" without one).
+inline std::string lens_kind(const Model& m) { return m.lens ? m.lens->kind_name() : "none"; }
 
 inline Vec3 origin_of(const OpticsRay& r) { return Vec3{r.origin_mm[0], r.origin_mm[1], r.origin_mm[2]}; }
 inline Vec3 dir_of(const OpticsRay& r) { return Vec3{r.dir[0], r.dir[1], r.dir[2]}; }

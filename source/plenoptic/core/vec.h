@@ -8,6 +8,9 @@
 
 namespace plenoptic {
 
+// The one definition of pi in the optics core.
+const double kPi = 3.14159265358979323846;
+
 struct Vec2 { double x, y; };
 struct Vec3 { double x, y, z; };
 

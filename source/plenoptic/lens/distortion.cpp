@@ -90,7 +90,7 @@ std::string check_distortion(const DistortionParams& d, double max_normalised_ra
     for (int i = 1; i <= 64; ++i) {
         const double r = max_normalised_radius * i / 64;
         for (int j = 0; j < 128; ++j) {
-            const double angle = 2 * 3.14159265358979323846 * j / 128;
+            const double angle = 2 * kPi * j / 128;
             double a, b, c, e;
             jacobian(d, Vec2{r * std::cos(angle), r * std::sin(angle)}, &a, &b, &c, &e);
             if (!(a * e - b * c > 0))

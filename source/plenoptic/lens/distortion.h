@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Parametric distortion of the thin main lens (issue 13, item 6): the Brown-Conrady radial (k1, k2,
+// Parametric distortion of the thin main lens: the Brown-Conrady radial (k1, k2,
 // k3) and tangential (p1, p2) polynomial, as OpenCV, Zeller et al. and libpleno write it, applied
 // where an image-side ray crosses the plane of the microlens array (the sensor without an array).
 // Coordinates there are normalised by the main-lens-to-array distance D: (x, y) / D, the tangent

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Issue 13, the lens catalogue (lenses/, installed with the program): every lens file parses
+// The lens catalogue (lenses/, installed with the program): every lens file parses
 // without a refusal, and each design's paraxial EFL and back focal distance (and f-number, where
 // the source states one) match the values published with the design. The published values are
 // written here, each with its source, and never taken from the file itself; see lenses/README.md.

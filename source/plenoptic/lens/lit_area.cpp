@@ -24,8 +24,6 @@ namespace {
 const int kIntervals = 256;     // tabulated radii from the axis to the edge of the field, minus one
 const int kPoints = 987;        // lattice points on the half disc (a Fibonacci number, F16)
 const int kLatticeStep = 610;   // F15: the Fibonacci lattice's generator
-const double kPi = 3.14159265358979323846;
-
 double relative_lit_area(const MainLens& traced, const PupilBounds& bounds, double r, double paraxial_area,
                          double irradiance_k_mm2, double angular_exponent)
 {

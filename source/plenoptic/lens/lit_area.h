@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// How much light reaches a sensor point behind a real main lens without a microlens array
-// (issue 13): per distance from the axis, the area of the exit pupil's plane through which rays
+// How much light reaches a sensor point behind a real main lens without a microlens array:
+// per distance from the axis, the area of the exit pupil's plane through which rays
 // from the point pass every aperture of the lens, relative to the paraxial exit pupil's area.
 //
 // A pixel's samples cover the pupil-bounds disc (lens/pupil_bounds.h); some of them are

@@ -3,10 +3,9 @@
 
 #include "plenoptic/lens/main_lens.h"
 
+#include <algorithm>
 #include <cmath>
 
-#include "plenoptic/lens/distortion.h"
-#include "plenoptic/lens/prescription.h"
 #include "plenoptic/core/sampling.h"
 
 namespace plenoptic {
@@ -25,7 +24,9 @@ bool inside_disc(double x, double y, double radius)
 // Every ray through it passes through the origin.
 class PinholeMainLens : public MainLens {
 public:
-    MainLensType type() const override { return MainLensType::Pinhole; }
+    const char* kind_name() const override { return "pinhole"; }
+    const char* chief_ray_description() const override { return "through the lens centre"; }
+    bool forms_image() const override { return false; }
     Vec3 exit_pupil_centre() const override { return Vec3{0, 0, 0}; }
     double exit_pupil_radius() const override { return 0; }
     Vec3 exit_pupil_point(double, double) const override { return Vec3{0, 0, 0}; }
@@ -58,12 +59,37 @@ public:
 // straight on both sides, and the object side is the ideal lens's.
 class ThinMainLens : public MainLens {
 public:
-    ThinMainLens(double focal_length_mm, double aperture_mm) : focal_(focal_length_mm), radius_(0.5 * aperture_mm),
-        distorted_(false), distortion_(DistortionParams{{0, 0, 0}, {0, 0}}), plane_z_(0) {}
-    ThinMainLens(double focal_length_mm, double aperture_mm, const DistortionParams& distortion, double plane_z)
-        : focal_(focal_length_mm), radius_(0.5 * aperture_mm), distorted_(!is_identity(distortion) && plane_z < 0),
-          distortion_(distortion), plane_z_(plane_z) {}
-    MainLensType type() const override { return MainLensType::ThinLens; }
+    ThinMainLens(double focal_length_mm, double aperture_mm, double f_number)
+        : focal_(focal_length_mm), aperture_(aperture_mm), f_number_(f_number), radius_(0.5 * aperture_mm),
+          distorted_(false), distortion_(DistortionParams{{0, 0, 0}, {0, 0}}), plane_z_(0) {}
+    ThinMainLens(double focal_length_mm, double aperture_mm, double f_number, const DistortionParams& distortion,
+                 double plane_z)
+        : focal_(focal_length_mm), aperture_(aperture_mm), f_number_(f_number), radius_(0.5 * aperture_mm),
+          distorted_(!is_identity(distortion) && plane_z < 0), distortion_(distortion), plane_z_(plane_z) {}
+    const char* kind_name() const override { return "thin_lens"; }
+    const char* chief_ray_description() const override { return "through the lens centre"; }
+    double focal_length_mm() const override { return focal_; }
+    double aperture_mm() const override { return aperture_; }
+    double f_number() const override { return f_number_; }
+    bool front_window(FrontWindow* window) const override
+    {
+        *window = FrontWindow{0, radius_, 0};
+        return aperture_ > 0;
+    }
+    FrontWindow entrance_pupil() const override { return FrontWindow{0, radius_, 0}; }
+    std::string dark_image_advice(double distance_mm) const override
+    {
+        return " (main-lens aperture " + format_number(aperture_) + " mm, f-number " + format_number(f_number_) +
+               "; main lens to array or sensor " + format_number(distance_mm) +
+               " mm: a focus distance at the focal length puts it far behind the lens)";
+    }
+    std::string overlap_advice(double free_mm, double magnification) const override
+    {
+        if (!(free_mm > 0))
+            return "";
+        return "; a main-lens f_number of at least " + format_number(focal_ / (2 * free_mm / magnification)) +
+               " avoids it";
+    }
     Vec3 exit_pupil_centre() const override { return Vec3{0, 0, 0}; }
     double exit_pupil_radius() const override { return radius_; }
     Vec3 exit_pupil_point(double u, double v) const override
@@ -121,6 +147,8 @@ public:
 
 private:
     double focal_;
+    double aperture_;
+    double f_number_;
     double radius_;
     bool distorted_;
     DistortionParams distortion_;
@@ -135,9 +163,29 @@ private:
 // inside the pupil.
 class ThickMainLens : public MainLens {
 public:
-    ThickMainLens(double efl, double front_h, double rear_h, double pupil_z, double pupil_radius)
-        : focal_(efl), front_h_(front_h), rear_h_(rear_h), pupil_z_(pupil_z), radius_(pupil_radius) {}
-    MainLensType type() const override { return MainLensType::ThickLens; }
+    ThickMainLens(const Prescription& lens, const ParaxialData& p)
+        : lens_(lens), paraxial_(p), length_(p.rear_vertex_z), focal_(p.efl_mm),
+          front_h_(length_ - p.front_principal_z), rear_h_(length_ - p.rear_principal_z),
+          pupil_z_(length_ - p.exit_pupil_z), radius_(0.5 * p.exit_pupil_mm) {}
+    const char* kind_name() const override { return "thick_lens"; }
+    const char* chief_ray_description() const override
+    {
+        return "through the centre of the entrance pupil (paraxial model)";
+    }
+    double focal_length_mm() const override { return paraxial_.efl_mm; }
+    double aperture_mm() const override { return paraxial_.stop_mm; }
+    double f_number() const override { return paraxial_.f_number; }
+    const Prescription* prescription() const override { return &lens_; }
+    const ParaxialData* paraxial() const override { return &paraxial_; }
+    bool front_window(FrontWindow* window) const override
+    {
+        *window = entrance_pupil();
+        return paraxial_.valid;
+    }
+    FrontWindow entrance_pupil() const override
+    {
+        return FrontWindow{length_ - paraxial_.entrance_pupil_z, 0.5 * paraxial_.entrance_pupil_mm, 0};
+    }
     Vec3 exit_pupil_centre() const override { return Vec3{0, 0, pupil_z_}; }
     double exit_pupil_radius() const override { return radius_; }
     Vec3 exit_pupil_point(double u, double v) const override
@@ -190,6 +238,9 @@ public:
     }
 
 private:
+    Prescription lens_;
+    ParaxialData paraxial_;
+    double length_;  // front vertex at z = length_, rear vertex at 0
     double focal_, front_h_, rear_h_, pupil_z_, radius_;
 };
 
@@ -202,7 +253,27 @@ public:
         : lens_(lens), unbounded_(unbounded(lens)), length_(length), paraxial_(paraxial)
     {
     }
-    MainLensType type() const override { return MainLensType::Prescription; }
+    const char* kind_name() const override { return "prescription"; }
+    const char* chief_ray_description() const override { return "through the centre of the aperture stop (traced)"; }
+    double focal_length_mm() const override { return paraxial_.focal_length_mm(); }
+    double aperture_mm() const override { return paraxial_.aperture_mm(); }
+    double f_number() const override { return paraxial_.f_number(); }
+    bool traced() const override { return true; }
+    const Prescription* prescription() const override { return paraxial_.prescription(); }
+    const ParaxialData* paraxial() const override { return paraxial_.paraxial(); }
+    // The first surface: its vertex plane, clear radius and sag.
+    bool front_window(FrontWindow* window) const override
+    {
+        const Prescription& lens = *prescription();
+        if (lens.surfaces.empty())
+            return false;
+        const LensSurface& first = lens.surfaces.front();
+        const double r = 0.5 * first.aperture_mm, R = std::fabs(first.radius_mm);
+        const double sag = (first.stop || R == 0) ? 0 : R - std::sqrt(std::max(0.0, R * R - r * r));
+        *window = FrontWindow{length_, r, sag};
+        return true;
+    }
+    FrontWindow entrance_pupil() const override { return paraxial_.entrance_pupil(); }
     Vec3 exit_pupil_centre() const override { return paraxial_.exit_pupil_centre(); }
     double exit_pupil_radius() const override { return paraxial_.exit_pupil_radius(); }
     Vec3 exit_pupil_point(double u, double v) const override { return paraxial_.exit_pupil_point(u, v); }
@@ -255,8 +326,7 @@ std::shared_ptr<const MainLens> make_prescription_lens(const Prescription& lens,
     if (!p.valid)
         return nullptr;
     const double length = p.rear_vertex_z;  // front vertex at z_optics = length, rear at 0
-    const ThickMainLens thick(p.efl_mm, length - p.front_principal_z, length - p.rear_principal_z,
-                              length - p.exit_pupil_z, 0.5 * p.exit_pupil_mm);
+    const ThickMainLens thick(sized, p);
     if (!exact)
         return std::make_shared<ThickMainLens>(thick);
     return std::make_shared<ExactMainLens>(sized, length, thick);
@@ -285,9 +355,10 @@ std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& p, double d
         return std::make_shared<PinholeMainLens>();
     case MainLensType::ThinLens: {
         const double aperture = p.has_aperture ? p.aperture_mm : p.focal_length_mm / p.f_number;
+        const double f_number = p.has_f_number ? p.f_number : p.focal_length_mm / aperture;
         if (p.has_distortion)
-            return std::make_shared<ThinMainLens>(p.focal_length_mm, aperture, p.distortion, -distance_mm);
-        return std::make_shared<ThinMainLens>(p.focal_length_mm, aperture);
+            return std::make_shared<ThinMainLens>(p.focal_length_mm, aperture, f_number, p.distortion, -distance_mm);
+        return std::make_shared<ThinMainLens>(p.focal_length_mm, aperture, f_number);
     }
     case MainLensType::ThickLens:
     case MainLensType::Prescription:

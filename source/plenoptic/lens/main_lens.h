@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// The main lens as ray generation sees it: one interface for every kind of lens (issue 13), with
-// one implementation per kind. The optics frame has its origin at the main lens's reference point
+// The main lens: one interface for every kind of lens, with one implementation per kind, each
+// answering for itself (its pupils, its rays, its first-order data, what it is called). Nothing
+// outside this folder asks which kind a lens is; it asks the lens. The optics frame has its origin at the main lens's reference point
 // (the pinhole; the thin lens's plane), +z towards the scene, millimetres.
 
 #ifndef PLENOPTIC_MAIN_LENS_H
@@ -11,6 +12,8 @@
 
 #include "plenoptic/camera/params.h"
 #include "plenoptic/core/vec.h"
+#include "plenoptic/lens/distortion.h"
+#include "plenoptic/lens/prescription.h"
 
 namespace plenoptic {
 
@@ -35,10 +38,50 @@ struct HomogeneousPoint {
     double w;
 };
 
+// A disc in a plane z = const (optics frame) that light from the scene crosses before the lens,
+// with the sag of the surface behind it (0 for a plane): every ray that passes the lens crosses the
+// plane within the reach computed from it (forward projection's search window).
+struct FrontWindow {
+    double z, radius, sag;
+};
+
 class MainLens {
 public:
     virtual ~MainLens() {}
-    virtual MainLensType type() const = 0;
+
+    // What the metadata calls this kind of lens ("pinhole", "thin_lens", "thick_lens",
+    // "prescription") and how its chief rays are defined (metadata's main_lens.chief_ray).
+    virtual const char* kind_name() const = 0;
+    virtual const char* chief_ray_description() const = 0;
+
+    // First-order data: effective focal length F, aperture diameter A (a real lens's stop) and
+    // f-number (a real lens's: F / entrance-pupil diameter); all 0 for a pinhole.
+    virtual double focal_length_mm() const { return 0; }
+    virtual double aperture_mm() const { return 0; }
+    virtual double f_number() const { return 0; }
+    // A pinhole forms no image: every point is in focus, its pupil is a point, nothing blurs.
+    virtual bool forms_image() const { return true; }
+    // Traced surface by surface: points image where the trace takes them (distortion, aberration),
+    // not where the paraxial image is, so projection and microimage centres are traced too.
+    virtual bool traced() const { return false; }
+    // A real lens's surfaces as used (stop sized, iris applied) and their paraxial data; nullptr
+    // for the ideal lenses.
+    virtual const Prescription* prescription() const { return nullptr; }
+    virtual const ParaxialData* paraxial() const { return nullptr; }
+    // The window light from the scene crosses first (a prescription's first surface, the thin
+    // lens's aperture, the thick lens's entrance pupil); false when the lens has none.
+    virtual bool front_window(FrontWindow* window) const { (void)window; return false; }
+    // The paraxial entrance pupil: optics-frame z and radius.
+    virtual FrontWindow entrance_pupil() const { return FrontWindow{0, 0, 0}; }
+    // Advice when a render would be almost dark, or when microimages overlap by `free_mm` too
+    // little on the array (magnification k = d / D): "" when the lens has none to give.
+    virtual std::string dark_image_advice(double distance_mm) const { (void)distance_mm; return ""; }
+    virtual std::string overlap_advice(double free_mm, double magnification) const
+    {
+        (void)free_mm;
+        (void)magnification;
+        return "";
+    }
 
     // The centre of the exit pupil: image-side lines through it find a sensor point's own
     // microlens and the microimage centres.
@@ -62,8 +105,6 @@ public:
     // infinity is fine. A pinhole forms none: it returns the point itself with w = 1 (unused).
     virtual HomogeneousPoint paraxial_image(Vec3 point) const = 0;
 };
-
-struct Prescription;
 
 // A prescription lens in the optics frame: its rear vertex at the origin, its front vertex at
 // z = the lens's length (towards the scene), the stop at its written diameter unless stop_mm > 0.

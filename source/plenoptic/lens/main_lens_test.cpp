@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Issue 13: one main-lens interface. The thin lens keeps its formulas; a prescription's exact trace
+// One main-lens interface. The thin lens keeps its formulas; a prescription's exact trace
 // and its paraxial (thick-lens) equivalent agree for paraxial rays, and the thick lens images a
 // point where the thick-lens formulas say.
 

@@ -14,8 +14,6 @@ namespace plenoptic {
 
 namespace {
 
-const double kPi = 3.14159265358979323846;
-
 std::string row_name(const LensSurface& s, int index)
 {
     std::ostringstream out;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// A real main lens given by its prescription (issue 13): the surfaces, read from pbrt's
+// A real main lens given by its prescription: the surfaces, read from pbrt's
 // RealisticCamera lens files; its paraxial (first-order) data; and the exact trace of a ray
 // through it, surface by surface, with Snell's law, total internal reflection and every clear
 // aperture. Pure optics, no POV-Ray dependency.
@@ -69,7 +69,7 @@ double flat_radius(double radius_mm);
 // before it is returned.
 ParsedPrescription parse_lens_file(const std::string& text);
 
-// The refusals of issue 13: no surface, no stop or more than one, a non-positive or non-finite
+// The refusals: no surface, no stop or more than one, a non-positive or non-finite
 // number where one is needed, an index below 1, a surface whose clear aperture exceeds its
 // sphere (aperture > 2 |radius|; a surface of radius 0, possible only inline, is flat), a negative thickness;
 // a length beyond kPrescriptionMaxLengthMm (a radius there must have been made flat by the parser);

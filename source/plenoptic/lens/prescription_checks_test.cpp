@@ -17,8 +17,6 @@
 namespace plenoptic {
 namespace {
 
-const double kPi = 3.14159265358979323846;
-
 // A plano-convex singlet behind a stop: the stop, R = 100 (n = 1.5), then a rear surface whose
 // radius is `rear`.
 std::string plano_convex(const std::string& rear)

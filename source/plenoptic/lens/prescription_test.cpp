@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Issue 13, the prescription core: reading pbrt lens files, the refusals, first-order data
+// The prescription core: reading pbrt lens files, the refusals, first-order data
 // against the textbook formulas of a thick lens, and the exact trace against the exact
 // (trigonometric) refraction at one spherical surface.
 
@@ -11,8 +11,6 @@
 
 namespace plenoptic {
 namespace {
-
-const double kPi = 3.14159265358979323846;
 
 // A biconvex singlet (R1 = 100, R2 = -100, n = 1.5, centre thickness t) behind a stop 10 mm in
 // front of it.

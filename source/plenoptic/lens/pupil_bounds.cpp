@@ -27,8 +27,6 @@ const int kBisections = 24;      // steps of each bisection (2^-24 of the grid r
 const double kMargin = 1.01;     // radius margin for the bins, and again for points between them
 const int kMaxFieldDoublings = 60;
 
-const double kPi = 3.14159265358979323846;
-
 struct Probe {
     const MainLens& lens;
     double plane_z, pupil_z;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Where light from a point behind a real main lens can pass it (issue 13, "efficient sampling"):
+// Where light from a point behind a real main lens can pass it:
 // per distance from the axis, a disc of the exit pupil's plane that holds every point of that
 // plane through which a ray from the point passes all of the lens's apertures. Computed once per
 // render from the exact trace; ray generation samples that disc instead of the whole rear element,

@@ -19,7 +19,7 @@ bool local_to_px(const Model& m, int W, int H, Vec2 local, Vec2* px)
 {
     const Vec3 c = to_optics(m, Vec3{local.x, local.y, 0});
     double x = c.x, y = c.y;
-    if (m.main_lens != MainLensType::None) {
+    if (m.lens) {
         // The central projection from the exit pupil's centre e onto the sensor plane.
         const Vec3 e = m.lens->exit_pupil_centre();
         if (!(c.z < e.z))
@@ -157,7 +157,7 @@ MicroimageLattice microimage_lattice(const Model& m, int W, int H)
     lattice.basis_b_px[1] = basis[1].y;
     // Orthogonal projection (no main lens) of any plane is affine; central projection only of a
     // plane parallel to the sensor.
-    lattice.exact = m.main_lens == MainLensType::None || !m.pose.tilted;
+    lattice.exact = !m.lens || !m.pose.tilted;
     fit_lftoolbox(m, W, H, &lattice);
     return lattice;
 }

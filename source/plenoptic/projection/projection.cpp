@@ -66,7 +66,7 @@ std::vector<Vec2> microimage_cell(const Model& m, LensIndex lens)
     for (int i = 0; i < count; ++i) {
         const Vec3 q = to_optics(m, Vec3{c.x + cell[i].x, c.y + cell[i].y, 0});
         double s = 1;
-        if (m.main_lens != MainLensType::None) {
+        if (m.lens) {
             if (!(q.z < 0))
                 return std::vector<Vec2>();
             s = m.sensor_z_mm / q.z;
@@ -284,7 +284,7 @@ bool cone_footprint(const Model& m, Homogeneous image, Vec2 footprint[kFootprint
     const double r = m.lens->exit_pupil_radius();
     double first_sign = 0;
     for (int i = 0; i < kFootprintSides; ++i) {
-        const double angle = 2 * 3.14159265358979323846 * i / kFootprintSides;
+        const double angle = 2 * kPi * i / kFootprintSides;
         Homogeneous hit;
         if (!line_meets_plane(image, pupil + Vec3{r * std::cos(angle), r * std::sin(angle), 0}, m.pose.normal,
                               m.pose.centre_mm, &hit))
@@ -371,7 +371,7 @@ double delivered_area(const Model& m, int W, int H, LensIndex lens, const std::v
     const Box lit = bounding_box(inside);
     const double x0 = lit.x0, x1 = lit.x1, y0 = lit.y0, y1 = lit.y1;
     const int rings = receiving_rings(m);
-    if (!m.pose.tilted && m.main_lens != MainLensType::None) {
+    if (!m.pose.tilted && m.lens) {
         // Fast path: the cells within `rings` rings cover the disc of radius rings * row spacing
         // about the lens centre (ring r lies at least r row spacings away, and a point that far
         // is nearer to a lens within the rings than to any beyond), or the cell's inscribed
@@ -394,7 +394,7 @@ double delivered_area(const Model& m, int W, int H, LensIndex lens, const std::v
             const LensIndex other = from_skew(m.grid, k0 + dk, lens.l + dl);
             if (!within_rings(m, other, lens, rings))
                 continue;
-            if (!m.pose.tilted && m.main_lens != MainLensType::None) {
+            if (!m.pose.tilted && m.lens) {
                 // Cheap rejection: the cell's circumscribed circle, scaled onto the sensor.
                 const Vec3 oc = lens_centre_mm(m, other);
                 if (oc.z < 0) {
@@ -539,7 +539,7 @@ void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::ve
         }
         std::vector<Vec2> spot;
         for (int i = 0; i < kFootprintSides; ++i) {
-            const double angle = 2 * 3.14159265358979323846 * i / kFootprintSides;
+            const double angle = 2 * kPi * i / kFootprintSides;
             const Vec3 on_aperture = pupil + Vec3{r * std::cos(angle), r * std::sin(angle), 0};
             Vec3 hit;
             if (!sensor_hit_through_lens(m, lens, h, h - on_aperture, &hit))
@@ -662,7 +662,7 @@ std::vector<PixelHit> forward_project(const Model& m, int W, int H, const double
     const Vec3 point{point_mm[0], point_mm[1], point_mm[2]};
     if (!is_finite(point))
         return hits;
-    if (m.main_lens == MainLensType::Prescription || m.has_distortion)
+    if ((m.lens && m.lens->traced()) || m.has_distortion)
         return forward_project_traced(m, W, H, point, default_traced_projection_options());
     if (m.grid == GridType::None) {
         if (!(point.z > 0))
@@ -674,13 +674,13 @@ std::vector<PixelHit> forward_project(const Model& m, int W, int H, const double
             hits.push_back(PixelHit{LensIndex{0, 0}, u, v, 1.0});
         return hits;
     }
-    if (m.main_lens == MainLensType::None) {
+    if (!m.lens) {
         project_without_main(m, W, H, point, &hits);
         return hits;
     }
     if (!(point.z > 0))
         return hits;
-    if (m.main_lens == MainLensType::Pinhole)
+    if (!m.lens->forms_image())
         project_through_pinhole_main(m, W, H, point, &hits);
     else
         project_through_thin_main(m, W, H, point, &hits);

@@ -52,7 +52,7 @@ TEST(Optics, FocusedOnTheArrayImagesToTheCentreOfTheOnAxisMicroimage)
 // arrays use the untilted footprint with a margin of a pitch: an over-approximation.
 bool partly_covered(const Model& m, Vec3 x, LensIndex lens)
 {
-    if (m.main_lens != MainLensType::ThinLens || m.microlens != MicrolensType::ThinLens)
+    if (test::lens_kind(m) != "thin_lens" || m.microlens != MicrolensType::ThinLens)
         return false;
     const double F = m.focal_length_mm, D = m.distance_mm;
     const double b = F * x.z / (x.z - F);             // image distance behind the main lens
@@ -165,7 +165,7 @@ void check_forward_is_centroid(const char* name, const CameraParams& params, dou
         std::mt19937_64 rng(11);
         std::uniform_real_distribution<double> uni(0, 1);
         for (int n = 0; n < 400000; ++n) {
-            const double rho = r * std::sqrt(uni(rng)), phi = 2 * 3.14159265358979323846 * uni(rng);
+            const double rho = r * std::sqrt(uni(rng)), phi = 2 * kPi * uni(rng);
             const double mx = rho * std::cos(phi), my = rho * std::sin(phi);
             // Slope (per unit +z) of the ray X -> aperture point, then undo the main lens.
             const double wx = (p[0] - mx) / p[2] + mx / F, wy = (p[1] - my) / p[2] + my / F;

@@ -22,51 +22,6 @@ using detail::delivered_point;
 using detail::sensor_hit_through_lens;
 using detail::to_local;
 
-// A disc in a plane z = const (optics frame) that light from the scene crosses before the lens,
-// with the sag of the surface behind it: every ray that passes the lens crosses the plane within
-// the reach computed from it (window_reach).
-struct Window {
-    double z, radius, sag;
-};
-
-// The lens's front window: a prescription's first surface (its vertex plane, clear radius and
-// sag), the thin lens's plane and aperture; the thick lens's entrance pupil (its aperture, paraxial).
-bool front_window(const Model& m, Window* w)
-{
-    switch (m.main_lens) {
-    case MainLensType::ThinLens:
-        *w = Window{0, 0.5 * m.aperture_mm, 0};
-        return m.aperture_mm > 0;
-    case MainLensType::ThickLens:
-        *w = Window{m.lens_length_mm - m.paraxial.entrance_pupil_z, 0.5 * m.paraxial.entrance_pupil_mm, 0};
-        return m.paraxial.valid;
-    case MainLensType::Prescription: {
-        if (m.prescription.surfaces.empty())
-            return false;
-        const LensSurface& first = m.prescription.surfaces.front();
-        const double r = 0.5 * first.aperture_mm, R = std::fabs(first.radius_mm);
-        const double sag = (first.stop || R == 0) ? 0 : R - std::sqrt(std::max(0.0, R * R - r * r));
-        *w = Window{m.lens_length_mm, r, sag};
-        return true;
-    }
-    default:
-        return false;
-    }
-}
-
-// The paraxial entrance pupil (optics-frame z, radius): where to look when the window's coarse
-// grid finds no passing ray (a stop far smaller than the front element).
-void entrance_pupil(const Model& m, double* z, double* radius)
-{
-    if (m.main_lens == MainLensType::ThinLens) {
-        *z = 0;
-        *radius = 0.5 * m.aperture_mm;
-    } else {
-        *z = m.lens_length_mm - m.paraxial.entrance_pupil_z;
-        *radius = 0.5 * m.paraxial.entrance_pupil_mm;
-    }
-}
-
 // A square of the window's plane: centre (x, y), half side.
 struct Square {
     double x, y, half;
@@ -288,8 +243,8 @@ std::vector<PixelHit> forward_project_traced(const Model& m, int W, int H, Vec3 
                                              const TracedProjectionOptions& options)
 {
     std::vector<PixelHit> hits;
-    Window window;
-    if (!m.lens || !is_finite(point) || !front_window(m, &window) || !(window.radius > 0))
+    FrontWindow window;
+    if (!m.lens || !is_finite(point) || !m.lens->front_window(&window) || !(window.radius > 0))
         return hits;
     const double gap = point.z - window.z;
     if (!(gap > 2 * window.sag) || !(gap > 0))
@@ -304,8 +259,8 @@ std::vector<PixelHit> forward_project_traced(const Model& m, int W, int H, Vec3 
     Coarse coarse = coarse_pass(m, point, window.z, Square{0, 0, reach}, kCoarse);
     if (!coarse.window.valid) {
         // A stop much smaller than the window: look about the paraxial entrance pupil.
-        double pupil_z, pupil_radius;
-        entrance_pupil(m, &pupil_z, &pupil_radius);
+        const FrontWindow pupil = m.lens->entrance_pupil();
+        const double pupil_z = pupil.z, pupil_radius = pupil.radius;
         if (!(point.z > pupil_z) || !(pupil_radius > 0))
             return hits;
         const double scale = gap / (point.z - pupil_z);

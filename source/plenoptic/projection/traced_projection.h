@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Forward projection through a traced main lens (issue 13): where a 3-D point images, found by
+// Forward projection through a traced main lens: where a 3-D point images, found by
 // tracing its light through the lens ray by ray, since a real lens has no closed-form image.
 
 #ifndef PLENOPTIC_TRACED_PROJECTION_H

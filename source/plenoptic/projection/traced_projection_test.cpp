@@ -99,7 +99,7 @@ TEST(TracedProjection, ThroughAThinLensAgreesWithTheClosedForm)
                                 {0.3, -0.2, 400}, {-0.5, 0.3, 600}, {0.05, 0.02, 250}};
     for (const Case& c : thin_lens_cases()) {
         const Model m = make_model(c.params);
-        ASSERT_EQ(m.main_lens, MainLensType::ThinLens);
+        ASSERT_EQ(test::lens_kind(m), "thin_lens");
         const bool pinholes = m.microlens == MicrolensType::Pinhole && m.grid != GridType::None;
         size_t images = 0;
         double worst_px = 0, worst_fraction = 0;
@@ -161,7 +161,7 @@ TEST(TracedProjection, AWeakSingletImagesWhereTheThinLensDoes)
         c->sensor.pixel_size_mm[0] = c->sensor.pixel_size_mm[1] = 0.01;
     }
     const Model mr = make_model(real), mt = make_model(thin);
-    ASSERT_EQ(mr.main_lens, MainLensType::Prescription);
+    ASSERT_EQ(test::lens_kind(mr), "prescription");
     const double points[][3] = {{0, 0, 30000}, {5, -3, 25000}, {-20, 12, 50000}, {1, 0.5, 4000}};
     for (const auto& q : points) {
         const std::vector<PixelHit> a = forward_project(mt, 301, 201, q);

@@ -37,7 +37,7 @@ std::string check_diffraction(const DiffractionParams& diffraction, const Camera
     if (params.array.given && params.array.lens == MicrolensType::Pinhole)
         return "diffraction needs apertures with a size: pinhole microlenses have none (a point diffracts light "
                "everywhere); give the array focal_length";
-    if (!params.array.given && params.main.given && params.main.type == MainLensType::Pinhole)
+    if (!params.array.given && is_pinhole(params.main))
         return "diffraction needs an aperture with a size: a pinhole main lens has none; use a thin_lens";
     return "";
 }

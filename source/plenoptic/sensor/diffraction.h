@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Diffraction (issue 14, item 2): the Airy pattern of the aperture that forms the sensor's image,
+// Diffraction: the Airy pattern of the aperture that forms the sensor's image,
 // one wavelength per colour channel, as a convolution of the rendered picture.
 //
 // With an array the aperture is a microlens's, of diameter p (the cell's inscribed circle) at d

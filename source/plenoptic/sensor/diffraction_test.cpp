@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Diffraction (issue 14, item 2): the Airy kernel against the Airy pattern's closed forms (its
+// Diffraction: the Airy kernel against the Airy pattern's closed forms (its
 // first dark ring, and the encircled energy 1 - J0(x)^2 - J1(x)^2, Rayleigh's result), the Airy
 // radius of a Lytro-class camera written out from 1.22 lambda N, and the convolution's bookkeeping.
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// The sensor model (issue 14): from the noise-free linear picture the camera renders to the raw
+// The sensor model: from the noise-free linear picture the camera renders to the raw
 // a real sensor would read out, in digital numbers (DN), optionally through a Bayer mosaic.
 //
 // Per pixel and colour site, with v the noise-free value (1.0 is the exposure's reference):

@@ -18,11 +18,10 @@ std::string check_white_image(const WhiteImageRequest& request, const CameraPara
     if (int(request.f_numbers.size()) > kMaxWhiteImages)
         return "white_image: f_numbers lists at most " + format_number(kMaxWhiteImages) + " f-numbers, got " +
                format_number(double(request.f_numbers.size()));
-    const MainLensType type = params.main.given ? params.main.type : MainLensType::None;
-    if (!(type == MainLensType::ThinLens || is_prescription_type(type)))
+    if (!has_sized_aperture(params.main))
         return "white_image: f_numbers needs a main lens with an aperture (thin_lens, thick_lens, lens_file or "
                "prescription { }); this camera has " +
-               std::string(type == MainLensType::Pinhole ? "a pinhole main lens" : "no main lens");
+               std::string(is_pinhole(params.main) ? "a pinhole main lens" : "no main lens");
     return check_white_image_f_numbers(request, params);
 }
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// White images (issue 14, part 4): what the camera records of a uniform white diffuser in front
+// White images: what the camera records of a uniform white diffuser in front
 // of the main lens, the calibration image every decoder starts from. Computed from the camera
 // alone: every ray that passes the optics brings radiance 1, so no scene ray is traced; the pixel
 // loop is the render's own (shade_pixel), with its samples, vignetting and overlap, so a white

@@ -18,7 +18,7 @@ const double kNaN = std::numeric_limits<double>::quiet_NaN();
 // The main lens's own blur on the sensor (no array).
 double main_lens_blur_px(const Model& m, Vec3 point)
 {
-    if (!m.lens || m.main_lens == MainLensType::Pinhole)
+    if (!m.lens || !m.lens->forms_image())
         return 0;
     const HomogeneousPoint image = m.lens->paraxial_image(point);
     const Vec3 pupil = m.lens->exit_pupil_centre();
@@ -38,11 +38,11 @@ double blur_radius_px(const Model& m, const double point_mm[3], LensIndex lens)
     const Vec3 point{point_mm[0], point_mm[1], point_mm[2]};
     if (m.grid == GridType::None)
         return main_lens_blur_px(m, point);
-    if (m.microlens == MicrolensType::Pinhole || m.main_lens == MainLensType::Pinhole)
+    if (m.microlens == MicrolensType::Pinhole || (m.lens && !m.lens->forms_image()))
         return 0;
     const Vec3 c = lens_centre_mm(m, lens);
     double inverse_a = 0;  // 1/a; 0 for an image at infinity
-    if (m.main_lens == MainLensType::None) {
+    if (!m.lens) {
         const double a = dot(m.pose.normal, point - c);
         inverse_a = 1 / a;
     } else {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Issue 12, item 2: the depth map is filled as the image is rendered. Its storage grows with the
+// The depth map is filled as the image is rendered. Its storage grows with the
 // rows rendered (a partial render holds only its region), and the depth a continued render owes
 // for the blocks it does not trace is handed out in step with the render, all of it by the end.
 

@@ -14,7 +14,6 @@ namespace plenoptic {
 
 namespace {
 
-const double kPi = 3.14159265358979323846;
 const int kSecantSteps = 40;
 
 // First-order data in the optics frame: focal length and the z of the two focal points.
@@ -28,7 +27,7 @@ class StopAim {
 public:
     explicit StopAim(const Model& m) : m_(m), stop_index_(-1), stop_lens_z_(0)
     {
-        if (m.main_lens != MainLensType::Prescription)
+        if (!m.lens || !m.lens->traced())
             return;
         const std::vector<double> z = vertex_positions(m.prescription);
         for (std::size_t i = 0; i < m.prescription.surfaces.size(); ++i) {
@@ -92,9 +91,10 @@ DistortionProfile distortion_profile(const Model& m, int W, int H, int count)
 {
     DistortionProfile out = DistortionProfile();
     out.valid = false;
-    const bool thin = m.main_lens == MainLensType::ThinLens;
-    if (!m.lens || !(thin || is_prescription_type(m.main_lens)) || count < 2 || W <= 0 || H <= 0)
+    if (!m.lens || !m.lens->forms_image() || count < 2 || W <= 0 || H <= 0)
         return out;
+    // An ideal thin lens has no paraxial data of its own: its focal points are at +-F.
+    const bool thin = !m.lens->paraxial();
     if (!thin && !m.paraxial.valid)
         return out;
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// The main lens's distortion profile (issue 13, ground truth): over the field, the height at
+// The main lens's distortion profile (ground truth): over the field, the height at
 // which the real chief ray meets the image plane against the paraxial image height.
 
 #ifndef PLENOPTIC_DISTORTION_PROFILE_H

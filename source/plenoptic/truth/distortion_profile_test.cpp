@@ -95,7 +95,7 @@ TEST(DistortionProfile, StopPositionGivesTheSignOfASinglesDistortion)
     const Model front = singlet_camera(20, MainLensType::Prescription);
     const Model behind = singlet_camera(-20, MainLensType::Prescription);
     const Model thick = singlet_camera(20, MainLensType::ThickLens);
-    ASSERT_EQ(front.main_lens, MainLensType::Prescription);
+    ASSERT_EQ(test::lens_kind(front), "prescription");
     const DistortionProfile a = distortion_profile(front, 1500, 1000, 9);
     const DistortionProfile b = distortion_profile(behind, 1500, 1000, 9);
     const DistortionProfile c = distortion_profile(thick, 1500, 1000, 9);

@@ -88,17 +88,6 @@ void layout(const Json& value, int depth, bool one_line, std::string* out)
     *out += object ? '}' : ']';
 }
 
-const char* main_lens_name(MainLensType type)
-{
-    switch (type) {
-    case MainLensType::ThinLens: return "thin_lens";
-    case MainLensType::Pinhole: return "pinhole";
-    case MainLensType::ThickLens: return "thick_lens";
-    case MainLensType::Prescription: return "prescription";
-    default: return "none";
-    }
-}
-
 // The surfaces as the render used them (the stop at its working diameter), object side first.
 Json prescription_json(const Model& m)
 {
@@ -158,10 +147,7 @@ Json distortion_profile_json(const Model& m, int W, int H)
     Json json = Json::object();
     json["object_plane_z_mm"] = profile.object_at_infinity ? Json(nullptr) : number(profile.object_plane_z_mm);
     json["image_plane_z_mm"] = number(profile.image_plane_z_mm);
-    json["chief_ray"] = m.main_lens == MainLensType::Prescription
-                            ? "through the centre of the aperture stop (traced)"
-                            : (m.main_lens == MainLensType::ThickLens ? "through the centre of the entrance pupil (paraxial model)"
-                                                                      : "through the lens centre");
+    json["chief_ray"] = m.lens->chief_ray_description();
     json["columns"] = Json::array({"relative_field", "field_angle_deg", "paraxial_height_mm", "real_height_mm", "distortion_percent"});
     Json samples = Json::array();
     for (const DistortionSample& s : profile.samples) {
@@ -175,15 +161,15 @@ Json distortion_profile_json(const Model& m, int W, int H)
 
 Json main_lens(const Model& m, int W, int H)
 {
-    const bool has_focal = m.main_lens == MainLensType::ThinLens || is_prescription_type(m.main_lens);
+    const bool has_focal = m.lens && m.lens->forms_image();
     Json json = Json::object();
-    json["type"] = main_lens_name(m.main_lens);
+    json["type"] = m.lens ? m.lens->kind_name() : "none";
     json["focal_length_mm"] = number_or_null(has_focal, m.focal_length_mm);
     json["aperture_mm"] = number_or_null(has_focal, m.aperture_mm);
     json["f_number"] = number_or_null(has_focal, m.f_number);
-    json["distance_mm"] = number_or_null(m.main_lens != MainLensType::None, m.distance_mm);
+    json["distance_mm"] = number_or_null(bool(m.lens), m.distance_mm);
     json["focus_distance"] = number_or_null(m.has_focus_distance, m.focus_distance_units);
-    if (is_prescription_type(m.main_lens)) {
+    if (m.lens && m.lens->prescription()) {
         json["prescription"] = prescription_json(m);
         json["paraxial"] = paraxial_json(m);
     }
@@ -231,7 +217,7 @@ Json lattice_json(const Model& m, const MicroimageLattice& lattice)
     json["lens_types"] = types;
     json["lens_type_rule"] = types == 3 ? "type(k, l) = (k - l) mod 3, focal_lengths_mm[type]" : "type(k, l) = 0";
     // Diameter of the main lens's exit pupil imaged through a lens centre (the f-number-matched disc).
-    const bool has_pupil = m.lens && m.main_lens != MainLensType::Pinhole;
+    const bool has_pupil = m.lens && m.lens->forms_image();
     const double pupil_mm = has_pupil ? 2 * m.lens->exit_pupil_radius() : 0;  // a thin lens's: A (2 * A/2, exact)
     json["microimage_diameter_px"] =
         number_or_null(has_pupil, pupil_mm * effective_array_distance_mm(m) / effective_main_distance_mm(m) / m.pixel_size_mm[0]);

@@ -24,7 +24,6 @@ namespace {
 using detail::project_to_array;
 using detail::to_optics;
 
-const double kPi = 3.14159265358979323846;
 const int kCoarseSearch = 24;   // grid points a side when the start point is dark
 const int kMaxDoublings = 8;    // of the bracket, when a boundary lies beyond it
 const int kMaxBisections = 60;
@@ -194,7 +193,7 @@ Guess guess_region(const Model& m, int W, int H, LensIndex lens, double lens_u, 
     PupilDisc disc{m.lens->exit_pupil_centre(), m.lens->exit_pupil_radius()};
     if (m.pupil_bounds)
         disc = m.pupil_bounds->disc_for(h);
-    if (m.main_lens == MainLensType::Pinhole || !(disc.radius >= 0)) {
+    if (!m.lens->forms_image() || !(disc.radius >= 0)) {
         const double main = effective_main_distance_mm(m);
         const double cell = m.cell_circumradius_mm * (main > 0 ? (main + behind) / main : 1);
         return Guess{true, lattice_px.x + 0.5, lattice_px.y + 0.5, 2 * cell / pixel + 2};

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Ground truth of the microimages (issue 13, `<image>.microimages.csv`): where the light of a
+// Ground truth of the microimages (`<image>.microimages.csv`): where the light of a
 // white scene falls behind each microlens, computed through the camera's own rays. Behind a real
 // main lens (pupil aberration, vignetting, distortion) the microimages are no longer the
 // projections of the lens centres from the exit pupil's centre: their centres leave the lattice

@@ -93,7 +93,7 @@ TEST(MicroimageTruth, CatsEyesAgreeWithABruteForceCount)
     params.main.prescription = lens;
     params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.5;
     const Model m = make_model(params);
-    ASSERT_EQ(m.main_lens, MainLensType::Prescription);
+    ASSERT_EQ(test::lens_kind(m), "prescription");
     const int W = 120, H = 120;
     const std::vector<MicroimageTruth> truth = microimage_truth(m, W, H, default_microimage_options());
     ASSERT_FALSE(truth.empty());

@@ -14,8 +14,7 @@ namespace plenoptic {
 
 bool is_focused_camera(const Model& m)
 {
-    if (m.grid == GridType::None || m.microlens != MicrolensType::ThinLens || !m.lens ||
-        m.main_lens == MainLensType::None || m.main_lens == MainLensType::Pinhole)
+    if (m.grid == GridType::None || m.microlens != MicrolensType::ThinLens || !m.lens || !m.lens->forms_image())
         return false;
     const double d = effective_array_distance_mm(m);
     for (int t = 0; t < m.lens_type_count; ++t)
@@ -27,7 +26,7 @@ bool is_focused_camera(const Model& m)
 double virtual_depth(const Model& m, Vec3 point)
 {
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    if (!m.lens || m.main_lens == MainLensType::None || m.main_lens == MainLensType::Pinhole || m.grid == GridType::None)
+    if (!m.lens || !m.lens->forms_image() || m.grid == GridType::None)
         return nan;
     const HomogeneousPoint image = m.lens->paraxial_image(point);
     if (!(image.w != 0))
