@@ -120,14 +120,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 
     // Write what was read, read it again: the same camera, and the same text when written again.
     const std::string written =
-        metadata_json(m, metadata.params, metadata.width, metadata.height, metadata.frame, metadata.depth_map);
+        metadata_json(with_film(m, metadata.width, metadata.height), metadata.params, metadata.frame, metadata.depth_map);
     RenderMetadata again;
     std::string again_error;
     FUZZ_ASSERT(parse_metadata(written, &again, &again_error), "the writer's own file is refused: %s\n%s",
                 again_error.c_str(), written.c_str());
     expect_same_camera(metadata, again);
     const std::string rewritten =
-        metadata_json(again.model, again.params, again.width, again.height, again.frame, again.depth_map);
+        metadata_json(with_film(again.model, again.width, again.height), again.params, again.frame, again.depth_map);
     FUZZ_ASSERT(rewritten == written, "writing the re-read camera changed the text:\n%s\n---\n%s", written.c_str(),
                 rewritten.c_str());
 

@@ -152,16 +152,16 @@ struct Count {
 // `samples` from make_sample, then generate_ray. Without an array also the pbrt-style sample: the
 // same aperture sample mapped onto the rear element's clear aperture (a disc in the plane of the
 // rear vertex), traced with the lens's own exact trace.
-void count_pixel(const Model& m, int W, int H, int i, int j, int samples, double rear_radius_mm, Count* c)
+void count_pixel(const Model& m, int i, int j, int samples, double rear_radius_mm, Count* c)
 {
     for (int n = 0; n < samples; ++n) {
         const CameraSample s = make_sample(i, j, n, samples);
         OpticsRay ray;
         ++c->generated;
-        if (generate_ray(m, W, H, i, j, s, nullptr, &ray))
+        if (generate_ray(m, i, j, s, nullptr, &ray))
             ++c->passed;
         if (m.grid == GridType::None && rear_radius_mm > 0) {
-            const Vec3 p = sensor_point(m, W, H, i + s.pixel_u, j + s.pixel_v);
+            const Vec3 p = sensor_point(m, i + s.pixel_u, j + s.pixel_v);
             const Vec2 d = concentric_disc(s.lens_u, s.lens_v);
             const Vec3 on_rear{rear_radius_mm * d.x, rear_radius_mm * d.y, 0};
             ++c->unbounded_generated;
@@ -236,7 +236,7 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "plenoptic_pass_fractions: %s\n", error.c_str());
         return 1;
     }
-    const Model m = make_model(params);
+    const Model m = with_film(make_model(params), o.width, o.height);
     const int W = o.width, H = o.height;
     int patch = o.patch;
     if (patch == 0)
@@ -272,11 +272,11 @@ int main(int argc, char** argv)
     for (int k = 0; k < 3; ++k) {
         const Place& p = places[k];
         Count pixel, block;
-        count_pixel(m, W, H, p.i, p.j, o.samples, unbounded ? rear_radius : 0, &pixel);
+        count_pixel(m, p.i, p.j, o.samples, unbounded ? rear_radius : 0, &pixel);
         for (int j = p.j0; j < p.j0 + patch; ++j)
             for (int i = p.i0; i < p.i0 + patch; ++i)
-                count_pixel(m, W, H, i, j, o.samples, unbounded ? rear_radius : 0, &block);
-        const Vec3 at = sensor_point(m, W, H, p.i + 0.5, p.j + 0.5);
+                count_pixel(m, i, j, o.samples, unbounded ? rear_radius : 0, &block);
+        const Vec3 at = sensor_point(m, p.i + 0.5, p.j + 0.5);
         std::printf("  {\"place\": \"%s\", \"pixel\": [%d, %d], \"field_radius_mm\": %.6f,\n", p.name, p.i, p.j,
                     std::hypot(at.x, at.y));
         std::printf("   \"pixel_counts\": %s,\n", counts_json(pixel, unbounded).c_str());
@@ -293,8 +293,8 @@ int main(int argc, char** argv)
         Count block;
         for (int j = j0; j < j0 + patch; ++j)
             for (int i = i0; i < i0 + patch; ++i)
-                count_pixel(m, W, H, i, j, o.samples, unbounded ? rear_radius : 0, &block);
-        const Vec3 at = sensor_point(m, W, H, i0 + 0.5 * patch, j0 + 0.5 * patch);
+                count_pixel(m, i, j, o.samples, unbounded ? rear_radius : 0, &block);
+        const Vec3 at = sensor_point(m, i0 + 0.5 * patch, j0 + 0.5 * patch);
         std::printf("  {\"patch_first_pixel\": [%d, %d], \"field_radius_mm\": %.6f, \"patch_counts\": %s}%s\n", i0, j0,
                     std::hypot(at.x, at.y), counts_json(block, unbounded).c_str(), k < kProfile ? "," : "");
     }

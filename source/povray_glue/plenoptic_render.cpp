@@ -41,7 +41,8 @@ std::shared_ptr<Render> published;
 
 Render::Render(std::shared_ptr<const CameraSetup> setup, const CameraFrame& frame, int width, int height,
                PixelRect area, const std::vector<PixelRect>& untraced)
-    : setup_(std::move(setup)), frame_(frame), frame_orthonormal_(is_orthonormal(frame)), width_(width),
+    : setup_(std::move(setup)), model_(with_film(setup_->model, width, height)), frame_(frame),
+      frame_orthonormal_(is_orthonormal(frame)), width_(width),
       height_(height), continued_(!untraced.empty())
 {
     if (setup_->depth_map) {

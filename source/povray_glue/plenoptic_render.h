@@ -24,7 +24,8 @@ public:
            PixelRect area, const std::vector<PixelRect>& untraced);
 
     const CameraSetup& setup() const { return *setup_; }
-    const Model& model() const { return setup_->model; }
+    // The camera of this render: the parsed model with the render's film (width x height).
+    const Model& model() const { return model_; }
     // The optics frame in the scene: +x right, +y up, +z towards the scene, unit axes.
     const CameraFrame& frame() const { return frame_; }
     // right, up, direction orthonormal: a unit optics direction stays unit in the scene.
@@ -41,6 +42,7 @@ public:
 
 private:
     std::shared_ptr<const CameraSetup> setup_;
+    Model model_;
     CameraFrame frame_;
     bool frame_orthonormal_;
     int width_, height_;

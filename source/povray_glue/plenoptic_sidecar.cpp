@@ -159,7 +159,7 @@ bool write_virtual_depth_exr(const std::string& path, const Model& model, const 
             return false;
         const float* rendered = depth.row(j);
         for (int i = 0; i < W; ++i)
-            row[i] = pixel_virtual_depth(model, W, H, i, j, rendered != nullptr ? rendered[i] : -1.0f);
+            row[i] = pixel_virtual_depth(model, i, j, rendered != nullptr ? rendered[i] : -1.0f);
         return true;
     });
 }
@@ -255,7 +255,9 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
     }
     bool ok = true;
     SidecarFiles files;
-    const Model& model = render->model();
+    // The camera with the film of the image written (the render's, unless the front end wrote
+    // another size).
+    const Model model = with_film(render->model(), W, H);
     if (render->depth() != nullptr && W == render->width() && H == render->height()) {
         const long long unknown = render->backfill() ? render->backfill()->pixels_not_handed_out() : 0;
         if (unknown > 0)
@@ -290,13 +292,13 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
             if (total >= 20000)
                 std::fprintf(stderr, "plenoptic camera: microimage centres: %zu of %zu lenses\n", done, total);
         };
-        const std::vector<MicroimageTruth> truth = microimage_truth(model, W, H, options, progress, render_cancel_requested);
+        const std::vector<MicroimageTruth> truth = microimage_truth(model, options, progress, render_cancel_requested);
         const std::string path = microimages_path_for(image_path);
         if (render_cancel_requested()) {
             std::fprintf(stderr, "plenoptic camera: cancelled: no microimage centres written (%s); the metadata says "
                                  "\"microimages\": null.\n", path.c_str());
         } else {
-            MicroimageSummary summary = summarise_microimages(model, W, H, truth, options, base_name(path));
+            MicroimageSummary summary = summarise_microimages(model, truth, options, base_name(path));
             if (write_text_atomically("microimage centres", path, microimages_csv(model, truth, summary.fit)))
                 microimages.reset(new MicroimageSummary(summary));
             else
@@ -334,9 +336,9 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
             const double f_number = own ? model.f_number : white.f_numbers[size_t(k)];
             std::unique_ptr<Model> other;
             if (!own)
-                other.reset(new Model(make_model(at_f_number(params, f_number))));
+                other.reset(new Model(with_film(make_model(at_f_number(params, f_number)), W, H)));
             const Model& optics = own ? model : *other;
-            const std::vector<float> values = white_image(optics, W, H, render_cancel_requested);
+            const std::vector<float> values = white_image(optics, render_cancel_requested);
             if (values.empty())
                 break;  // cancelled
             // R, G and B of the grey white image, where they are needed: diffraction differs by
@@ -392,7 +394,7 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
     files.microimages = microimages.get();
     files.raw = raw_file;
     files.white_images = whites.get();
-    const std::string json = metadata_json(model, render->setup().params, W, H, render->frame(), files);
+    const std::string json = metadata_json(model, render->setup().params, render->frame(), files);
     if (!write_text_atomically("metadata", metadata_path_for(image_path), json))
         ok = false;
     return ok;

@@ -46,21 +46,23 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 	plenoptic::Render& render = *camera.PlenopticRender;
 	const plenoptic::Model& model = render.model();
 	const int W = (int)width, H = (int)height;
+	if (W != model.film.width || H != model.film.height)
+		throw POV_EXCEPTION_STRING("plenoptic camera: a pixel of an image of another size than the render's (internal error).");
 	// Antialiasing may ask for sub-pixel positions: the camera samples the whole pixel itself.
 	const int i = (int)std::floor(x + 0.5), j = (int)std::floor(y + 0.5);
 
 	plenoptic::DepthMap *depth = render.depth();
-	if (depth != NULL && !pretrace && W == render.width() && H == render.height())
+	if (depth != NULL && !pretrace)
 	{
 		// Distance along a pixel's chief ray, from the lens it leaves to the first surface;
 		// +inf where it hits nothing, -1 where no sample of the pixel passes the apertures.
 		auto depth_of = [&](int column, int row) -> float
 		{
-			if (!plenoptic::pixel_receives_light(model, column, row, W, H))
+			if (!plenoptic::pixel_receives_light(model, column, row))
 				return -1.0f;
 			Ray ray;
 			ray.SetFlags(Ray::PrimaryRay, false, false, false, false, pretrace);
-			To_Scene(render, plenoptic::chief_ray(model, W, H, column, row), ray);
+			To_Scene(render, plenoptic::chief_ray(model, column, row), ray);
 			Intersection isect;
 			return FindIntersection(isect, ray) ? (float)isect.Depth : std::numeric_limits<float>::infinity();
 		};
@@ -78,7 +80,7 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 	}
 
 	POV_ULONG traced = 0;  // camera rays into the scene, for the render statistics' "Samples"
-	plenoptic::Rgbt value = plenoptic::shade_pixel(model, i, j, W, H,
+	plenoptic::Rgbt value = plenoptic::shade_pixel(model, i, j,
 		[&](const plenoptic::OpticsRay& optics_ray) -> plenoptic::Rgbt
 		{
 			traced++;

@@ -430,7 +430,7 @@ void read_all(const Json& root, RenderMetadata* out)
     const std::string problem = check_camera(p);
     if (!problem.empty())
         throw FieldError("the camera described is invalid: " + problem);
-    out->model = make_model(p);
+    out->model = with_film(make_model(p), out->width, out->height);
     const Model& m = out->model;
 
     // Derived values must agree with what the parameters give.
@@ -438,7 +438,7 @@ void read_all(const Json& root, RenderMetadata* out)
                 "the distances (main_lens.distance_mm, microlens_array.distance_mm, translate_mm)");
     double principal[2];
     numbers(root, "", "principal_point_px", 2, false, principal);
-    const Vec2 pp = principal_point_px(m, out->width, out->height);
+    const Vec2 pp = principal_point_px(m);
     check_close("principal_point_px[0]", principal[0], pp.x, out->width + 1.0, "image.width and sensor.offset_mm");
     check_close("principal_point_px[1]", principal[1], pp.y, out->height + 1.0, "image.height and sensor.offset_mm");
     const Json& lattice = member(root, "", "microimage_lattice");
@@ -447,14 +447,14 @@ void read_all(const Json& root, RenderMetadata* out)
             refuse("microimage_lattice", "null when microlens_array is null", lattice);
     } else {
         // null only where the writer writes null: a lattice whose numbers overflow (absurd poses).
-        if (lattice.is_null() && !microimage_lattice(m, out->width, out->height).valid)
+        if (lattice.is_null() && !microimage_lattice(m).valid)
             return;
         if (!lattice.is_object())
             refuse("microimage_lattice", "an object (the file has a microlens array)", lattice);
         double origin[2];
         numbers(lattice, "microimage_lattice", "origin_px", 2, false, origin);
         double u, v;
-        if (microimage_centre_px(m, out->width, out->height, LensIndex{0, 0}, &u, &v)) {
+        if (microimage_centre_px(m, LensIndex{0, 0}, &u, &v)) {
             const double scale = out->width + out->height + 1.0;
             check_close("microimage_lattice.origin_px[0]", origin[0], u, scale, "the lens parameters");
             check_close("microimage_lattice.origin_px[1]", origin[1], v, scale, "the lens parameters");
@@ -531,7 +531,7 @@ std::vector<PixelHit> project_world_point(const RenderMetadata& md, const double
     double optics[3];
     if (!world_to_optics_mm(md, world, optics))
         return std::vector<PixelHit>();
-    return forward_project(md.model, md.width, md.height, optics);
+    return forward_project(md.model, optics);
 }
 
 } // namespace plenoptic

@@ -49,7 +49,7 @@ CameraParams hexagonal_camera()
 std::string good_text(const std::string& depth_map = "scene.depth.exr")
 {
     const CameraParams p = hexagonal_camera();
-    return metadata_json(make_model(p), p, 320, 240, kFrame, depth_map);
+    return metadata_json(with_film(make_model(p), 320, 240), p, kFrame, depth_map);
 }
 
 // The text with its first `from` replaced by `to`.
@@ -184,7 +184,7 @@ TEST(MetadataReader, ExtremeShiftsKeepALatticeTheReaderTakesBack)
     p.array.translate_mm[0] = 1e12;
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 1e-12;
     ASSERT_EQ(check_camera(p), "");
-    const std::string text = metadata_json(make_model(p), p, 320, 240, kFrame, "");
+    const std::string text = metadata_json(with_film(make_model(p), 320, 240), p, kFrame, "");
     ASSERT_FALSE(contains(text, "\"microimage_lattice\": null")) << text;
     RenderMetadata metadata;
     std::string error;

@@ -65,14 +65,15 @@ CameraParams pinhole_main(double D)
 }
 
 // Rays of one sensor point: pixel (i, j)'s centre, `count` aperture samples. Unblocked ones only.
-std::vector<OpticsRay> rays_of_point(const Model& m, int W, int H, int i, int j, int count)
+std::vector<OpticsRay> rays_of_point(const Model& m, int i, int j, int count)
 {
+    const int W = m.film.width, H = m.film.height;
     std::vector<OpticsRay> rays;
     for (int n = 0; n < count; ++n) {
         CameraSample s = make_sample(i, j, n, count);
         s.pixel_u = s.pixel_v = 0.5;
         OpticsRay ray;
-        if (generate_ray(m, W, H, i, j, s, nullptr, &ray))
+        if (generate_ray(with_film(m, W, H), i, j, s, nullptr, &ray))
             rays.push_back(ray);
     }
     return rays;
@@ -91,11 +92,11 @@ TEST(OpticsExtremes, ThinMainLensRaysMeetAtTheConjugateFromFocalLength1e6To1e_6)
             params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = F * 1e-3;  // ~0.01 rad per pixel
             ASSERT_EQ(check_camera(params), "") << describe(params);
             const Model m = make_model(params);
-            const Vec3 p = sensor_point(m, W, H, i + 0.5, j + 0.5);
+            const Vec3 p = sensor_point(with_film(m, W, H), i + 0.5, j + 0.5);
             // Independently, with divisions (the code under test has none): the image of p.
             const double u = 1 / (1 / F - 1 / m.distance_mm);
             const Vec3 conjugate{-p.x * u / m.distance_mm, -p.y * u / m.distance_mm, u};
-            const std::vector<OpticsRay> rays = rays_of_point(m, W, H, i, j, 64);
+            const std::vector<OpticsRay> rays = rays_of_point(with_film(m, W, H), i, j, 64);
             ASSERT_EQ(rays.size(), 64u) << describe(params) << ": a bare thin lens blocks nothing";
             for (const OpticsRay& r : rays) {
                 if (D_over_F > 1 + 1e-9) {
@@ -121,8 +122,8 @@ TEST(OpticsExtremes, SensorAtTheFocalPlaneGivesParallelRaysAtEveryScale)
         CameraParams params = thin_main(F, 1.4, F);  // D = F exactly
         params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = F * 1e-3;
         const Model m = make_model(params);
-        const Vec3 expected = normalized(-sensor_point(m, W, H, i + 0.5, j + 0.5));
-        for (const OpticsRay& r : rays_of_point(m, W, H, i, j, 64))
+        const Vec3 expected = normalized(-sensor_point(with_film(m, W, H), i + 0.5, j + 0.5));
+        for (const OpticsRay& r : rays_of_point(with_film(m, W, H), i, j, 64))
             EXPECT_LT(length(dir_of(r) - expected), 1e-14) << describe(params) << " " << str(dir_of(r));
     }
 }
@@ -186,12 +187,12 @@ TEST(OpticsExtremes, PlenopticRaysOfASensorPointMeetAtTheSystemConjugate)
             const Model m = make_model(params);
             int met = 0;
             for (const auto& px : pixels) {
-                const Vec3 p = sensor_point(m, W, H, px[0] + 0.5, px[1] + 0.5);
+                const Vec3 p = sensor_point(with_film(m, W, H), px[0] + 0.5, px[1] + 0.5);
                 LensIndex lens;
                 ASSERT_TRUE(own_lens(m, p, &lens));
                 const Vec3 c = lens_centre_mm(m, lens);
                 const Homog X = system_conjugate(p, c, sc.f, sc.d, sc.D, sc.F);
-                for (const OpticsRay& r : rays_of_point(m, W, H, px[0], px[1], 128)) {
+                for (const OpticsRay& r : rays_of_point(with_film(m, W, H), px[0], px[1], 128)) {
                     double scale;
                     const double err = homog_miss(X, r, &scale);
                     EXPECT_LT(err, 1e-9 * std::max(scale, sc.F))
@@ -223,7 +224,7 @@ TEST(OpticsExtremes, BareArrayRaysMeetAtTheMicrolensConjugateEvenTiltedNearlyEdg
                 const double* deg = params.array.rotate_deg;
                 for (int i : {5, 20, 37}) {
                     const int j = (i * 7) % H;
-                    const Vec3 p = sensor_point(m, W, H, i + 0.5, j + 0.5);
+                    const Vec3 p = sensor_point(with_film(m, W, H), i + 0.5, j + 0.5);
                     LensIndex lens;
                     if (!own_lens(m, p, &lens))
                         continue;
@@ -233,13 +234,13 @@ TEST(OpticsExtremes, BareArrayRaysMeetAtTheMicrolensConjugateEvenTiltedNearlyEdg
                     const Vec3 p_local = test::reference_unrotate(deg, p - m.pose.centre_mm);
                     const double s = -p_local.z;
                     if (!(s > 0)) {  // the point is in front of the (steeply tilted) array: no light
-                        EXPECT_TRUE(rays_of_point(m, W, H, i, j, 16).empty()) << describe(params);
+                        EXPECT_TRUE(rays_of_point(with_film(m, W, H), i, j, 16).empty()) << describe(params);
                         continue;
                     }
                     // Homogeneous image of p by the microlens: (c (s - f) + (c - p) f, f s, w = s - f).
                     const double w = s - f;
                     const Vec3 xyz = w * c_local + f * (c_local - p_local);  // z: f s
-                    const std::vector<OpticsRay> rays = rays_of_point(m, W, H, i, j, 64);
+                    const std::vector<OpticsRay> rays = rays_of_point(with_film(m, W, H), i, j, 64);
                     for (const OpticsRay& r : rays) {
                         const Vec3 o = origin_of(r);
                         // Origin on the array plane (the last element).
@@ -284,7 +285,7 @@ TEST(OpticsExtremes, PinholeMainLensRaysAllLeaveThroughThePinhole)
                     for (int i = 0; i < W; i += 3) {
                         for (int n = 0; n < 8; ++n) {
                             OpticsRay r;
-                            if (!generate_ray(m, W, H, i, j, make_sample(i, j, n, 8), nullptr, &r))
+                            if (!generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, 8), nullptr, &r))
                                 continue;
                             ++unblocked;
                             if (!(r.origin_mm[0] == 0 && r.origin_mm[1] == 0 && r.origin_mm[2] == 0))
@@ -327,7 +328,7 @@ void check_invariants(const CameraParams& params, int W, int H, int* models, lon
         const int i = px[0], j = px[1];
         for (int n = 0; n < 6; ++n) {
             OpticsRay r;
-            if (!generate_ray(m, W, H, i, j, make_sample(i, j, n, 6), nullptr, &r))
+            if (!generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, 6), nullptr, &r))
                 continue;
             ++*rays;
             const Vec3 o = origin_of(r), d = dir_of(r);
@@ -346,7 +347,7 @@ void check_invariants(const CameraParams& params, int W, int H, int* models, lon
                     << what << " origin " << str(o) << " off the array plane";
             }
         }
-        const OpticsRay chief = chief_ray(m, W, H, i, j);
+        const OpticsRay chief = chief_ray(with_film(m, W, H), i, j);
         ASSERT_TRUE(is_finite(origin_of(chief)) && is_finite(dir_of(chief))) << what << " chief ray";
         ASSERT_NEAR(length(dir_of(chief)), 1.0, 1e-12) << what << " chief ray";
     }
@@ -357,7 +358,7 @@ void check_invariants(const CameraParams& params, int W, int H, int* models, lon
         return;
     for (double z : {1e-3, 1.0, 1e3, 1e9}) {
         const double point[3] = {0.05 * z, -0.03 * z, z};
-        for (const PixelHit& hit : forward_project(m, W, H, point)) {
+        for (const PixelHit& hit : forward_project(with_film(m, W, H), point)) {
             ASSERT_TRUE(std::isfinite(hit.u) && std::isfinite(hit.v)) << what << " z " << z;
             ASSERT_TRUE(hit.u >= -0.5 && hit.u < W - 0.5 && hit.v >= -0.5 && hit.v < H - 0.5)
                 << what << " forward_project hit (" << hit.u << ", " << hit.v << ") outside the image";

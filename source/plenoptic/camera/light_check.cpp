@@ -17,18 +17,19 @@ const int kMaxPatchPixels = 64;
 
 } // namespace
 
-double lit_fraction_near_axis(const Model& model)
+double lit_fraction_near_axis(const Model& camera)
 {
     // A patch about three microimages (or, without an array, a few pixels) across, centred on
     // the pixel where the optical axis meets the sensor.
     int patch = 8;
-    if (model.grid != GridType::None) {
-        const double pixel_mm = std::min(model.pixel_size_mm[0], model.pixel_size_mm[1]);
-        const double across = 3 * model.pitch_mm / pixel_mm;
+    if (camera.grid != GridType::None) {
+        const double pixel_mm = std::min(camera.pixel_size_mm[0], camera.pixel_size_mm[1]);
+        const double across = 3 * camera.pitch_mm / pixel_mm;
         patch = int(std::min<double>(kMaxPatchPixels, std::max(8.0, std::ceil(across))));
     }
-    const int W = patch, H = patch;
-    const Vec2 axis = principal_point_px(model, W, H);
+    // The camera taking a picture of just the patch.
+    const Model model = with_film(camera, patch, patch);
+    const Vec2 axis = principal_point_px(model);
     if (!std::isfinite(axis.x) || !std::isfinite(axis.y))
         return 0;
     const int i0 = int(std::floor(axis.x)) - patch / 2, j0 = int(std::floor(axis.y)) - patch / 2;
@@ -37,7 +38,7 @@ double lit_fraction_near_axis(const Model& model)
         for (int i = i0; i < i0 + patch; ++i)
             for (int n = 0; n < kSamplesPerPixel; ++n, ++total) {
                 OpticsRay ray;
-                if (generate_ray(model, W, H, i, j, make_sample(i, j, n, kSamplesPerPixel), nullptr, &ray))
+                if (generate_ray(model, i, j, make_sample(i, j, n, kSamplesPerPixel), nullptr, &ray))
                     ++passing;
             }
     return total > 0 ? double(passing) / total : 0;

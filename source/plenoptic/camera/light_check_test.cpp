@@ -11,7 +11,7 @@
 namespace plenoptic {
 namespace {
 
-using test::kPi;
+
 
 CameraParams plenoptic_1_0(double f_number)
 {

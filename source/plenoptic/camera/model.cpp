@@ -87,6 +87,12 @@ double effective_array_distance_mm(const Model& model)
     return model.pose.centre_mm.z - model.sensor_z_mm;
 }
 
+Model with_film(Model model, int width, int height)
+{
+    model.film = Film{width, height};
+    return model;
+}
+
 Model make_model(const CameraParams& params)
 {
     Model m = Model();

@@ -33,6 +33,14 @@ struct ArrayPose {
 // Above this tilt (sine of the angle, about 11.5 degrees) a pixel's overlap lenses are not pruned.
 const double kMaxPrunedTiltSine = 0.2;
 
+// The sensor's picture: its size in pixels. The scene parser knows no image size (POV-Ray's +W
+// and +H come with the render), so a model is made without one (0 x 0) and a render's camera
+// carries its own (with_film): everything that maps pixels to sensor points reads it here.
+struct Film {
+    int width;
+    int height;
+};
+
 // Optics frame: origin at the main-lens centre (a real lens's rear vertex; the array centre when
 // there is no main lens), +z towards the scene, +x right, +y up; millimetres throughout.
 struct Model {
@@ -79,6 +87,7 @@ struct Model {
     double cell_inradius_mm;     // of a lens's lattice cell
     double cell_circumradius_mm;
 
+    Film film;                   // the picture's size in pixels (0 x 0 until with_film)
     double sensor_z_mm;          // -(D + d); -D without array; -d without main lens
     double pixel_size_mm[2];
     double sensor_offset_mm[2];
@@ -98,6 +107,9 @@ struct Model {
 
 // Builds the model from parameters that passed check_camera. Pure: no image size, no state.
 Model make_model(const CameraParams& params);
+
+// The same camera taking a picture of width x height pixels.
+Model with_film(Model model, int width, int height);
 
 // Legal but implausible parameters, one sentence each (empty when nothing is odd).
 std::vector<std::string> warnings(const Model& model);

@@ -89,7 +89,7 @@ TEST(Model, RotationFollowsPovRayConvention)
     // with its element layout ([1][2] = sin x, [0][2] = -sin y, [0][1] = sin z), and compare.
     const double angles[][3] = {{10, 0, 0}, {0, 20, 0}, {0, 0, 30}, {10, -20, 30}, {89.99, 45, -170}};
     for (const auto& deg : angles) {
-        const double rad = test::kPi / 180;
+        const double rad = kPi / 180;
         const double cx = std::cos(deg[0] * rad), sx = std::sin(deg[0] * rad);
         const double cy = std::cos(deg[1] * rad), sy = std::sin(deg[1] * rad);
         const double cz = std::cos(deg[2] * rad), sz = std::sin(deg[2] * rad);

@@ -95,13 +95,13 @@ inline CameraSample lens_sample(int i, int j, int n, int count, int lenses, int*
 
 // How many of samples from .. to-1 of pixel (i, j) pass the apertures through the pixel's own
 // lenses (geometry only); *first is the first of them (-1 if none).
-inline int passing_samples(const Model& model, int i, int j, int W, int H, int from, int to, int* first)
+inline int passing_samples(const Model& model, int i, int j, int from, int to, int* first)
 {
     int passing = 0;
     *first = -1;
     for (int n = from; n < to; ++n) {
         OpticsRay ray;
-        if (generate_ray(model, W, H, i, j, make_sample(i, j, n, to), nullptr, &ray)) {
+        if (generate_ray(model, i, j, make_sample(i, j, n, to), nullptr, &ray)) {
             ++passing;
             if (*first < 0)
                 *first = n;
@@ -116,15 +116,15 @@ inline int passing_samples(const Model& model, int i, int j, int W, int H, int f
 // `sum` holds the sums of the `passed` traced colours of samples 0 .. n-1. With none passed but
 // some probe passing, that probe's sample is traced so the pixel is not black where light lands.
 template <class TraceFn>
-Rgbt vignetted_value(const Model& model, int i, int j, int W, int H, int n, int passed, double sum[4], TraceFn& trace)
+Rgbt vignetted_value(const Model& model, int i, int j, int n, int passed, double sum[4], TraceFn& trace)
 {
     const int probes = n * kVignettingProbesPerSample;
     int first_untraced;
     // Samples 0 .. n-1 were generated already: only the points after them are new.
-    const int passing = passed + passing_samples(model, i, j, W, H, n, probes, &first_untraced);
+    const int passing = passed + passing_samples(model, i, j, n, probes, &first_untraced);
     if (passed == 0 && first_untraced >= 0) {
         OpticsRay ray;
-        generate_ray(model, W, H, i, j, make_sample(i, j, first_untraced, probes), nullptr, &ray);
+        generate_ray(model, i, j, make_sample(i, j, first_untraced, probes), nullptr, &ray);
         const Rgbt c = detail::traced(trace, ray);
         sum[0] = c.r;
         sum[1] = c.g;
@@ -144,12 +144,12 @@ const int kLitAreaGrid = 4;
 // The mean lit area (LitAreaTable) of pixel (i, j): the midpoint rule on a kLitAreaGrid square
 // grid over the pixel. The lit area is smooth across a pixel (a kink where vignetting sets in at
 // most), so the rule's error is second order in the pixel's size; a table look-up each, no trace.
-inline double mean_lit_area(const Model& model, int i, int j, int W, int H)
+inline double mean_lit_area(const Model& model, int i, int j)
 {
     double total = 0;
     for (int b = 0; b < kLitAreaGrid; ++b)
         for (int a = 0; a < kLitAreaGrid; ++a)
-            total += model.lit_area->at(sensor_point(model, W, H, i + (a + 0.5) / kLitAreaGrid, j + (b + 0.5) / kLitAreaGrid));
+            total += model.lit_area->at(sensor_point(model, i + (a + 0.5) / kLitAreaGrid, j + (b + 0.5) / kLitAreaGrid));
     return total / (kLitAreaGrid * kLitAreaGrid);
 }
 
@@ -161,9 +161,9 @@ inline double mean_lit_area(const Model& model, int i, int j, int W, int H)
 // vignetting costs look-ups, not traces. With none passed, the first passing point of
 // kVignettingProbesPerSample n points of its sample sequence is traced for the colour.
 template <class TraceFn>
-Rgbt lit_area_value(const Model& model, int i, int j, int W, int H, int n, int passed, const double plain[4], TraceFn& trace)
+Rgbt lit_area_value(const Model& model, int i, int j, int n, int passed, const double plain[4], TraceFn& trace)
 {
-    const double lit = mean_lit_area(model, i, j, W, H);
+    const double lit = mean_lit_area(model, i, j);
     if (!(lit > 0))
         return Rgbt{0, 0, 0, 0};
     if (passed > 0) {
@@ -173,7 +173,7 @@ Rgbt lit_area_value(const Model& model, int i, int j, int W, int H, int n, int p
     const int points = n * kVignettingProbesPerSample;
     for (int k = n; k < points; ++k) {
         OpticsRay ray;
-        if (generate_ray(model, W, H, i, j, make_sample(i, j, k, points), nullptr, &ray)) {
+        if (generate_ray(model, i, j, make_sample(i, j, k, points), nullptr, &ray)) {
             const Rgbt c = trace(ray);
             return Rgbt{c.r * lit, c.g * lit, c.b * lit, c.t * lit};
         }
@@ -199,7 +199,7 @@ Rgbt lit_area_value(const Model& model, int i, int j, int W, int H, int n, int p
 // the value is the sum over lenses of each lens's mean; t is clamped to [0, 1]. A pixel that no
 // lens reaches is black and opaque, never background.
 template <class TraceFn>
-Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
+Rgbt shade_pixel(const Model& model, int i, int j, TraceFn trace)
 {
     const int count = std::max(1, model.samples_max);
     if (!model.adaptive && !model.model_overlap) {
@@ -210,7 +210,7 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
         int passed = 0;
         for (int n = 0; n < count; ++n) {
             OpticsRay ray;
-            if (generate_ray(model, W, H, i, j, make_sample(i, j, n, count), nullptr, &ray)) {
+            if (generate_ray(model, i, j, make_sample(i, j, n, count), nullptr, &ray)) {
                 // With a lit-area table the colours are summed without the ray weight: the
                 // pixel's lit area scales their mean (detail::lit_area_value).
                 const Rgbt c = lit_area ? trace(ray) : detail::traced(trace, ray);
@@ -222,16 +222,16 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
             }
         }
         if (lit_area)
-            return detail::lit_area_value(model, i, j, W, H, count, passed, sum, trace);
+            return detail::lit_area_value(model, i, j, count, passed, sum, trace);
         if (count > 1 && passed < count)
-            return detail::vignetted_value(model, i, j, W, H, count, passed, sum, trace);
+            return detail::vignetted_value(model, i, j, count, passed, sum, trace);
         return Rgbt{sum[0] / count, sum[1] / count, sum[2] / count, sum[3] / count};
     }
 
     LensIndex lenses[kMaxOverlapLenses];
     int lens_count = 1;
     if (model.model_overlap) {
-        lens_count = overlap_lenses(model, W, H, i, j, lenses, kMaxOverlapLenses);
+        lens_count = overlap_lenses(model, i, j, lenses, kMaxOverlapLenses);
         if (lens_count == 0)
             return Rgbt{0, 0, 0, 0};
     }
@@ -251,7 +251,7 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
             const CameraSample sample = detail::lens_sample(i, j, n, count, lens_count, &slot);
             OpticsRay ray;
             Rgbt colour{0, 0, 0, 0};
-            if (generate_ray(model, W, H, i, j, sample, model.model_overlap ? &lenses[slot] : nullptr, &ray)) {
+            if (generate_ray(model, i, j, sample, model.model_overlap ? &lenses[slot] : nullptr, &ray)) {
                 const Rgbt raw = trace(ray);
                 colour = Rgbt{raw.r * ray.weight, raw.g * ray.weight, raw.b * ray.weight, raw.t * ray.weight};
                 plain[0] += raw.r;
@@ -280,9 +280,9 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
             break;
     }
     if (lens_count == 1 && n > 1 && model.lit_area)
-        return detail::lit_area_value(model, i, j, W, H, n, passed, plain, trace);
+        return detail::lit_area_value(model, i, j, n, passed, plain, trace);
     if (lens_count == 1 && n > 1 && passed < n)
-        return detail::vignetted_value(model, i, j, W, H, n, passed, sums[0].sum, trace);
+        return detail::vignetted_value(model, i, j, n, passed, sums[0].sum, trace);
     detail::estimate(sums, lens_count, value, variance);
     const double t = lens_count > 1 ? std::min(1.0, std::max(0.0, value[3])) : value[3];
     return Rgbt{value[0], value[1], value[2], t};
@@ -291,10 +291,10 @@ Rgbt shade_pixel(const Model& model, int i, int j, int W, int H, TraceFn trace)
 // Whether any of the sample points shade_pixel looks at for pixel (i, j) passes the apertures
 // (the traced samples and the vignetting probes): the pixels for which it is false are those
 // no light reaches (no scene needed).
-inline bool pixel_receives_light(const Model& model, int i, int j, int W, int H)
+inline bool pixel_receives_light(const Model& model, int i, int j)
 {
     bool lit = false;
-    shade_pixel(model, i, j, W, H, [&lit](const OpticsRay&) {
+    shade_pixel(model, i, j, [&lit](const OpticsRay&) {
         lit = true;
         return Rgbt{0, 0, 0, 0};
     });

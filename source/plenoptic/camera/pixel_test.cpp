@@ -43,14 +43,14 @@ TEST(Pixel, BlockedSamplesAreBlackAndOpaqueNeverBackground)
         ++calls;
         return Rgbt{1, 1, 1, 1};
     };
-    const Rgbt dark = shade_pixel(m, 70, 50, W, H, background);
+    const Rgbt dark = shade_pixel(with_film(m, W, H), 70, 50, background);
     EXPECT_EQ(calls, 0) << "no ray reaches a pixel between the microimages";
     EXPECT_EQ(dark.r, 0.0);
     EXPECT_EQ(dark.g, 0.0);
     EXPECT_EQ(dark.b, 0.0);
     EXPECT_EQ(dark.t, 0.0) << "a pixel no ray reaches is opaque, never background";
 
-    const Rgbt lit = shade_pixel(m, 50, 50, W, H, background);
+    const Rgbt lit = shade_pixel(with_film(m, W, H), 50, 50, background);
     EXPECT_EQ(calls, 16);
     EXPECT_EQ(lit.r, 1.0);
     EXPECT_EQ(lit.t, 1.0);
@@ -59,14 +59,14 @@ TEST(Pixel, BlockedSamplesAreBlackAndOpaqueNeverBackground)
     // 4 x 16 sample points looked at (the vignetting probes).
     bool partial = false;
     for (int i = 51; i < 60 && !partial; ++i) {
-        const Rgbt edge = shade_pixel(m, i, 50, W, H, background);
+        const Rgbt edge = shade_pixel(with_film(m, W, H), i, 50, background);
         if (edge.r > 0 && edge.r < 1) {
             partial = true;
             EXPECT_EQ(edge.r, edge.t);
             const int probes = 16 * kVignettingProbesPerSample;
             EXPECT_NEAR(edge.r * probes, std::round(edge.r * probes), 1e-9) << "a whole number of the probes";
             int first;
-            EXPECT_EQ(edge.r, double(detail::passing_samples(m, i, 50, W, H, 0, probes, &first)) / probes);
+            EXPECT_EQ(edge.r, double(detail::passing_samples(with_film(m, W, H), i, 50, 0, probes, &first)) / probes);
         }
     }
     EXPECT_TRUE(partial) << "expected a partly vignetted pixel near the microimage's edge";
@@ -84,7 +84,7 @@ TEST(Pixel, AdaptiveSamplingStopsEarlyOnFlatScenesAndGoesOnOnNoisyOnes)
         ++calls;
         return Rgbt{0.3, 0.3, 0.3, 0};
     };
-    const Rgbt value = shade_pixel(m, 10, 10, 64, 64, flat);
+    const Rgbt value = shade_pixel(with_film(m, 64, 64), 10, 10, flat);
     EXPECT_EQ(calls, 8) << "zero variance after the minimum";
     EXPECT_NEAR(value.r, 0.3, 1e-15);
 
@@ -93,7 +93,7 @@ TEST(Pixel, AdaptiveSamplingStopsEarlyOnFlatScenesAndGoesOnOnNoisyOnes)
         ++calls;
         return Rgbt{ray.origin_mm[0] > 0 ? 1.0 : 0.0, 0, 0, 0};
     };
-    shade_pixel(m, 10, 10, 64, 64, noisy);
+    shade_pixel(with_film(m, 64, 64), 10, 10, noisy);
     EXPECT_GT(calls, 8);
     EXPECT_LE(calls, 64);
     EXPECT_EQ((calls - 8) % 4 == 0 || calls == 64, true) << calls << " samples: batches of 4 after the minimum";
@@ -118,12 +118,12 @@ TEST(Pixel, AdaptiveSamplingDoesNotTakeAnUnluckyBlockedStartForADarkPixel)
             bool first_lit = false;
             for (int n = 0; n < minimum && !first_lit; ++n) {
                 OpticsRay ray;
-                first_lit = generate_ray(m_adaptive, W, H, i, j, make_sample(i, j, n, maximum), nullptr, &ray);
+                first_lit = generate_ray(with_film(m_adaptive, W, H), i, j, make_sample(i, j, n, maximum), nullptr, &ray);
             }
-            const bool lit = shade_pixel(m_fixed, i, j, W, H, white).r > 0;
-            const Rgbt value = shade_pixel(m_adaptive, i, j, W, H, white);
+            const bool lit = shade_pixel(with_film(m_fixed, W, H), i, j, white).r > 0;
+            const Rgbt value = shade_pixel(with_film(m_adaptive, W, H), i, j, white);
             EXPECT_EQ(value.r > 0, lit) << "pixel " << i << "," << j << ": dark exactly when no sample passes";
-            EXPECT_EQ(pixel_receives_light(m_adaptive, i, j, W, H), lit) << "pixel " << i << "," << j;
+            EXPECT_EQ(pixel_receives_light(with_film(m_adaptive, W, H), i, j), lit) << "pixel " << i << "," << j;
             if (lit && !first_lit)
                 ++unlucky;
         }
@@ -144,13 +144,13 @@ TEST(Pixel, VignettingProbesBringRimPixelsCloserToTheirTrueLitFraction)
     for (int j = 0; j < H; j += 2)
         for (int i = 0; i < W; i += 2) {
             int first;
-            const double truth = double(detail::passing_samples(m, i, j, W, H, 0, reference, &first)) / reference;
+            const double truth = double(detail::passing_samples(with_film(m, W, H), i, j, 0, reference, &first)) / reference;
             if (truth == 0 || truth == 1)
                 continue;
             ++rim;
-            const double plain = double(detail::passing_samples(m, i, j, W, H, 0, samples, &first)) / samples;
+            const double plain = double(detail::passing_samples(with_film(m, W, H), i, j, 0, samples, &first)) / samples;
             error_plain += (plain - truth) * (plain - truth);
-            const double probed = shade_pixel(m, i, j, W, H, white).r;
+            const double probed = shade_pixel(with_film(m, W, H), i, j, white).r;
             error_probed += (probed - truth) * (probed - truth);
         }
     ASSERT_GT(rim, 500) << "f-number-matched microimages: many pixels at their rims";
@@ -167,10 +167,10 @@ TEST(Pixel, DeterministicWhateverThePixelOrder)
     std::vector<Rgbt> forward, backward(W * H);
     for (int j = 0; j < H; ++j)
         for (int i = 0; i < W; ++i)
-            forward.push_back(shade_pixel(m, i, j, W, H, textured));
+            forward.push_back(shade_pixel(with_film(m, W, H), i, j, textured));
     for (int j = H - 1; j >= 0; --j)
         for (int i = W - 1; i >= 0; --i)
-            backward[j * W + i] = shade_pixel(m, i, j, W, H, textured);
+            backward[j * W + i] = shade_pixel(with_film(m, W, H), i, j, textured);
     for (int k = 0; k < W * H; ++k) {
         ASSERT_EQ(forward[k].r, backward[k].r) << k;
         ASSERT_EQ(forward[k].g, backward[k].g) << k;
@@ -195,11 +195,11 @@ TEST(Pixel, OverlapModellingLeavesSingleLensPixelsUnchanged)
     LensIndex lenses[kMaxOverlapLenses];
     for (int j = 0; j < H; ++j) {
         for (int i = 0; i < W; ++i) {
-            if (overlap_lenses(forced, W, H, i, j, lenses, kMaxOverlapLenses) != 1)
+            if (overlap_lenses(with_film(forced, W, H), i, j, lenses, kMaxOverlapLenses) != 1)
                 continue;
             ++single;
-            const Rgbt a = shade_pixel(plain, i, j, W, H, textured);
-            const Rgbt b = shade_pixel(forced, i, j, W, H, textured);
+            const Rgbt a = shade_pixel(with_film(plain, W, H), i, j, textured);
+            const Rgbt b = shade_pixel(with_film(forced, W, H), i, j, textured);
             ASSERT_EQ(a.r, b.r) << i << "," << j;
             ASSERT_EQ(a.g, b.g) << i << "," << j;
             ASSERT_EQ(a.b, b.b) << i << "," << j;
@@ -285,7 +285,7 @@ TEST(Pixel, OverlapPixelsAreUnbiasedEstimatesOfEachLensIntegral)
     for (int j = 10; j < 20; ++j) {
         for (int i = 10; i < 20; ++i) {
             LensIndex lenses[kMaxOverlapLenses];
-            const int L = overlap_lenses(m, W, H, i, j, lenses, kMaxOverlapLenses);
+            const int L = overlap_lenses(with_film(m, W, H), i, j, lenses, kMaxOverlapLenses);
             if (L < 2)
                 continue;
             double truth[3] = {0, 0, 0};
@@ -298,7 +298,7 @@ TEST(Pixel, OverlapPixelsAreUnbiasedEstimatesOfEachLensIntegral)
                                 const CameraSample sample{(a + 0.5) / grid, (b + 0.5) / grid, (c + 0.5) / grid,
                                                           (e + 0.5) / grid};
                                 OpticsRay ray;
-                                if (!generate_ray(m, W, H, i, j, sample, &lenses[s], &ray))
+                                if (!generate_ray(with_film(m, W, H), i, j, sample, &lenses[s], &ray))
                                     continue;
                                 const Rgbt v = scene(ray);
                                 sum[0] += v.r;
@@ -308,7 +308,7 @@ TEST(Pixel, OverlapPixelsAreUnbiasedEstimatesOfEachLensIntegral)
                 for (int ch = 0; ch < 3; ++ch)
                     truth[ch] += sum[ch] / (grid * grid * grid * grid);
             }
-            const Rgbt got = shade_pixel(m, i, j, W, H, scene);
+            const Rgbt got = shade_pixel(with_film(m, W, H), i, j, scene);
             const double error[3] = {got.r - truth[0], got.g - truth[1], got.b - truth[2]};
             for (int ch = 0; ch < 3; ++ch) {
                 EXPECT_NEAR(error[ch], 0.0, 0.05) << "pixel " << i << "," << j << " lenses " << L << " channel " << ch;
@@ -319,12 +319,13 @@ TEST(Pixel, OverlapPixelsAreUnbiasedEstimatesOfEachLensIntegral)
     EXPECT_GT(compared, 10);
 }
 
-double mean_white_image(const Model& m, int W, int H)
+double mean_white_image(const Model& m)
 {
+    const int W = m.film.width, H = m.film.height;
     double sum = 0;
     for (int j = 0; j < H; ++j)
         for (int i = 0; i < W; ++i)
-            sum += shade_pixel(m, i, j, W, H, [](const OpticsRay&) { return Rgbt{1, 1, 1, 0}; }).r;
+            sum += shade_pixel(with_film(m, W, H), i, j, [](const OpticsRay&) { return Rgbt{1, 1, 1, 0}; }).r;
     return sum / (double(W) * H);
 }
 
@@ -342,15 +343,15 @@ TEST(Pixel, WhiteSceneMeanIsApertureImageAreaOverCellArea)
         const Model m = make_model(params);
         const int W = 220, H = 220;
         const double A = F / f_number;
-        const double expected = test::kPi * (A * d / (2 * D)) * (A * d / (2 * D)) / (cell * cell);
-        const double mean = mean_white_image(m, W, H);
+        const double expected = kPi * (A * d / (2 * D)) * (A * d / (2 * D)) / (cell * cell);
+        const double mean = mean_white_image(with_film(m, W, H));
         EXPECT_NEAR(mean, expected, 0.003 * expected)
             << "f/" << f_number << " overlap modelled: " << m.model_overlap << " rings " << m.overlap_rings;
         if (f_number == 2.5) {
             // Without overlap modelling the neighbours' light would be lost.
             Model without = m;
             without.model_overlap = false;
-            EXPECT_LT(mean_white_image(without, W, H), 0.5 * expected);
+            EXPECT_LT(mean_white_image(with_film(without, W, H)), 0.5 * expected);
         }
     }
 }
@@ -366,11 +367,11 @@ TEST(Pixel, ReceivesLightExactlyWhenSomeSampleIsTraced)
     for (int j = 0; j < H; ++j)
         for (int i = 0; i < W; ++i) {
             int traced = 0;
-            shade_pixel(m, i, j, W, H, [&traced](const OpticsRay&) {
+            shade_pixel(with_film(m, W, H), i, j, [&traced](const OpticsRay&) {
                 ++traced;
                 return Rgbt{1, 1, 1, 0};
             });
-            EXPECT_EQ(pixel_receives_light(m, i, j, W, H), traced > 0) << "pixel " << i << "," << j;
+            EXPECT_EQ(pixel_receives_light(with_film(m, W, H), i, j), traced > 0) << "pixel " << i << "," << j;
             (traced > 0 ? lit : dark)++;
         }
     EXPECT_GT(dark, 100) << "the set-up should leave pixels in the dark";

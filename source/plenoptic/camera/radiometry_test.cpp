@@ -15,7 +15,7 @@
 namespace plenoptic {
 namespace {
 
-using test::kPi;
+
 
 Rgbt white(const OpticsRay&) { return Rgbt{1, 1, 1, 1}; }
 
@@ -48,13 +48,13 @@ TEST(Radiometry, PinholeWithoutArrayFallsOffAsCos4AndIsOneOnAxis)
         for (int i = 0; i < W; i += 20) {
             const double x = centre_x(i, W, 0.5), y = centre_y(j, H, 0.5);
             const double cos2 = 2500 / (2500 + x * x + y * y);
-            worst = std::max(worst, std::fabs(shade_pixel(m, i, j, W, H, white).r - cos2 * cos2));
+            worst = std::max(worst, std::fabs(shade_pixel(with_film(m, W, H), i, j, white).r - cos2 * cos2));
         }
     EXPECT_LT(worst, 1e-12);
-    EXPECT_NEAR(shade_pixel(m, 100, 75, W, H, white).r, 1, 1e-15);
+    EXPECT_NEAR(shade_pixel(with_film(m, W, H), 100, 75, white).r, 1, 1e-15);
     // Flat radiometry is the stock perspective camera: 1 everywhere.
     p.radiometry = Radiometry::Flat;
-    EXPECT_EQ(shade_pixel(make_model(p), 0, 0, W, H, white).r, 1);
+    EXPECT_EQ(shade_pixel(with_film(make_model(p), W, H), 0, 0, white).r, 1);
 }
 
 // E / L of a point at distance r from the axis of a Lambertian disc of radius a, parallel to the
@@ -81,7 +81,7 @@ TEST(Radiometry, ThinLensWithoutArrayMatchesTheDiscViewFactorAcrossTheSensor)
     for (int i = 120; i < W; i += 10) {
         const double r = std::fabs(centre_x(i, W, 0.25));
         const double expected = disc_irradiance(a, h, r) / on_axis;
-        const double got = shade_pixel(m, i, 1, W, H, white).r;
+        const double got = shade_pixel(with_film(m, W, H), i, 1, white).r;
         worst = std::max(worst, std::fabs(got / expected - 1));
     }
     // 4096 stratified samples of a smooth integrand; the pixel (0.25 mm) is as good as a point.
@@ -125,12 +125,12 @@ TEST(Radiometry, BareArrayMicroimageFollowsTheCos4IntegralOverItsCell)
         for (int i = 25; i < 50; i += 3) {
             const double x = centre_x(i, W, 0.004), y = centre_y(j, H, 0.004);
             const double expected = cell_cos4(0.1, 0, 0, 0.2, x, y) / reference;
-            worst = std::max(worst, std::fabs(shade_pixel(m, i, j, W, H, white).r / expected - 1));
+            worst = std::max(worst, std::fabs(shade_pixel(with_film(m, W, H), i, j, white).r / expected - 1));
         }
     EXPECT_LT(worst, 2e-3) << worst;
     // The falloff within the microimage is large enough to see: a corner pixel of the cell.
     EXPECT_LT(cell_cos4(0.1, 0, 0, 0.2, 0.048, 0.048) / reference, 0.92);
-    EXPECT_NEAR(shade_pixel(m, 37, 37, W, H, white).r, 1, 2e-3);
+    EXPECT_NEAR(shade_pixel(with_film(m, W, H), 37, 37, white).r, 1, 2e-3);
 }
 
 // The mean of cos^4 over a hexagonal cell of pitch p seen from distance d under its centre, on
@@ -177,7 +177,7 @@ TEST(Radiometry, AnIdealArrayPassesTheEtendueOfItsCellThroughTheMainPupil)
             double sum = 0;
             for (int n = 0; n < count; ++n) {
                 OpticsRay ray;
-                if (generate_ray(m, W, H, i, j, make_sample(i, j, n, count), &centre, &ray))
+                if (generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, count), &centre, &ray))
                     sum += ray.weight;
             }
             rendered += sum / count * 0.01 * 0.01;
@@ -244,7 +244,7 @@ TEST(Radiometry, MicroimageCentresFallOffAcrossTheSensorAsTheirCellIsSeen)
         const int i = int(std::lround(0.5 * W - 0.5 - s / 0.002));
         const double x = centre_x(i, W, 0.002);
         const double expected = cell_cos4(0.2, c, 0, d, x, centre_y(1, H, 0.002)) / reference;
-        const double got = shade_pixel(m, i, 1, W, H, white).r;
+        const double got = shade_pixel(with_film(m, W, H), i, 1, white).r;
         worst = std::max(worst, std::fabs(got / expected - 1));
         if (k == 0) {
             EXPECT_NEAR(got, 1, 2e-3);  // the on-axis pixel lit through its whole cell sees L as L
@@ -283,7 +283,7 @@ TEST(Radiometry, AngularResponseMultipliesTheCos4LawAndKeepsTheAxisAtOne)
     const Model pinhole = make_model(p);
     const double x = centre_x(170, 201, 0.5);
     const double cos2 = 2500 / (2500 + x * x);
-    EXPECT_NEAR(shade_pixel(pinhole, 170, 0, 201, 1, white).r, std::pow(cos2, 5), 1e-12);
+    EXPECT_NEAR(shade_pixel(with_film(pinhole, 201, 1), 170, 0, white).r, std::pow(cos2, 5), 1e-12);
 
     // A 50 mm f/2 thin lens: the pixel is the integral of cos^(4 + e) over the pupil, 1 on the axis.
     CameraParams t = test::thin_lens_camera(50, 2, 52);
@@ -298,7 +298,7 @@ TEST(Radiometry, AngularResponseMultipliesTheCos4LawAndKeepsTheAxisAtOne)
     for (int i = 120; i < W; i += 20) {
         const double r = std::fabs(centre_x(i, W, 0.25));
         const double expected = disc_cos_power(12.5, 52, r, 12) / on_axis;
-        worst = std::max(worst, std::fabs(shade_pixel(thin, i, 1, W, 3, white).r / expected - 1));
+        worst = std::max(worst, std::fabs(shade_pixel(with_film(thin, W, 3), i, 1, white).r / expected - 1));
     }
     EXPECT_LT(worst, 2e-3) << worst;
     // Without the response the same pixel 30 mm off axis is brighter: the test sees the exponent.

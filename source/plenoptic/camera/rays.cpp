@@ -218,23 +218,25 @@ bool lens_reaches_pixel(const Model& m, LensIndex lens, Vec3 p)
 
 } // namespace
 
-Vec3 sensor_point(const Model& m, int W, int H, double pu, double pv)
+Vec3 sensor_point(const Model& m, double pu, double pv)
 {
+    const int W = m.film.width, H = m.film.height;
     return Vec3{-(pu - 0.5 * W) * m.pixel_size_mm[0] + m.sensor_offset_mm[0],
                 (pv - 0.5 * H) * m.pixel_size_mm[1] + m.sensor_offset_mm[1], m.sensor_z_mm};
 }
 
-bool sensor_to_pixel(const Model& m, int W, int H, double x_mm, double y_mm, double* u, double* v)
+bool sensor_to_pixel(const Model& m, double x_mm, double y_mm, double* u, double* v)
 {
+    const int W = m.film.width, H = m.film.height;
     *u = 0.5 * W - 0.5 - (x_mm - m.sensor_offset_mm[0]) / m.pixel_size_mm[0];
     *v = 0.5 * H - 0.5 + (y_mm - m.sensor_offset_mm[1]) / m.pixel_size_mm[1];
     return *u >= -0.5 && *u < W - 0.5 && *v >= -0.5 && *v < H - 0.5;
 }
 
-Vec2 principal_point_px(const Model& m, int W, int H)
+Vec2 principal_point_px(const Model& m)
 {
     Vec2 p;
-    sensor_to_pixel(m, W, H, 0, 0, &p.x, &p.y);
+    sensor_to_pixel(m, 0, 0, &p.x, &p.y);
     return p;
 }
 
@@ -253,18 +255,18 @@ bool own_lens(const Model& m, Vec3 p, LensIndex* lens)
     return true;
 }
 
-bool generate_ray(const Model& m, int W, int H, int i, int j, const CameraSample& sample, const LensIndex* lens,
+bool generate_ray(const Model& m, int i, int j, const CameraSample& sample, const LensIndex* lens,
                   OpticsRay* out)
 {
-    const Vec3 p = sensor_point(m, W, H, i + sample.pixel_u, j + sample.pixel_v);
+    const Vec3 p = sensor_point(m, i + sample.pixel_u, j + sample.pixel_v);
     return trace_sensor_point(m, p, lens, sample.lens_u, sample.lens_v, true, out);
 }
 
-int overlap_lenses(const Model& m, int W, int H, int i, int j, LensIndex* out, int capacity)
+int overlap_lenses(const Model& m, int i, int j, LensIndex* out, int capacity)
 {
     if (capacity < 1 || m.grid == GridType::None)
         return 0;
-    const Vec3 p = sensor_point(m, W, H, i + 0.5, j + 0.5);
+    const Vec3 p = sensor_point(m, i + 0.5, j + 0.5);
     LensIndex own;
     if (!own_lens(m, p, &own))
         return 0;
@@ -292,17 +294,17 @@ int overlap_lenses(const Model& m, int W, int H, int i, int j, LensIndex* out, i
     return count;
 }
 
-bool chief_ray_through(const Model& m, int W, int H, double pu, double pv, const LensIndex* lens, OpticsRay* out)
+bool chief_ray_through(const Model& m, double pu, double pv, const LensIndex* lens, OpticsRay* out)
 {
-    return trace_sensor_point(m, sensor_point(m, W, H, pu, pv), lens, 0.5, 0.5, false, out);
+    return trace_sensor_point(m, sensor_point(m, pu, pv), lens, 0.5, 0.5, false, out);
 }
 
-OpticsRay chief_ray(const Model& m, int W, int H, int i, int j)
+OpticsRay chief_ray(const Model& m, int i, int j)
 {
     OpticsRay ray;
-    if (chief_ray_through(m, W, H, i + 0.5, j + 0.5, nullptr, &ray))
+    if (chief_ray_through(m, i + 0.5, j + 0.5, nullptr, &ray))
         return ray;
-    const Vec3 p = sensor_point(m, W, H, i + 0.5, j + 0.5);
+    const Vec3 p = sensor_point(m, i + 0.5, j + 0.5);
     const Vec3 e = m.lens ? m.lens->exit_pupil_centre() : Vec3{0, 0, 0};
     if (!finish(e, e - p, &ray))
         finish(e, Vec3{0, 0, 1}, &ray);

@@ -28,14 +28,14 @@ struct OpticsRay {
 // Point on the sensor (optics frame, mm) at continuous pixel coordinates (pu, pv), where pixel
 // (i, j) spans [i, i+1) x [j, j+1); (i + 0.5, j + 0.5) is its centre:
 //   x = -(pu - W/2) * sx + ox,  y = (pv - H/2) * sy + oy,  z = sensor plane.
-Vec3 sensor_point(const Model& model, int W, int H, double pu, double pv);
+Vec3 sensor_point(const Model& model, double pu, double pv);
 
 // Inverse of sensor_point in the centre convention used by the metadata: pixel (i, j)'s centre is
 // at (u, v) = (i, j). Returns whether the point lies inside the image.
-bool sensor_to_pixel(const Model& model, int W, int H, double x_mm, double y_mm, double* u, double* v);
+bool sensor_to_pixel(const Model& model, double x_mm, double y_mm, double* u, double* v);
 
 // Where the optical axis meets the sensor, centre convention.
-Vec2 principal_point_px(const Model& model, int W, int H);
+Vec2 principal_point_px(const Model& model);
 
 // Centre of a lens in the optics frame (posed array), mm.
 Vec3 lens_centre_mm(const Model& model, LensIndex lens);
@@ -49,7 +49,7 @@ bool own_lens(const Model& model, Vec3 sensor_point_mm, LensIndex* lens);
 // (overlap modelling); nullptr uses the own lens of the sample's sensor point. Returns false when
 // an aperture blocks the ray (it then carries no light: black, opaque). No allocation, no
 // search over lenses, no trigonometry except the concentric disc map of a bare main lens.
-bool generate_ray(const Model& model, int W, int H, int i, int j, const CameraSample& sample,
+bool generate_ray(const Model& model, int i, int j, const CameraSample& sample,
                   const LensIndex* lens, OpticsRay* out);
 
 // The lenses whose light can reach pixel (i, j) when the model models overlap: the pixel
@@ -57,18 +57,18 @@ bool generate_ray(const Model& model, int W, int H, int i, int j, const CameraSa
 // conservative reach test (all of them for an array tilted by more than kMaxPrunedTiltSine).
 // Without overlap modelling: the own lens only. Returns the count (0 if the pixel sees no lens),
 // at most `capacity`.
-int overlap_lenses(const Model& model, int W, int H, int i, int j, LensIndex* out, int capacity);
+int overlap_lenses(const Model& model, int i, int j, LensIndex* out, int capacity);
 
 // The chief ray of pixel (i, j): pixel centre -> centre of its microlens (undeviated) -> refracted
 // by the main lens; with no array, pixel centre through the main-lens centre; with a pinhole main
 // lens, the pixel's only ray. Apertures are ignored (depth maps want a ray for every pixel).
 // Falls back to the line from the pixel centre through the main-lens centre when the geometry
 // has no such ray.
-OpticsRay chief_ray(const Model& model, int W, int H, int i, int j);
+OpticsRay chief_ray(const Model& model, int i, int j);
 
 // The same at continuous pixel coordinates (sensor_point's convention), optionally through a
 // given lens. False when the geometry has no such ray.
-bool chief_ray_through(const Model& model, int W, int H, double pu, double pv, const LensIndex* lens,
+bool chief_ray_through(const Model& model, double pu, double pv, const LensIndex* lens,
                        OpticsRay* out);
 
 } // namespace plenoptic

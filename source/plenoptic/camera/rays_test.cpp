@@ -36,15 +36,15 @@ TEST(Optics, SensorPointConvention)
     const Model m = make_model(p);
     const int W = 640, H = 480;
     // Pixel (i, j)'s centre: x = -((i + 0.5) - W/2) sx + ox, y = ((j + 0.5) - H/2) sy + oy.
-    const Vec3 c = sensor_point(m, W, H, 10 + 0.5, 20 + 0.5);
+    const Vec3 c = sensor_point(with_film(m, W, H), 10 + 0.5, 20 + 0.5);
     EXPECT_DOUBLE_EQ(c.x, -((10 + 0.5) - 320) * 0.01 + 0.3);
     EXPECT_DOUBLE_EQ(c.y, ((20 + 0.5) - 240) * 0.02 - 0.1);
     EXPECT_DOUBLE_EQ(c.z, -52);
     double u, v;
-    EXPECT_TRUE(sensor_to_pixel(m, W, H, c.x, c.y, &u, &v));
+    EXPECT_TRUE(sensor_to_pixel(with_film(m, W, H), c.x, c.y, &u, &v));
     EXPECT_NEAR(u, 10, 1e-9);
     EXPECT_NEAR(v, 20, 1e-9);
-    const Vec2 principal = principal_point_px(m, W, H);
+    const Vec2 principal = principal_point_px(with_film(m, W, H));
     EXPECT_NEAR(principal.x, 319.5 + 30, 1e-9);
     EXPECT_NEAR(principal.y, 239.5 + 5, 1e-9);
 }
@@ -63,14 +63,14 @@ TEST(Optics, CentreSampleGivesTheOpticalAxis)
 {
     const int W = 101, H = 101;  // pixel (50, 50) is centred on the axis
     OpticsRay ray;
-    ASSERT_TRUE(generate_ray(make_model(thin_lens_camera(50, 4, 52)), W, H, 50, 50, kCentreSample, nullptr, &ray));
+    ASSERT_TRUE(generate_ray(with_film(make_model(thin_lens_camera(50, 4, 52)), W, H), 50, 50, kCentreSample, nullptr, &ray));
     expect_axis(ray, "thin lens, no array");
 
     for (GridType grid : {GridType::Hexagonal, GridType::Rectangular}) {
-        ASSERT_TRUE(generate_ray(make_model(plenoptic_camera(grid, 0.5, 2, 2, 50, 4, 52)), W, H, 50, 50,
+        ASSERT_TRUE(generate_ray(with_film(make_model(plenoptic_camera(grid, 0.5, 2, 2, 50, 4, 52)), W, H), 50, 50,
                                  kCentreSample, nullptr, &ray));
         expect_axis(ray, "plenoptic 1.0");
-        ASSERT_TRUE(generate_ray(make_model(plenoptic_camera(grid, 0.5, 0, 2, 50, 4, 52)), W, H, 50, 50,
+        ASSERT_TRUE(generate_ray(with_film(make_model(plenoptic_camera(grid, 0.5, 0, 2, 50, 4, 52)), W, H), 50, 50,
                                  kCentreSample, nullptr, &ray));
         expect_axis(ray, "pinhole array");
     }
@@ -81,7 +81,7 @@ TEST(Optics, CentreSampleGivesTheOpticalAxis)
     pinhole_main.main.distance_mm = 52;
     test::add_array(&pinhole_main, GridType::Hexagonal, 0.5, 1.5, 2);
     ASSERT_EQ(check_camera(pinhole_main), "");
-    ASSERT_TRUE(generate_ray(make_model(pinhole_main), W, H, 50, 50, kCentreSample, nullptr, &ray));
+    ASSERT_TRUE(generate_ray(with_film(make_model(pinhole_main), W, H), 50, 50, kCentreSample, nullptr, &ray));
     expect_axis(ray, "pinhole main lens, thin array");
 }
 
@@ -92,7 +92,7 @@ TEST(Optics, RaysFromASensorPointMeetAtTheThinLensConjugate)
     const double F = 50, D = 60;
     const Model m = make_model(thin_lens_camera(F, 2.8, D));
     const int W = 101, H = 101, i = 10, j = 80;
-    const Vec3 p = sensor_point(m, W, H, i + 0.5, j + 0.5);
+    const Vec3 p = sensor_point(with_film(m, W, H), i + 0.5, j + 0.5);
     // Independently: 1/u = 1/F - 1/D, lateral magnification -u/D.
     const double u = 1 / (1 / F - 1 / D);
     const Vec3 conjugate{-p.x * u / D, -p.y * u / D, u};
@@ -101,7 +101,7 @@ TEST(Optics, RaysFromASensorPointMeetAtTheThinLensConjugate)
         CameraSample s = make_sample(i, j, n, 200);
         s.pixel_u = s.pixel_v = 0.5;  // one sensor point, many lens points
         OpticsRay ray;
-        ASSERT_TRUE(generate_ray(m, W, H, i, j, s, nullptr, &ray));
+        ASSERT_TRUE(generate_ray(with_film(m, W, H), i, j, s, nullptr, &ray));
         const double miss = test::distance_to_line(conjugate, origin_of(ray), dir_of(ray));
         EXPECT_LT(miss, 1e-9 * u) << "sample " << n << " origin " << str(origin_of(ray)) << " misses "
                                   << str(conjugate) << " by " << miss;
@@ -115,13 +115,13 @@ TEST(Optics, SensorAtTheFocalPlaneGivesParallelRays)
     const double F = 50;
     const Model m = make_model(thin_lens_camera(F, 2.8, F));  // D = F exactly
     const int W = 101, H = 101, i = 3, j = 77;
-    const Vec3 p = sensor_point(m, W, H, i + 0.5, j + 0.5);
+    const Vec3 p = sensor_point(with_film(m, W, H), i + 0.5, j + 0.5);
     const Vec3 expected = normalized(-p);
     for (int n = 0; n < 100; ++n) {
         CameraSample s = make_sample(i, j, n, 100);
         s.pixel_u = s.pixel_v = 0.5;
         OpticsRay ray;
-        ASSERT_TRUE(generate_ray(m, W, H, i, j, s, nullptr, &ray));
+        ASSERT_TRUE(generate_ray(with_film(m, W, H), i, j, s, nullptr, &ray));
         EXPECT_LT(length(dir_of(ray) - expected), 1e-14) << "sample " << n << " " << str(dir_of(ray));
     }
 }
@@ -136,7 +136,7 @@ void check_microlens_conjugate(double f, double d, const double pose_deg[3])
     ASSERT_EQ(check_camera(params), "");
     const Model m = make_model(params);
     const int W = 200, H = 200, i = 120, j = 61;
-    const Vec3 p = sensor_point(m, W, H, i + 0.5, j + 0.5);
+    const Vec3 p = sensor_point(with_film(m, W, H), i + 0.5, j + 0.5);
     // Lens and distances in the array's frame, computed here with the reference rotation.
     const Vec3 centre = m.pose.centre_mm;
     const Vec3 n = test::reference_rotate(pose_deg, Vec3{0, 0, 1});
@@ -159,7 +159,7 @@ void check_microlens_conjugate(double f, double d, const double pose_deg[3])
         CameraSample s = make_sample(i, j, k, 100);
         s.pixel_u = s.pixel_v = 0.5;
         OpticsRay ray;
-        ASSERT_TRUE(generate_ray(m, W, H, i, j, s, nullptr, &ray));
+        ASSERT_TRUE(generate_ray(with_film(m, W, H), i, j, s, nullptr, &ray));
         if (parallel) {
             EXPECT_LT(length(dir_of(ray) - chief), 1e-13) << "sample " << k << " " << str(dir_of(ray))
                                                           << " vs " << str(chief);
@@ -322,11 +322,11 @@ TEST(Optics, PixelToRayToSensorRoundTrip)
                 for (int n = 0; n < 8; ++n) {
                     const CameraSample s = make_sample(i, j, n, 8);
                     OpticsRay ray;
-                    if (!generate_ray(m, W, H, i, j, s, nullptr, &ray))
+                    if (!generate_ray(with_film(m, W, H), i, j, s, nullptr, &ray))
                         continue;
                     std::string failure;
                     const Vec3 back = trace_back(m, c.params, ray, &failure);
-                    const Vec3 start = sensor_point(m, W, H, i + s.pixel_u, j + s.pixel_v);
+                    const Vec3 start = sensor_point(with_film(m, W, H), i + s.pixel_u, j + s.pixel_v);
                     EXPECT_TRUE(failure.empty()) << c.name << ": " << failure;
                     worst = std::max(worst, length(back - start));
                     EXPECT_LT(length(back - start), 1e-9) << c.name << " pixel " << i << "," << j << " sample " << n
@@ -355,7 +355,7 @@ void check_overlap_pruning(const char* name, CameraParams params, double max_kep
     int failures = 0;
     for (int j = 1; j < H && failures < 5; j += 5) {
         for (int i = 2; i < W && failures < 5; i += 4) {
-            const int count = overlap_lenses(m, W, H, i, j, lenses, kMaxOverlapLenses);
+            const int count = overlap_lenses(with_film(m, W, H), i, j, lenses, kMaxOverlapLenses);
             ASSERT_GE(count, 1) << name;
             kept += count;
             const LensIndex own = lenses[0];
@@ -371,7 +371,7 @@ void check_overlap_pruning(const char* name, CameraParams params, double max_kep
                     bool lit = false;
                     for (int n = 0; n < 48 && !lit; ++n) {
                         OpticsRay ray;
-                        lit = generate_ray(m, W, H, i, j, make_sample(i, j, n, 48), &lens, &ray);
+                        lit = generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, 48), &lens, &ray);
                     }
                     if (!lit)
                         continue;
@@ -425,16 +425,16 @@ TEST(Optics, OverlapLensesListsTheOwnLensFirst)
     const int W = 200, H = 200;
     const Model apart = make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 10, 50));
     LensIndex lenses[kMaxOverlapLenses];
-    EXPECT_EQ(overlap_lenses(apart, W, H, 10, 20, lenses, kMaxOverlapLenses), 1);
+    EXPECT_EQ(overlap_lenses(with_film(apart, W, H), 10, 20, lenses, kMaxOverlapLenses), 1);
     LensIndex own;
-    ASSERT_TRUE(own_lens(apart, sensor_point(apart, W, H, 10.5, 20.5), &own));
+    ASSERT_TRUE(own_lens(apart, sensor_point(with_film(apart, W, H), 10.5, 20.5), &own));
     EXPECT_EQ(lenses[0], own);
 
     const Model overlapping = make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 2.5, 50));
     int most = 0;
     for (int j = 0; j < H; j += 3)
         for (int i = 0; i < W; i += 3)
-            most = std::max(most, overlap_lenses(overlapping, W, H, i, j, lenses, kMaxOverlapLenses));
+            most = std::max(most, overlap_lenses(with_film(overlapping, W, H), i, j, lenses, kMaxOverlapLenses));
     EXPECT_GE(most, 3) << "a main lens at half the matched f-number lights pixels through several lenses";
     EXPECT_LE(most, kMaxOverlapLenses);
 }

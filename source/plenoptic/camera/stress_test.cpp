@@ -96,13 +96,13 @@ TEST(Stress, ExtremeParametersGiveFiniteUnitDirections)
             for (int i = 0; i < W; ++i) {
                 for (int n = 0; n < 4; ++n) {
                     OpticsRay ray;
-                    if (generate_ray(m, W, H, i, j, make_sample(i, j, n, 4), nullptr, &ray)) {
+                    if (generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, 4), nullptr, &ray)) {
                         ++unblocked;
                         expect_unit_and_finite(ray, c.name + " generate_ray");
                     }
                 }
-                expect_unit_and_finite(chief_ray(m, W, H, i, j), c.name + " chief_ray");
-                const Rgbt value = shade_pixel(m, i, j, W, H, [](const OpticsRay& r) {
+                expect_unit_and_finite(chief_ray(with_film(m, W, H), i, j), c.name + " chief_ray");
+                const Rgbt value = shade_pixel(with_film(m, W, H), i, j, [](const OpticsRay& r) {
                     return Rgbt{r.dir[0], r.dir[1], r.dir[2], 0};
                 });
                 ASSERT_TRUE(std::isfinite(value.r) && std::isfinite(value.g) && std::isfinite(value.b) &&
@@ -113,11 +113,11 @@ TEST(Stress, ExtremeParametersGiveFiniteUnitDirections)
         RecordProperty(c.name, unblocked);
         for (double z : {1.0, 60.0, 1e4, 1e9}) {
             const double point[3] = {0.01 * z, -0.02 * z, z};
-            for (const PixelHit& hit : forward_project(m, W, H, point))
+            for (const PixelHit& hit : forward_project(with_film(m, W, H), point))
                 ASSERT_TRUE(std::isfinite(hit.u) && std::isfinite(hit.v)) << c.name << " z " << z;
         }
         CameraFrame frame = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-        const std::string json = metadata_json(m, c.params, W, H, frame, "");
+        const std::string json = metadata_json(with_film(m, W, H), c.params, frame, "");
         EXPECT_EQ(json.find("nan"), std::string::npos) << c.name;
         EXPECT_EQ(json.find("inf"), std::string::npos) << c.name;
     }
@@ -133,12 +133,12 @@ TEST(Stress, HugeCoordinatesDoNotOverflowTheLattice)
     const Model m = make_model(p);
     for (int n = 0; n < 16; ++n) {
         OpticsRay ray;
-        if (generate_ray(m, 8, 8, 0, 0, make_sample(0, 0, n, 16), nullptr, &ray))
+        if (generate_ray(with_film(m, 8, 8), 0, 0, make_sample(0, 0, n, 16), nullptr, &ray))
             expect_unit_and_finite(ray, "tiny pitch");
     }
     const double point[3] = {1, 2, 1000};
-    EXPECT_TRUE(forward_project(m, 8, 8, point).size() <= 1u);
-    const MicroimageLattice lattice = microimage_lattice(m, 8, 8);
+    EXPECT_TRUE(forward_project(with_film(m, 8, 8), point).size() <= 1u);
+    const MicroimageLattice lattice = microimage_lattice(with_film(m, 8, 8));
     if (lattice.lftoolbox_valid) {
         for (double x : {lattice.h_spacing, lattice.v_spacing, lattice.h_offset, lattice.v_offset, lattice.rot})
             EXPECT_TRUE(std::isfinite(x)) << "LFToolbox fields of a 1 nm pitch array";

@@ -14,7 +14,7 @@
 namespace plenoptic {
 namespace {
 
-using test::kPi;
+
 
 // Area of the intersection of two discs (radii a, b, centres d apart): the textbook lens formula.
 double disc_intersection_area(double a, double b, double d)

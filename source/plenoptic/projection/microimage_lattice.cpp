@@ -15,7 +15,7 @@ namespace {
 using detail::to_optics;
 
 // Pixel coordinates (centre convention) of an array-local point projected onto the sensor.
-bool local_to_px(const Model& m, int W, int H, Vec2 local, Vec2* px)
+bool local_to_px(const Model& m, Vec2 local, Vec2* px)
 {
     const Vec3 c = to_optics(m, Vec3{local.x, local.y, 0});
     double x = c.x, y = c.y;
@@ -28,7 +28,7 @@ bool local_to_px(const Model& m, int W, int H, Vec2 local, Vec2* px)
         x = e.x + (c.x - e.x) * s;
         y = e.y + (c.y - e.y) * s;
     }
-    sensor_to_pixel(m, W, H, x, y, &px->x, &px->y);
+    sensor_to_pixel(m, x, y, &px->x, &px->y);
     return is_finite(*px);
 }
 
@@ -43,8 +43,9 @@ double wrap(double x, double m)
 // estimate: the grid origin's projections on the rotated axes are reduced to [0, HSpacing/2) and
 // [0, VSpacing) (1-based pixels), and the row parity decides FirstPosShiftRow. A perfect
 // LFToolbox estimate of the rendered white image gives these same numbers.
-void fit_lftoolbox(const Model& m, int W, int H, MicroimageLattice* lattice)
+void fit_lftoolbox(const Model& m, MicroimageLattice* lattice)
 {
+    const int W = m.film.width, H = m.film.height;
     lattice->lftoolbox_valid = false;
     const Vec2 a{lattice->basis_a_px[0], lattice->basis_a_px[1]};
     const Vec2 b{lattice->basis_b_px[0], lattice->basis_b_px[1]};
@@ -91,7 +92,7 @@ void fit_lftoolbox(const Model& m, int W, int H, MicroimageLattice* lattice)
     const double first_shift = shift_row == 1 ? h_spacing / 2 : 0.0;
     const double first_u = offset.x + first_shift * e.x - 1, first_v = offset.y + first_shift * e.y - 1;
     LensIndex first;
-    if (!own_lens(m, sensor_point(m, W, H, first_u + 0.5, first_v + 0.5), &first))
+    if (!own_lens(m, sensor_point(m, first_u + 0.5, first_v + 0.5), &first))
         return;
     // As LFBuildLensletGridModel: UMax = floor((W - HOffset) / HSpacing) + 1, likewise VMax;
     // counts beyond 1e15 (absurdly fine grids) are not expressible.
@@ -114,17 +115,17 @@ void fit_lftoolbox(const Model& m, int W, int H, MicroimageLattice* lattice)
 
 } // namespace
 
-bool microimage_centre_px(const Model& m, int W, int H, LensIndex lens, double* u, double* v)
+bool microimage_centre_px(const Model& m, LensIndex lens, double* u, double* v)
 {
     Vec2 px;
-    if (m.grid == GridType::None || !local_to_px(m, W, H, lens_centre(m.grid, m.pitch_mm, lens), &px))
+    if (m.grid == GridType::None || !local_to_px(m, lens_centre(m.grid, m.pitch_mm, lens), &px))
         return false;
     *u = px.x;
     *v = px.y;
     return true;
 }
 
-MicroimageLattice microimage_lattice(const Model& m, int W, int H)
+MicroimageLattice microimage_lattice(const Model& m)
 {
     MicroimageLattice lattice = MicroimageLattice();
     lattice.valid = false;
@@ -132,7 +133,7 @@ MicroimageLattice microimage_lattice(const Model& m, int W, int H)
     if (m.grid == GridType::None)
         return lattice;
     Vec2 origin;
-    if (!local_to_px(m, W, H, Vec2{0, 0}, &origin))
+    if (!local_to_px(m, Vec2{0, 0}, &origin))
         return lattice;
     const double p = m.pitch_mm;
     const Vec2 a_local{p, 0};
@@ -143,8 +144,8 @@ MicroimageLattice microimage_lattice(const Model& m, int W, int H)
     const Vec2 directions[2] = {a_local, b_local};
     for (int i = 0; i < 2; ++i) {
         Vec2 plus, minus;
-        if (!local_to_px(m, W, H, step * directions[i], &plus) ||
-            !local_to_px(m, W, H, (-step) * directions[i], &minus))
+        if (!local_to_px(m, step * directions[i], &plus) ||
+            !local_to_px(m, (-step) * directions[i], &minus))
             return lattice;
         basis[i] = (0.5 / step) * (plus - minus);
     }
@@ -158,7 +159,7 @@ MicroimageLattice microimage_lattice(const Model& m, int W, int H)
     // Orthogonal projection (no main lens) of any plane is affine; central projection only of a
     // plane parallel to the sensor.
     lattice.exact = !m.lens || !m.pose.tilted;
-    fit_lftoolbox(m, W, H, &lattice);
+    fit_lftoolbox(m, &lattice);
     return lattice;
 }
 

@@ -31,12 +31,12 @@ void check_lftoolbox(GridType grid, double rotate_z, double offset_x, double tx)
     ASSERT_EQ(check_camera(params), "");
     const Model m = make_model(params);
     const int W = 320, H = 240;
-    const MicroimageLattice lattice = microimage_lattice(m, W, H);
+    const MicroimageLattice lattice = microimage_lattice(with_film(m, W, H));
     ASSERT_TRUE(lattice.valid);
     ASSERT_TRUE(lattice.lftoolbox_valid);
     EXPECT_TRUE(lattice.exact);
     // The optics -> pixel map mirrors x, so a rotation theta appears as -theta.
-    EXPECT_NEAR(lattice.rot, -rotate_z * test::kPi / 180, 1e-9) << "rotate " << rotate_z;
+    EXPECT_NEAR(lattice.rot, -rotate_z * kPi / 180, 1e-9) << "rotate " << rotate_z;
     if (grid == GridType::Hexagonal)
         EXPECT_TRUE(lattice.first_pos_shift_row == 1 || lattice.first_pos_shift_row == 2);
     else
@@ -68,9 +68,9 @@ void check_lftoolbox(GridType grid, double rotate_z, double offset_x, double tx)
             const double y = s * uu + c * vv + lattice.v_offset;
             const double u = x - 1, v = y - 1;
             LensIndex lens;
-            ASSERT_TRUE(own_lens(m, sensor_point(m, W, H, u + 0.5, v + 0.5), &lens));
+            ASSERT_TRUE(own_lens(m, sensor_point(with_film(m, W, H), u + 0.5, v + 0.5), &lens));
             double cu, cv;
-            ASSERT_TRUE(microimage_centre_px(m, W, H, lens, &cu, &cv));
+            ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), lens, &cu, &cv));
             EXPECT_NEAR(cu, u, 1e-6) << "grid (" << row << "," << col << ") rotate " << rotate_z;
             EXPECT_NEAR(cv, v, 1e-6) << "grid (" << row << "," << col << ") rotate " << rotate_z;
             if (u >= -0.5 && u <= W - 1 && v >= -0.5 && v <= H - 1)
@@ -82,8 +82,8 @@ void check_lftoolbox(GridType grid, double rotate_z, double offset_x, double tx)
     }
     // The basis of the microimage lattice matches neighbouring lenses' centres.
     double u0, v0, u1, v1;
-    ASSERT_TRUE(microimage_centre_px(m, W, H, from_skew(grid, 3, -2), &u0, &v0));
-    ASSERT_TRUE(microimage_centre_px(m, W, H, from_skew(grid, 4, -1), &u1, &v1));
+    ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), from_skew(grid, 3, -2), &u0, &v0));
+    ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), from_skew(grid, 4, -1), &u1, &v1));
     EXPECT_NEAR(u1 - u0, lattice.basis_a_px[0] + lattice.basis_b_px[0], 1e-6);
     EXPECT_NEAR(v1 - v0, lattice.basis_a_px[1] + lattice.basis_b_px[1], 1e-6);
 
@@ -94,7 +94,7 @@ void check_lftoolbox(GridType grid, double rotate_z, double offset_x, double tx)
         for (int l = -200; l <= 200; ++l) {
             for (int k = -200; k <= 200; ++k) {
                 double u, v;
-                microimage_centre_px(m, W, H, LensIndex{k, l}, &u, &v);
+                microimage_centre_px(with_film(m, W, H), LensIndex{k, l}, &u, &v);
                 if (u >= -0.5 && u <= W - 1 && v >= -0.5 && v <= H - 1)
                     ++expected;
             }
@@ -117,13 +117,13 @@ TEST(Optics, TiltedArrayLatticeIsMarkedApproximate)
     CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.137, 0.7, 0.7, 50, 5, 52);
     test::set_pose(&params, 1, 0, 0, 0, 0, 0);
     const Model m = make_model(params);
-    const MicroimageLattice lattice = microimage_lattice(m, 320, 240);
+    const MicroimageLattice lattice = microimage_lattice(with_film(m, 320, 240));
     ASSERT_TRUE(lattice.valid);
     EXPECT_FALSE(lattice.exact);
     // Still a tenth of a pixel near the centre.
     double u0, v0, u1, v1;
-    ASSERT_TRUE(microimage_centre_px(m, 320, 240, LensIndex{0, 0}, &u0, &v0));
-    ASSERT_TRUE(microimage_centre_px(m, 320, 240, LensIndex{1, 0}, &u1, &v1));
+    ASSERT_TRUE(microimage_centre_px(with_film(m, 320, 240), LensIndex{0, 0}, &u0, &v0));
+    ASSERT_TRUE(microimage_centre_px(with_film(m, 320, 240), LensIndex{1, 0}, &u1, &v1));
     EXPECT_NEAR(u1 - u0, lattice.basis_a_px[0], 0.1);
     EXPECT_NEAR(v1 - v0, lattice.basis_a_px[1], 0.1);
 }
@@ -139,9 +139,9 @@ TEST(Optics, MicroimageCentreIsTheCentralProjectionOfTheLensCentre)
     for (int k = -4; k <= 4; ++k) {
         const LensIndex lens{k, k / 2};
         double u, v;
-        ASSERT_TRUE(microimage_centre_px(m, W, H, lens, &u, &v));
+        ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), lens, &u, &v));
         OpticsRay ray;
-        ASSERT_TRUE(chief_ray_through(m, W, H, u + 0.5, v + 0.5, &lens, &ray));
+        ASSERT_TRUE(chief_ray_through(with_film(m, W, H), u + 0.5, v + 0.5, &lens, &ray));
         EXPECT_LT(length(origin_of(ray)), 1e-9) << "lens " << k << " origin " << str(origin_of(ray));
     }
 }

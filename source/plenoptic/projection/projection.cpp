@@ -51,9 +51,10 @@ bool within_rings(const Model& m, LensIndex a, LensIndex b, int rings)
     return d <= rings;
 }
 
-std::vector<Vec2> picture_polygon(const Model& m, int W, int H)
+std::vector<Vec2> picture_polygon(const Model& m)
 {
-    const Vec3 a = sensor_point(m, W, H, 0, 0), b = sensor_point(m, W, H, W, H);
+    const int W = m.film.width, H = m.film.height;
+    const Vec3 a = sensor_point(m, 0, 0), b = sensor_point(m, W, H);
     return std::vector<Vec2>{Vec2{a.x, a.y}, Vec2{b.x, a.y}, Vec2{b.x, b.y}, Vec2{a.x, b.y}};
 }
 
@@ -76,21 +77,21 @@ std::vector<Vec2> microimage_cell(const Model& m, LensIndex lens)
     return out;
 }
 
-bool delivered_point(const Model& m, int W, int H, LensIndex lens, Vec2 s)
+bool delivered_point(const Model& m, LensIndex lens, Vec2 s)
 {
     double u, v;
-    if (!sensor_to_pixel(m, W, H, s.x, s.y, &u, &v))
+    if (!sensor_to_pixel(m, s.x, s.y, &u, &v))
         return false;
     LensIndex owner;
     return own_lens(m, Vec3{s.x, s.y, m.sensor_z_mm}, &owner) && within_rings(m, owner, lens, receiving_rings(m));
 }
 
-void add_point_hit(const Model& m, int W, int H, LensIndex lens, Vec3 s, double fraction, std::vector<PixelHit>* hits)
+void add_point_hit(const Model& m, LensIndex lens, Vec3 s, double fraction, std::vector<PixelHit>* hits)
 {
-    if (!delivered_point(m, W, H, lens, Vec2{s.x, s.y}))
+    if (!delivered_point(m, lens, Vec2{s.x, s.y}))
         return;
     double u, v;
-    sensor_to_pixel(m, W, H, s.x, s.y, &u, &v);
+    sensor_to_pixel(m, s.x, s.y, &u, &v);
     hits->push_back(PixelHit{lens, u, v, fraction});
 }
 
@@ -182,13 +183,14 @@ bool overlap(Box a, Box b)
 
 // The part of the array plane whose lenses can image into the picture: the image corners
 // projected onto the array, grown by two pitches. Invalid if a corner does not project.
-Box sensor_box(const Model& m, int W, int H)
+Box sensor_box(const Model& m)
 {
+    const int W = m.film.width, H = m.film.height;
     Box box{false, 0, 0, 0, 0};
     const double corners[4][2] = {{0, 0}, {double(W), 0}, {0, double(H)}, {double(W), double(H)}};
     for (int i = 0; i < 4; ++i) {
         Vec2 q;
-        if (!project_to_array(m, sensor_point(m, W, H, corners[i][0], corners[i][1]), &q))
+        if (!project_to_array(m, sensor_point(m, corners[i][0], corners[i][1]), &q))
             return Box{false, 0, 0, 0, 0};
         include(&box, q);
     }
@@ -363,9 +365,9 @@ double area_centroid(const std::vector<Vec2>& poly, Vec2* centroid)
 // The part of `light` (a convex polygon on the sensor plane, x, y, mm, uniformly lit) that the
 // renderer delivers through `lens`: inside the picture and inside the microimage cells of the
 // lenses within the receiving rings. Returns its area and centroid.
-double delivered_area(const Model& m, int W, int H, LensIndex lens, const std::vector<Vec2>& light, Vec2* centroid)
+double delivered_area(const Model& m, LensIndex lens, const std::vector<Vec2>& light, Vec2* centroid)
 {
-    const std::vector<Vec2> inside = clip_polygon(light, picture_polygon(m, W, H));
+    const std::vector<Vec2> inside = clip_polygon(light, picture_polygon(m));
     if (inside.size() < 3)
         return 0;
     const Box lit = bounding_box(inside);
@@ -428,7 +430,7 @@ double delivered_area(const Model& m, int W, int H, LensIndex lens, const std::v
 // Adds the image of the light `light` (sensor plane, uniformly lit, carrying `fraction` of the
 // point's light) through `lens`: the centroid of the part the renderer delivers, with the fraction
 // scaled to that part. A spot smaller than a thousandth of a pixel is a point.
-void add_spot_hit(const Model& m, int W, int H, LensIndex lens, const std::vector<Vec2>& light, double fraction,
+void add_spot_hit(const Model& m, LensIndex lens, const std::vector<Vec2>& light, double fraction,
                   std::vector<PixelHit>* hits)
 {
     Vec2 centre{0, 0};
@@ -441,21 +443,21 @@ void add_spot_hit(const Model& m, int W, int H, LensIndex lens, const std::vecto
         for (const Vec2& q : light)
             mean = mean + q;
         mean = (1.0 / light.size()) * mean;
-        add_point_hit(m, W, H, lens, Vec3{mean.x, mean.y, m.sensor_z_mm}, fraction, hits);
+        add_point_hit(m, lens, Vec3{mean.x, mean.y, m.sensor_z_mm}, fraction, hits);
         return;
     }
     Vec2 centroid;
-    const double kept = delivered_area(m, W, H, lens, light, &centroid);
+    const double kept = delivered_area(m, lens, light, &centroid);
     if (!(kept > 0))
         return;
     double u, v;
-    if (!sensor_to_pixel(m, W, H, centroid.x, centroid.y, &u, &v))
+    if (!sensor_to_pixel(m, centroid.x, centroid.y, &u, &v))
         return;  // only by rounding, for light along the picture's edge
     hits->push_back(PixelHit{lens, u, v, fraction * std::min(1.0, kept / area)});
 }
 
 // The picture on the sensor plane (x, y, mm), as a box.
-Box picture_box(const Model& m, int W, int H) { return bounding_box(picture_polygon(m, W, H)); }
+Box picture_box(const Model& m) { return bounding_box(picture_polygon(m)); }
 
 // Whether light through `lens` from a part of its cell (array-local corners) towards the sensor,
 // along lines from the image point, can land in the picture: false only when the bounding box of
@@ -477,7 +479,7 @@ bool cell_spot_may_reach_picture(const Model& m, LensIndex lens, Homogeneous ima
     return !spot.valid || !picture.valid || overlap(spot, picture);
 }
 
-void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::vector<PixelHit>* hits)
+void project_through_thin_main(const Model& m, Vec3 point, std::vector<PixelHit>* hits)
 {
     const Homogeneous image = m.lens->paraxial_image(point);
     const Vec3 pupil = m.lens->exit_pupil_centre();
@@ -510,7 +512,7 @@ void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::ve
         footprint = grow(footprint, m.cell_circumradius_mm);
     // With overlap modelling, light through a lens reaches the microimages of lenses up to
     // overlap_rings rings away (each ring at most a pitch further).
-    const Box box = intersect(footprint, grow(sensor_box(m, W, H), receiving_rings(m) * m.pitch_mm));
+    const Box box = intersect(footprint, grow(sensor_box(m), receiving_rings(m) * m.pitch_mm));
     if (!box.valid)
         return;
 
@@ -534,7 +536,7 @@ void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::ve
                 return;  // a pinhole passes light only at its centre
             Vec3 hit;
             if (sensor_hit_through_lens(m, lens, h, h - pupil, &hit))
-                add_point_hit(m, W, H, lens, hit, 1.0, hits);
+                add_point_hit(m, lens, hit, 1.0, hits);
             return;
         }
         std::vector<Vec2> spot;
@@ -546,7 +548,7 @@ void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::ve
                 return;
             spot.push_back(Vec2{hit.x, hit.y});
         }
-        add_spot_hit(m, W, H, lens, spot, 1.0, hits);
+        add_spot_hit(m, lens, spot, 1.0, hits);
         return;
     }
 
@@ -568,7 +570,7 @@ void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::ve
     Vec2 unused;
     const double cone_area = use_footprint ? area_centroid(cone_polygon, &unused) : 0;
 
-    const Box picture = picture_box(m, W, H);
+    const Box picture = picture_box(m);
     for_each_lens_in_box(m, box, [&](LensIndex lens) {
         if (!lens_sees(m, image, lens))
             return;
@@ -601,7 +603,7 @@ void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::ve
                     return;
                 spot.push_back(Vec2{hit.x, hit.y});
             }
-            add_spot_hit(m, W, H, lens, spot, std::min(1.0, part_area / cone_area), hits);
+            add_spot_hit(m, lens, spot, std::min(1.0, part_area / cone_area), hits);
             return;
         }
         // Pinhole microlenses (or a cone that does not cross the array as a bounded region): the
@@ -611,11 +613,11 @@ void project_through_thin_main(const Model& m, int W, int H, Vec3 point, std::ve
             return;
         const Vec3 hit = (1 / meet.w) * meet.xyz;
         if (is_finite(hit))
-            add_point_hit(m, W, H, lens, hit, 1.0, hits);
+            add_point_hit(m, lens, hit, 1.0, hits);
     });
 }
 
-void project_through_pinhole_main(const Model& m, int W, int H, Vec3 point, std::vector<PixelHit>* hits)
+void project_through_pinhole_main(const Model& m, Vec3 point, std::vector<PixelHit>* hits)
 {
     if (m.microlens == MicrolensType::Pinhole)
         return;
@@ -630,15 +632,15 @@ void project_through_pinhole_main(const Model& m, int W, int H, Vec3 point, std:
     const LensIndex lens = nearest_lens(m.grid, m.pitch_mm, h_local.x, h_local.y);
     Vec3 hit;
     if (sensor_hit_through_lens(m, lens, h, towards_sensor, &hit))
-        add_point_hit(m, W, H, lens, hit, 1.0, hits);
+        add_point_hit(m, lens, hit, 1.0, hits);
 }
 
-void project_without_main(const Model& m, int W, int H, Vec3 point, std::vector<PixelHit>* hits)
+void project_without_main(const Model& m, Vec3 point, std::vector<PixelHit>* hits)
 {
     const Vec3 local = to_local(m, point);
     if (!(local.z > 0))
         return;  // behind the array
-    Box box = sensor_box(m, W, H);
+    Box box = sensor_box(m);
     if (!m.pose.tilted) {
         // A lens images the point into its own cell only if the point is within
         // R (z + d) / d of the lens centre, sideways.
@@ -650,40 +652,40 @@ void project_without_main(const Model& m, int W, int H, Vec3 point, std::vector<
         const Vec3 c = lens_centre_mm(m, lens);
         Vec3 hit;
         if (sensor_hit_through_lens(m, lens, c, c - point, &hit))
-            add_point_hit(m, W, H, lens, hit, 1.0, hits);
+            add_point_hit(m, lens, hit, 1.0, hits);
     });
 }
 
 } // namespace
 
-std::vector<PixelHit> forward_project(const Model& m, int W, int H, const double point_mm[3])
+std::vector<PixelHit> forward_project(const Model& m, const double point_mm[3])
 {
     std::vector<PixelHit> hits;
     const Vec3 point{point_mm[0], point_mm[1], point_mm[2]};
     if (!is_finite(point))
         return hits;
     if ((m.lens && m.lens->traced()) || m.has_distortion)
-        return forward_project_traced(m, W, H, point, default_traced_projection_options());
+        return forward_project_traced(m, point, default_traced_projection_options());
     if (m.grid == GridType::None) {
         if (!(point.z > 0))
             return hits;
         // Pinhole, or the chief ray of a thin lens (the centre of its blur disc).
         const double s = m.sensor_z_mm / point.z;
         double u, v;
-        if (sensor_to_pixel(m, W, H, point.x * s, point.y * s, &u, &v))
+        if (sensor_to_pixel(m, point.x * s, point.y * s, &u, &v))
             hits.push_back(PixelHit{LensIndex{0, 0}, u, v, 1.0});
         return hits;
     }
     if (!m.lens) {
-        project_without_main(m, W, H, point, &hits);
+        project_without_main(m, point, &hits);
         return hits;
     }
     if (!(point.z > 0))
         return hits;
     if (!m.lens->forms_image())
-        project_through_pinhole_main(m, W, H, point, &hits);
+        project_through_pinhole_main(m, point, &hits);
     else
-        project_through_thin_main(m, W, H, point, &hits);
+        project_through_thin_main(m, point, &hits);
     return hits;
 }
 

@@ -30,7 +30,7 @@ int receiving_rings(const Model& m);
 bool within_rings(const Model& m, LensIndex a, LensIndex b, int rings);
 
 // The picture on the sensor plane (x, y, mm).
-std::vector<Vec2> picture_polygon(const Model& m, int W, int H);
+std::vector<Vec2> picture_polygon(const Model& m);
 
 // Lens `lens`'s microimage cell on the sensor plane: its cell seen from the main-lens centre
 // (straight down without a main lens). Empty if a corner does not project.
@@ -38,10 +38,10 @@ std::vector<Vec2> microimage_cell(const Model& m, LensIndex lens);
 
 // Whether the renderer delivers light through `lens` to sensor point s (x, y, mm): inside the
 // picture and in the microimage cell of a lens within the receiving rings of `lens`.
-bool delivered_point(const Model& m, int W, int H, LensIndex lens, Vec2 s);
+bool delivered_point(const Model& m, LensIndex lens, Vec2 s);
 
 // Adds the image at sensor point s if the renderer delivers light there through `lens`.
-void add_point_hit(const Model& m, int W, int H, LensIndex lens, Vec3 s, double fraction, std::vector<PixelHit>* hits);
+void add_point_hit(const Model& m, LensIndex lens, Vec3 s, double fraction, std::vector<PixelHit>* hits);
 
 } // namespace detail
 } // namespace plenoptic

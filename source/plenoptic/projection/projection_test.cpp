@@ -35,13 +35,13 @@ TEST(Optics, FocusedOnTheArrayImagesToTheCentreOfTheOnAxisMicroimage)
         const Model m = make_model(plenoptic_camera(grid, 0.5, 2, 2, F, 4, D));
         const int W = 301, H = 201;
         const double point[3] = {0, 0, F * D / (D - F)};
-        const std::vector<PixelHit> hits = forward_project(m, W, H, point);
+        const std::vector<PixelHit> hits = forward_project(with_film(m, W, H), point);
         ASSERT_EQ(hits.size(), 1u) << "only the lens on which the point is focused sees it";
         EXPECT_EQ(hits[0].lens, (LensIndex{0, 0}));
         EXPECT_NEAR(hits[0].u, (W - 1) / 2.0, 1e-9);
         EXPECT_NEAR(hits[0].v, (H - 1) / 2.0, 1e-9);
         double u, v;
-        ASSERT_TRUE(microimage_centre_px(m, W, H, LensIndex{0, 0}, &u, &v));
+        ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), LensIndex{0, 0}, &u, &v));
         EXPECT_NEAR(u, (W - 1) / 2.0, 1e-9);
         EXPECT_NEAR(v, (H - 1) / 2.0, 1e-9);
     }
@@ -77,7 +77,7 @@ void check_forward_then_chief(const char* name, CameraParams params, int min_mul
     for (int k = 0; k < 200; ++k) {
         const double z = depth(rng);
         const double point[3] = {side(rng) * z, side(rng) * z, z};
-        const std::vector<PixelHit> hits = forward_project(m, W, H, point);
+        const std::vector<PixelHit> hits = forward_project(with_film(m, W, H), point);
         hits_total += int(hits.size());
         if (hits.size() >= 2)
             ++multi;
@@ -86,7 +86,7 @@ void check_forward_then_chief(const char* name, CameraParams params, int min_mul
             EXPECT_GE(hit.u, -0.5);
             EXPECT_LT(hit.u, W - 0.5);
             OpticsRay ray;
-            ASSERT_TRUE(chief_ray_through(m, W, H, hit.u + 0.5, hit.v + 0.5, &hit.lens, &ray)) << name;
+            ASSERT_TRUE(chief_ray_through(with_film(m, W, H), hit.u + 0.5, hit.v + 0.5, &hit.lens, &ray)) << name;
             const Vec3 x{point[0], point[1], point[2]};
             const double miss = test::distance_to_line(x, origin_of(ray), dir_of(ray));
             // A thin microlens that the point's cone of light covers only in part images it at
@@ -105,7 +105,7 @@ void check_forward_then_chief(const char* name, CameraParams params, int min_mul
             // The hit lies in that lens's microimage cell or, where overlap is modelled, in the cell
             // of a lens within overlap_rings rings of it (the pixels that receive its light).
             LensIndex owner;
-            ASSERT_TRUE(own_lens(m, sensor_point(m, W, H, hit.u + 0.5, hit.v + 0.5), &owner));
+            ASSERT_TRUE(own_lens(m, sensor_point(with_film(m, W, H), hit.u + 0.5, hit.v + 0.5), &owner));
             if (!m.model_overlap) {
                 EXPECT_EQ(owner, hit.lens) << name;
             } else {
@@ -160,7 +160,7 @@ void check_forward_is_centroid(const char* name, const CameraParams& params, dou
     int compared = 0;
     const double xs[][3] = {{3, -2, 400}, {-10, 6, 900}, {20, 12, 1500}, {0.4, -0.3, F * D / (D - F) * 1.02}};
     for (const auto& p : xs) {
-        const std::vector<PixelHit> hits = forward_project(m, W, H, p);
+        const std::vector<PixelHit> hits = forward_project(with_film(m, W, H), p);
         std::map<std::pair<long long, long long>, std::array<double, 3>> sums;  // u, v, count
         std::mt19937_64 rng(11);
         std::uniform_real_distribution<double> uni(0, 1);
@@ -211,14 +211,14 @@ TEST(Optics, ForwardProjectionWithoutArrayIsThePerspectiveProjection)
     const Model m = make_model(thin_lens_camera(50, 4, 52));
     const int W = 640, H = 480;
     const double point[3] = {100, -50, 2000};
-    const std::vector<PixelHit> hits = forward_project(m, W, H, point);
+    const std::vector<PixelHit> hits = forward_project(with_film(m, W, H), point);
     ASSERT_EQ(hits.size(), 1u);
     // Inverted on the sensor: x = -100 * 52 / 2000 = -2.6 mm, y = +1.3 mm; read out upright:
     // right of the axis -> right of the image (u = 319.5 + 260), below -> below (v = 239.5 + 130).
     EXPECT_NEAR(hits[0].u, 319.5 + 2.6 / 0.01, 1e-9);
     EXPECT_NEAR(hits[0].v, 239.5 + 1.3 / 0.01, 1e-9);
     const double behind[3] = {0, 0, -10};
-    EXPECT_TRUE(forward_project(m, W, H, behind).empty());
+    EXPECT_TRUE(forward_project(with_film(m, W, H), behind).empty());
 }
 
 } // namespace

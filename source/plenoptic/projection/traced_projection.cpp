@@ -158,7 +158,7 @@ struct Ray {
 // The ray from the point through window point (wx, wy): traced through the main lens, to the
 // array, through its microlens to the sensor; Delivered when the renderer gives it to the picture
 // (delivered_point); without an array, Delivered when it reaches the sensor plane.
-Ray sample(const Model& m, int W, int H, Vec3 point, double window_z, double wx, double wy)
+Ray sample(const Model& m, Vec3 point, double window_z, double wx, double wy)
 {
     Ray out{Ray::Blocked, RowKey(0, 0), 0, 0, 0, wx, wy, -1};
     const Vec3 to_window = Vec3{wx, wy, window_z} - point;
@@ -189,7 +189,7 @@ Ray sample(const Model& m, int W, int H, Vec3 point, double window_z, double wx,
     out.nearest2 = (local.x - c.x) * (local.x - c.x) + (local.y - c.y) * (local.y - c.y);
     Vec3 sensor;
     if (m.microlens == MicrolensType::Pinhole || !sensor_hit_through_lens(m, lens, h, ray.dir, &sensor) ||
-        !delivered_point(m, W, H, lens, Vec2{sensor.x, sensor.y}))
+        !delivered_point(m, lens, Vec2{sensor.x, sensor.y}))
         return out;
     out.kind = Ray::Delivered;
     out.sx = sensor.x;
@@ -239,7 +239,7 @@ TracedProjectionOptions default_traced_projection_options()
     return options;
 }
 
-std::vector<PixelHit> forward_project_traced(const Model& m, int W, int H, Vec3 point,
+std::vector<PixelHit> forward_project_traced(const Model& m, Vec3 point,
                                              const TracedProjectionOptions& options)
 {
     std::vector<PixelHit> hits;
@@ -292,7 +292,7 @@ std::vector<PixelHit> forward_project_traced(const Model& m, int W, int H, Vec3 
     auto node_row = [&](int j, std::vector<Ray>* row) {
         row->resize(n + 1);
         for (int i = 0; i <= n; ++i)
-            (*row)[i] = sample(m, W, H, point, window.z, x0 + i * step_x, y0 + j * step_y);
+            (*row)[i] = sample(m, point, window.z, x0 + i * step_x, y0 + j * step_y);
     };
     std::vector<Ray> below, above;
     node_row(0, &below);
@@ -314,7 +314,7 @@ std::vector<PixelHit> forward_project_traced(const Model& m, int W, int H, Vec3 
             }
             for (int b = 0; b < sub; ++b)
                 for (int a = 0; a < sub; ++a)
-                    light.add(sample(m, W, H, point, window.z, x0 + (i + (a + 0.5) / sub) * step_x,
+                    light.add(sample(m, point, window.z, x0 + (i + (a + 0.5) / sub) * step_x,
                                      y0 + (j + (b + 0.5) / sub) * step_y),
                               1.0 / (sub * sub));
         }
@@ -330,7 +330,7 @@ std::vector<PixelHit> forward_project_traced(const Model& m, int W, int H, Vec3 
     if (m.grid == GridType::None) {
         const LensLight& spot = light.lenses[RowKey(0, 0)];
         double u, v;
-        if (spot.weight > 0 && sensor_to_pixel(m, W, H, spot.sx / spot.weight, spot.sy / spot.weight, &u, &v))
+        if (spot.weight > 0 && sensor_to_pixel(m, spot.sx / spot.weight, spot.sy / spot.weight, &u, &v))
             hits.push_back(PixelHit{LensIndex{0, 0}, u, v, 1.0});
         return hits;
     }
@@ -344,13 +344,13 @@ std::vector<PixelHit> forward_project_traced(const Model& m, int W, int H, Vec3 
             const ImageRay ray = trace_through(m, point, window.z, wx, wy, true);
             Vec3 h, sensor;
             if (ray.passed && array_hit(m, ray, &h) && sensor_hit_through_lens(m, lens, h, ray.dir, &sensor))
-                add_point_hit(m, W, H, lens, sensor, 1.0, &hits);
+                add_point_hit(m, lens, sensor, 1.0, &hits);
             continue;
         }
         if (!(acc.weight > 0))
             continue;
         double u, v;
-        if (sensor_to_pixel(m, W, H, acc.sx / acc.weight, acc.sy / acc.weight, &u, &v))
+        if (sensor_to_pixel(m, acc.sx / acc.weight, acc.sy / acc.weight, &u, &v))
             hits.push_back(PixelHit{lens, u, v, std::min(1.0, acc.weight / total)});
     }
     return hits;

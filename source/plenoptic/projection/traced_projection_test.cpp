@@ -106,8 +106,8 @@ TEST(TracedProjection, ThroughAThinLensAgreesWithTheClosedForm)
         for (const auto& p : points) {
             if (pinholes && p[0] == 0 && p[1] == 0 && p[2] == 1300)
                 continue;  // focused on a pinhole: every ray passes it (no single ray to find)
-            const std::vector<PixelHit> closed = forward_project(m, c.W, c.H, p);
-            const std::vector<PixelHit> traced = forward_project_traced(m, c.W, c.H, Vec3{p[0], p[1], p[2]}, options);
+            const std::vector<PixelHit> closed = forward_project(with_film(m, c.W, c.H), p);
+            const std::vector<PixelHit> traced = forward_project_traced(with_film(m, c.W, c.H), Vec3{p[0], p[1], p[2]}, options);
             images += closed.size();
             // Pinholes: single rays, found by Newton's method to a tiny fraction of a pixel. No
             // array: the spot's centroid (weighted by solid angle) against the chief ray, within a
@@ -164,9 +164,9 @@ TEST(TracedProjection, AWeakSingletImagesWhereTheThinLensDoes)
     ASSERT_EQ(test::lens_kind(mr), "prescription");
     const double points[][3] = {{0, 0, 30000}, {5, -3, 25000}, {-20, 12, 50000}, {1, 0.5, 4000}};
     for (const auto& q : points) {
-        const std::vector<PixelHit> a = forward_project(mt, 301, 201, q);
+        const std::vector<PixelHit> a = forward_project(with_film(mt, 301, 201), q);
         const double in_real[3] = {q[0], q[1], q[2] + front_h};
-        const std::vector<PixelHit> b = forward_project(mr, 301, 201, in_real);
+        const std::vector<PixelHit> b = forward_project(with_film(mr, 301, 201), in_real);
         ASSERT_FALSE(a.empty());
         const Difference d = compare(a, b, 0.05);
         EXPECT_EQ(d.unmatched, 0) << "point z " << q[2];
@@ -179,9 +179,9 @@ TEST(TracedProjection, RefusesPointsBehindTheFrontWindow)
 {
     const Model m = make_model(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52));
     const TracedProjectionOptions options = default_traced_projection_options();
-    EXPECT_TRUE(forward_project_traced(m, 301, 201, Vec3{0, 0, -10}, options).empty());
-    EXPECT_TRUE(forward_project_traced(m, 301, 201, Vec3{0, 0, 0}, options).empty());
-    EXPECT_TRUE(forward_project_traced(m, 301, 201, Vec3{NAN, 0, 100}, options).empty());
+    EXPECT_TRUE(forward_project_traced(with_film(m, 301, 201), Vec3{0, 0, -10}, options).empty());
+    EXPECT_TRUE(forward_project_traced(with_film(m, 301, 201), Vec3{0, 0, 0}, options).empty());
+    EXPECT_TRUE(forward_project_traced(with_film(m, 301, 201), Vec3{NAN, 0, 100}, options).empty());
 }
 
 } // namespace

@@ -63,15 +63,16 @@ CameraParams at_f_number(const CameraParams& params, double f_number)
     return p;
 }
 
-std::vector<float> white_image(const Model& model, int W, int H, const std::function<bool()>& cancelled, int threads)
+std::vector<float> white_image(const Model& model, const std::function<bool()>& cancelled, int threads)
 {
+    const int W = model.film.width, H = model.film.height;
     std::vector<float> out(size_t(std::max(0, W)) * std::max(0, H), 0.0f);
     std::atomic<int> next_row(0);
     std::atomic<bool> stop(false);
     auto shade_row = [&](int j) {
         for (int i = 0; i < W; ++i)
             out[size_t(j) * W + i] =
-                float(shade_pixel(model, i, j, W, H, [](const OpticsRay&) { return Rgbt{1, 1, 1, 1}; }).r);
+                float(shade_pixel(model, i, j, [](const OpticsRay&) { return Rgbt{1, 1, 1, 1}; }).r);
     };
     auto work = [&]() {
         for (int j = next_row++; j < H && !stop; j = next_row++)

@@ -87,8 +87,9 @@ ChiefRay ray_for(bool at_infinity, Vec3 object_or_direction, double pupil_z, dou
 
 } // namespace
 
-DistortionProfile distortion_profile(const Model& m, int W, int H, int count)
+DistortionProfile distortion_profile(const Model& m, int count)
 {
+    const int W = m.film.width, H = m.film.height;
     DistortionProfile out = DistortionProfile();
     out.valid = false;
     if (!m.lens || !m.lens->forms_image() || count < 2 || W <= 0 || H <= 0)
@@ -125,7 +126,7 @@ DistortionProfile distortion_profile(const Model& m, int W, int H, int count)
     double largest = 0;
     const double corners[4][2] = {{0, 0}, {double(W), 0}, {0, double(H)}, {double(W), double(H)}};
     for (const auto& corner : corners) {
-        const Vec3 s = sensor_point(m, W, H, corner[0], corner[1]);
+        const Vec3 s = sensor_point(m, corner[0], corner[1]);
         largest = std::max(largest, std::hypot(s.x, s.y));
     }
 

@@ -18,7 +18,7 @@
 namespace plenoptic {
 namespace {
 
-using test::kPi;
+
 using test::thin_lens_camera;
 
 TEST(DistortionProfile, IdealThinLensHasNone)
@@ -26,7 +26,7 @@ TEST(DistortionProfile, IdealThinLensHasNone)
     CameraParams p = thin_lens_camera(50, 4, 60);
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.02;
     const Model m = make_model(p);
-    const DistortionProfile profile = distortion_profile(m, 1200, 800, 17);
+    const DistortionProfile profile = distortion_profile(with_film(m, 1200, 800), 17);
     ASSERT_TRUE(profile.valid);
     ASSERT_EQ(profile.samples.size(), 17u);
     EXPECT_FALSE(profile.object_at_infinity);
@@ -48,7 +48,7 @@ TEST(DistortionProfile, ThinLensRadialDistortionFollowsThePolynomial)
     p.main.distortion = DistortionParams{{-0.12, 0.03, -0.004}, {0, 0}};
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.02;
     const Model m = make_model(p);
-    const DistortionProfile profile = distortion_profile(m, 1200, 800, 9);
+    const DistortionProfile profile = distortion_profile(with_film(m, 1200, 800), 9);
     ASSERT_TRUE(profile.valid);
     ASSERT_EQ(profile.samples.size(), 9u);
     for (const DistortionSample& s : profile.samples) {
@@ -96,9 +96,9 @@ TEST(DistortionProfile, StopPositionGivesTheSignOfASinglesDistortion)
     const Model behind = singlet_camera(-20, MainLensType::Prescription);
     const Model thick = singlet_camera(20, MainLensType::ThickLens);
     ASSERT_EQ(test::lens_kind(front), "prescription");
-    const DistortionProfile a = distortion_profile(front, 1500, 1000, 9);
-    const DistortionProfile b = distortion_profile(behind, 1500, 1000, 9);
-    const DistortionProfile c = distortion_profile(thick, 1500, 1000, 9);
+    const DistortionProfile a = distortion_profile(with_film(front, 1500, 1000), 9);
+    const DistortionProfile b = distortion_profile(with_film(behind, 1500, 1000), 9);
+    const DistortionProfile c = distortion_profile(with_film(thick, 1500, 1000), 9);
     ASSERT_TRUE(a.valid && b.valid && c.valid);
     ASSERT_EQ(a.samples.size(), 9u);
     ASSERT_EQ(b.samples.size(), 9u);
@@ -117,9 +117,9 @@ TEST(DistortionProfile, StopPositionGivesTheSignOfASinglesDistortion)
 TEST(DistortionProfile, NoneWithoutARealObjectOrALens)
 {
     CameraParams inside = thin_lens_camera(50, 4, 40);  // D < F: no real object images onto z = -D
-    EXPECT_FALSE(distortion_profile(make_model(inside), 100, 100, 9).valid);
+    EXPECT_FALSE(distortion_profile(with_film(make_model(inside), 100, 100), 9).valid);
     CameraParams at_focus = thin_lens_camera(50, 4, 50);
-    const DistortionProfile infinity = distortion_profile(make_model(at_focus), 100, 100, 9);
+    const DistortionProfile infinity = distortion_profile(with_film(make_model(at_focus), 100, 100), 9);
     ASSERT_TRUE(infinity.valid);
     EXPECT_TRUE(infinity.object_at_infinity);
     for (const DistortionSample& s : infinity.samples)

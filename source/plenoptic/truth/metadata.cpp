@@ -139,9 +139,9 @@ Json paraxial_json(const Model& m)
 
 // The chief ray's image height over the field against the paraxial one (null when the lens has
 // no profile).
-Json distortion_profile_json(const Model& m, int W, int H)
+Json distortion_profile_json(const Model& m)
 {
-    const DistortionProfile profile = distortion_profile(m, W, H, kDistortionProfileSamples);
+    const DistortionProfile profile = distortion_profile(m, kDistortionProfileSamples);
     if (!profile.valid)
         return nullptr;
     Json json = Json::object();
@@ -159,7 +159,7 @@ Json distortion_profile_json(const Model& m, int W, int H)
     return json;
 }
 
-Json main_lens(const Model& m, int W, int H)
+Json main_lens(const Model& m)
 {
     const bool has_focal = m.lens && m.lens->forms_image();
     Json json = Json::object();
@@ -181,7 +181,7 @@ Json main_lens(const Model& m, int W, int H)
         distortion["plane_z_mm"] = number(-m.distance_mm);
         json["distortion"] = distortion;
     }
-    json["distortion_profile"] = distortion_profile_json(m, W, H);
+    json["distortion_profile"] = distortion_profile_json(m);
     return json;
 }
 
@@ -329,9 +329,10 @@ Json read_out_json(const SensorChainParams& c, const std::string& raw_file)
 
 } // namespace
 
-std::string metadata_json(const Model& m, const CameraParams& params, int W, int H, const CameraFrame& frame,
+std::string metadata_json(const Model& m, const CameraParams& params, const CameraFrame& frame,
                           const SidecarFiles& files)
 {
+    const int W = m.film.width, H = m.film.height;
     Json json = Json::object();
     json["format"] = "povray-plenoptic-metadata";
     json["version"] = 1;
@@ -347,7 +348,7 @@ std::string metadata_json(const Model& m, const CameraParams& params, int W, int
     camera_frame["direction"] = numbers(frame.direction, 3);
     json["camera_frame"] = camera_frame;
 
-    json["main_lens"] = main_lens(m, W, H);
+    json["main_lens"] = main_lens(m);
     json["microlens_array"] = microlens_array(m, params);
 
     Json sensor = Json::object();
@@ -372,11 +373,11 @@ std::string metadata_json(const Model& m, const CameraParams& params, int W, int
     json["samples"] = samples;
     json["diffraction"] = diffraction_json(diffraction_of(m, params.diffraction), params.diffraction, m);
 
-    const Vec2 principal = principal_point_px(m, W, H);
+    const Vec2 principal = principal_point_px(m);
     const double principal_px[2] = {principal.x, principal.y};
     json["principal_point_px"] = numbers(principal_px, 2);
 
-    const MicroimageLattice lattice = microimage_lattice(m, W, H);
+    const MicroimageLattice lattice = microimage_lattice(m);
     json["microimage_lattice"] = lattice_json(m, lattice);
     json["lftoolbox_lenslet_grid_model"] = lftoolbox(lattice);
     json["depth_map"] = files.depth_map.empty() ? Json(nullptr) : Json(files.depth_map);

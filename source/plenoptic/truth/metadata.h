@@ -50,7 +50,7 @@ struct SidecarFiles {
     SidecarFiles(const char* depth_map_file) : depth_map(depth_map_file) {}
 };
 
-std::string metadata_json(const Model& model, const CameraParams& params, int W, int H,
+std::string metadata_json(const Model& model, const CameraParams& params,
                           const CameraFrame& frame, const SidecarFiles& files = SidecarFiles());
 
 } // namespace plenoptic

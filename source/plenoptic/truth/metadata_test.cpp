@@ -118,7 +118,7 @@ TEST(Metadata, PlenopticCameraWritesEveryField)
     const CameraParams p = documented_camera();
     ASSERT_EQ(check_camera(p), "");
     const Model m = make_model(p);
-    const std::string json = metadata_json(m, p, 640, 480, kFrame, "scene.depth.exr");
+    const std::string json = metadata_json(with_film(m, 640, 480), p, kFrame, "scene.depth.exr");
     parsed(json);
     const char* keys[] = {"\"format\": \"povray-plenoptic-metadata\"", "\"version\": 1", "\"image\"", "\"width\": 640",
                           "\"height\": 480", "\"mm_per_unit\": 1000", "\"camera_frame\"", "\"location\": [0, 0.5, -3]",
@@ -148,7 +148,7 @@ TEST(Metadata, KeysComeInTheDocumentedOrder)
 {
     // docs/metadata.md is the contract: these names, in this order, at every level.
     const CameraParams p = documented_camera();
-    const Json doc = parsed(metadata_json(make_model(p), p, 640, 480, kFrame, "scene.depth.exr"));
+    const Json doc = parsed(metadata_json(with_film(make_model(p), 640, 480), p, kFrame, "scene.depth.exr"));
     auto keys = [](const Json& object) {
         std::vector<std::string> names;
         for (auto it = object.begin(); it != object.end(); ++it)
@@ -190,7 +190,7 @@ TEST(Metadata, NumbersAreWrittenInTheirShortestRoundTripForm)
     test::set_pose(&p, 0, 0, 0.3, 0.01, 0, 0);
     ASSERT_EQ(check_camera(p), "");
     const Model m = make_model(p);
-    const std::string json = metadata_json(m, p, 640, 480, kFrame, "");
+    const std::string json = metadata_json(with_film(m, 640, 480), p, kFrame, "");
     parsed(json);
     EXPECT_TRUE(has(json, "\"pitch_mm\": 0.15,")) << json;
     EXPECT_TRUE(has(json, "\"focal_lengths_mm\": [0.6, 2.1, 2.2]")) << json;
@@ -216,7 +216,7 @@ TEST(Metadata, ExtremeNumbersReadBackExactly)
     Model m = make_model(p);
     m.sensor_offset_mm[0] = 1e300;  // not from checked input; the writer must still be exact
     m.sensor_offset_mm[1] = 9007199254740994.0;  // whole, above 2^53
-    const Json doc = parsed(metadata_json(m, p, 64, 48, kFrame, ""));
+    const Json doc = parsed(metadata_json(with_film(m, 64, 48), p, kFrame, ""));
     EXPECT_EQ(doc["mm_per_unit"].get<double>(), 1e-300);
     EXPECT_EQ(doc["microlens_array"]["rotate_deg"][2].get<double>(), 1e-9);
     EXPECT_EQ(doc["microlens_array"]["translate_mm"][0].get<double>(), 1.0 / 3);
@@ -230,7 +230,7 @@ TEST(Metadata, SensorReadOut)
 {
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.1, 0.4, 0.4, 50, 4, 52);
     const Model m = make_model(p);
-    EXPECT_TRUE(parsed(metadata_json(m, p, 64, 48, kFrame, ""))["sensor"]["read_out"].is_null());
+    EXPECT_TRUE(parsed(metadata_json(with_film(m, 64, 48), p, kFrame, ""))["sensor"]["read_out"].is_null());
     SensorChainParams& c = p.sensor.chain;
     c.given = true;
     c.bayer = BayerPattern::GRBG;
@@ -239,7 +239,7 @@ TEST(Metadata, SensorReadOut)
     c.read_noise_e = 3;
     c.black_level_dn = 64;
     c.seed = 7;
-    Json out = parsed(metadata_json(m, p, 64, 48, kFrame, with_raw("scene.raw.png")))["sensor"]["read_out"];
+    Json out = parsed(metadata_json(with_film(m, 64, 48), p, kFrame, with_raw("scene.raw.png")))["sensor"]["read_out"];
     EXPECT_EQ(out["raw_file"], "scene.raw.png");
     EXPECT_EQ(out["bayer"], "grbg");
     EXPECT_EQ(out["bit_depth"], 10);
@@ -250,7 +250,7 @@ TEST(Metadata, SensorReadOut)
     EXPECT_EQ(out["gain_dn_per_e"].get<double>(), (1023.0 - 64) / 4500);
     // Asked for but not written (the file could not be written): the parameters, and no file.
     c.bayer = BayerPattern::None;
-    out = parsed(metadata_json(m, p, 64, 48, kFrame, ""))["sensor"]["read_out"];
+    out = parsed(metadata_json(with_film(m, 64, 48), p, kFrame, ""))["sensor"]["read_out"];
     EXPECT_TRUE(out["raw_file"].is_null());
     EXPECT_TRUE(out["bayer"].is_null());
 }
@@ -259,12 +259,12 @@ TEST(Metadata, StringsAreEscapedAndValidUtf8)
 {
     CameraParams p = plenoptic_camera(GridType::Rectangular, 0.1, 2.0, 2.0, 50, 4, 52);
     const Model m = make_model(p);
-    std::string json = metadata_json(m, p, 64, 48, kFrame, "dir\\name \"quoted\"\t\xc3\xa9.exr");
+    std::string json = metadata_json(with_film(m, 64, 48), p, kFrame, "dir\\name \"quoted\"\t\xc3\xa9.exr");
     EXPECT_EQ(parsed(json)["depth_map"].get<std::string>(), "dir\\name \"quoted\"\t\xc3\xa9.exr");
     EXPECT_TRUE(has(json, "\"depth_map\": \"dir\\\\name \\\"quoted\\\"\\t\xc3\xa9.exr\"")) << json;
     // A file name that is not UTF-8 (Latin-1 bytes) cannot be JSON text: each bad byte is written
     // as U+FFFD and the file stays valid.
-    json = metadata_json(m, p, 64, 48, kFrame, "caf\xe9\xff.exr");
+    json = metadata_json(with_film(m, 64, 48), p, kFrame, "caf\xe9\xff.exr");
     EXPECT_EQ(parsed(json)["depth_map"].get<std::string>(), "caf\xef\xbf\xbd\xef\xbf\xbd.exr") << json;
     // A rectangular grid has no LFToolbox row shift.
     EXPECT_TRUE(has(json, "\"FirstPosShiftRow\": null")) << json;
@@ -274,7 +274,7 @@ TEST(Metadata, StringsAreEscapedAndValidUtf8)
 TEST(Metadata, AbsentPartsAreNull)
 {
     const CameraParams lens_only = test::thin_lens_camera(50, 4, 52);
-    std::string json = metadata_json(make_model(lens_only), lens_only, 64, 48, kFrame, "");
+    std::string json = metadata_json(with_film(make_model(lens_only), 64, 48), lens_only, kFrame, "");
     parsed(json);
     EXPECT_TRUE(has(json, "\"microlens_array\": null")) << json;
     EXPECT_TRUE(has(json, "\"microimage_lattice\": null")) << json;
@@ -284,7 +284,7 @@ TEST(Metadata, AbsentPartsAreNull)
 
     CameraParams bare;
     test::add_array(&bare, GridType::Hexagonal, 0.5, 0, 2);
-    json = metadata_json(make_model(bare), bare, 64, 48, kFrame, "");
+    json = metadata_json(with_film(make_model(bare), 64, 48), bare, kFrame, "");
     parsed(json);
     EXPECT_TRUE(has(json, "\"type\": \"none\"")) << json;
     EXPECT_TRUE(has(json, "\"focal_length_mm\": null")) << json;
@@ -298,7 +298,7 @@ TEST(Metadata, AbsentPartsAreNull)
     multi.array.focal_length_count = 3;
     multi.array.focal_lengths_mm[1] = 2.1;
     multi.array.focal_lengths_mm[2] = 2.2;
-    json = metadata_json(make_model(multi), multi, 64, 48, kFrame, "");
+    json = metadata_json(with_film(make_model(multi), 64, 48), multi, kFrame, "");
     EXPECT_TRUE(has(json, "\"lens_types\": 3")) << json;
     EXPECT_TRUE(has(json, "\"lens_type_rule\": \"type(k, l) = (k - l) mod 3, focal_lengths_mm[type]\"")) << json;
     EXPECT_TRUE(has(json, "\"focal_lengths_mm\": [2, 2.1, 2.2]")) << json;
@@ -310,7 +310,7 @@ TEST(Metadata, NonFiniteNumbersAreWrittenAsNull)
     Model m = make_model(p);
     m.sensor_offset_mm[0] = NAN;  // cannot come from checked input; the writer must still cope
     m.sensor_offset_mm[1] = -INFINITY;
-    const std::string json = metadata_json(m, p, 64, 48, kFrame, "");
+    const std::string json = metadata_json(with_film(m, 64, 48), p, kFrame, "");
     parsed(json);
     EXPECT_TRUE(has(json, "\"offset_mm\": [null, null]")) << json;
     EXPECT_FALSE(has(json, "nan")) << json;
@@ -320,7 +320,7 @@ TEST(Metadata, NonFiniteNumbersAreWrittenAsNull)
 TEST(Metadata, LayoutIsOneMemberPerLineWithArraysOnOneLine)
 {
     const CameraParams p = documented_camera();
-    const std::string json = metadata_json(make_model(p), p, 640, 480, kFrame, "");
+    const std::string json = metadata_json(with_film(make_model(p), 640, 480), p, kFrame, "");
     EXPECT_EQ(json.rfind("{\n  \"format\": \"povray-plenoptic-metadata\",\n  \"version\": 1,\n", 0), 0u) << json;
     EXPECT_TRUE(has(json, "\n  \"image\": {\n    \"width\": 640,\n    \"height\": 480\n  },\n")) << json;
     EXPECT_TRUE(has(json, "\n  \"samples\": {\"adaptive\": false, \"min\": ")) << json;
@@ -335,8 +335,8 @@ TEST(Metadata, LatticeFieldsMatchTheMicroimageLattice)
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2.0, 2.0, 50, 4, 52);
     test::set_pose(&p, 0, 0, 2, 0, 0, 0);
     const Model m = make_model(p);
-    const MicroimageLattice lattice = microimage_lattice(m, 640, 480);
-    const Json doc = parsed(metadata_json(m, p, 640, 480, kFrame, ""));
+    const MicroimageLattice lattice = microimage_lattice(with_film(m, 640, 480));
+    const Json doc = parsed(metadata_json(with_film(m, 640, 480), p, kFrame, ""));
     const Json& grid = doc["lftoolbox_lenslet_grid_model"];
     EXPECT_EQ(grid["HSpacing"].get<double>(), lattice.h_spacing);
     EXPECT_EQ(grid["Rot"].get<double>(), lattice.rot);
@@ -368,7 +368,7 @@ TEST(Metadata, MicroimagesSummaryIsWrittenAsGiven)
     summary.fit.worst = LensIndex{-3, 2};
     summary.from_lattice_rms_px = 0.25;
     summary.from_lattice_max_px = 1.5;
-    const Json doc = parsed(metadata_json(m, p, 640, 480, kFrame, with_microimages(&summary)));
+    const Json doc = parsed(metadata_json(with_film(m, 640, 480), p, kFrame, with_microimages(&summary)));
     const Json& mi = doc["microimages"];
     std::vector<std::string> names;
     for (auto it = mi.begin(); it != mi.end(); ++it)
@@ -384,7 +384,7 @@ TEST(Metadata, MicroimagesSummaryIsWrittenAsGiven)
     EXPECT_EQ(mi["lattice_fit"]["max_residual_lens"], Json::parse("[-3, 2]"));
     EXPECT_EQ(mi["from_microimage_lattice"]["max_px"].get<double>(), 1.5);
     summary.fit.valid = false;
-    EXPECT_TRUE(parsed(metadata_json(m, p, 640, 480, kFrame, with_microimages(&summary)))["microimages"]["lattice_fit"].is_null());
+    EXPECT_TRUE(parsed(metadata_json(with_film(m, 640, 480), p, kFrame, with_microimages(&summary)))["microimages"]["lattice_fit"].is_null());
 }
 
 TEST(Metadata, DistortionProfileOfAThinLensWithDistortion)
@@ -392,7 +392,7 @@ TEST(Metadata, DistortionProfileOfAThinLensWithDistortion)
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2.0, 2.0, 50, 4, 60);
     p.main.has_distortion = true;
     p.main.distortion = DistortionParams{{-0.1, 0, 0}, {0, 0}};
-    const Json doc = parsed(metadata_json(make_model(p), p, 640, 480, kFrame, ""));
+    const Json doc = parsed(metadata_json(with_film(make_model(p), 640, 480), p, kFrame, ""));
     const Json& profile = doc["main_lens"]["distortion_profile"];
     ASSERT_TRUE(profile.is_object());
     EXPECT_EQ(profile["samples"].size(), 17u);
@@ -407,7 +407,7 @@ TEST(Metadata, DistortionProfileOfAThinLensWithDistortion)
     pinhole.main.type = MainLensType::Pinhole;
     pinhole.main.has_distortion = false;
     pinhole.array.lens = MicrolensType::ThinLens;
-    EXPECT_TRUE(parsed(metadata_json(make_model(pinhole), pinhole, 640, 480, kFrame, ""))["main_lens"]["distortion_profile"].is_null());
+    EXPECT_TRUE(parsed(metadata_json(with_film(make_model(pinhole), 640, 480), pinhole, kFrame, ""))["main_lens"]["distortion_profile"].is_null());
 }
 
 } // namespace

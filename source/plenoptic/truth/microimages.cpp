@@ -38,8 +38,8 @@ struct Moments {
 // aperture sample (lens_u, lens_v), as the renderer decides it.
 class LensProbe {
 public:
-    LensProbe(const Model& m, int W, int H, LensIndex lens, double lens_u, double lens_v)
-        : m_(m), W_(W), H_(H), lens_(lens), lens_u_(lens_u), lens_v_(lens_v)
+    LensProbe(const Model& m, LensIndex lens, double lens_u, double lens_v)
+        : m_(m), lens_(lens), lens_u_(lens_u), lens_v_(lens_v)
     {
     }
 
@@ -47,18 +47,17 @@ public:
     {
         const CameraSample sample{u, v, lens_u_, lens_v_};
         OpticsRay ray;
-        if (!generate_ray(m_, W_, H_, 0, 0, sample, &lens_, &ray))
+        if (!generate_ray(m_, 0, 0, sample, &lens_, &ray))
             return false;
         if (m_.model_overlap)
             return true;
         // Without overlap modelling the renderer gives a sensor point the light of its own lens only.
         LensIndex own;
-        return own_lens(m_, sensor_point(m_, W_, H_, u, v), &own) && own == lens_;
+        return own_lens(m_, sensor_point(m_, u, v), &own) && own == lens_;
     }
 
 private:
     const Model& m_;
-    int W_, H_;
     LensIndex lens_;
     double lens_u_, lens_v_;
 };
@@ -143,25 +142,25 @@ Moments region_moments(const LensProbe& probe, double gu, double gv, double sear
 
 // Sensor pixel (centre convention, unbounded) of an optics-frame point projected from the exit
 // pupil's centre onto the sensor plane.
-bool project_to_sensor_px(const Model& m, int W, int H, Vec3 q, Vec2* px)
+bool project_to_sensor_px(const Model& m, Vec3 q, Vec2* px)
 {
     const Vec3 e = m.lens->exit_pupil_centre();
     if (!(q.z < e.z))
         return false;
     const double t = (m.sensor_z_mm - e.z) / (q.z - e.z);
-    sensor_to_pixel(m, W, H, e.x + t * (q.x - e.x), e.y + t * (q.y - e.y), &px->x, &px->y);
+    sensor_to_pixel(m, e.x + t * (q.x - e.x), e.y + t * (q.y - e.y), &px->x, &px->y);
     return is_finite(*px);
 }
 
 // Area (pixels^2) of the lens's cell projected from the exit pupil's centre onto the sensor.
-double microimage_cell_area_px(const Model& m, int W, int H, LensIndex lens)
+double microimage_cell_area_px(const Model& m, LensIndex lens)
 {
     Vec2 corners[6];
     const int count = cell_polygon(m.grid, m.pitch_mm, corners);
     const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
     Vec2 px[6];
     for (int i = 0; i < count; ++i)
-        if (!project_to_sensor_px(m, W, H, to_optics(m, Vec3{c.x + corners[i].x, c.y + corners[i].y, 0}), &px[i]))
+        if (!project_to_sensor_px(m, to_optics(m, Vec3{c.x + corners[i].x, c.y + corners[i].y, 0}), &px[i]))
             return 0;
     double twice = 0;
     for (int i = 0; i < count; ++i)
@@ -182,7 +181,7 @@ struct Guess {
 // point h - (h_z - sensor_z) (w' + (h - c) / f), w' = (q - h) / (q_z - h_z) (pinholes: no
 // (h - c) / f). Exact for an array parallel to the sensor, a guess otherwise (the bracket grows
 // where light reaches farther). A pinhole main lens has no pupil disc: the cell's image then.
-Guess guess_region(const Model& m, int W, int H, LensIndex lens, double lens_u, double lens_v, Vec2 lattice_px)
+Guess guess_region(const Model& m, LensIndex lens, double lens_u, double lens_v, Vec2 lattice_px)
 {
     const double pixel = std::min(m.pixel_size_mm[0], m.pixel_size_mm[1]);
     const double behind = effective_array_distance_mm(m);
@@ -211,7 +210,7 @@ Guess guess_region(const Model& m, int W, int H, LensIndex lens, double lens_u, 
         wy += shift.y;
     }
     Guess guess{true, 0, 0, disc.radius * drop / along / pixel};
-    sensor_to_pixel(m, W, H, h.x - drop * wx, h.y - drop * wy, &guess.u, &guess.v);
+    sensor_to_pixel(m, h.x - drop * wx, h.y - drop * wy, &guess.u, &guess.v);
     guess.u += 0.5;
     guess.v += 0.5;
     if (!(std::isfinite(guess.u) && std::isfinite(guess.v) && std::isfinite(guess.radius_px)))
@@ -220,14 +219,15 @@ Guess guess_region(const Model& m, int W, int H, LensIndex lens, double lens_u, 
 }
 
 // The array-local box (x0, y0, x1, y1) that the picture's corners project to, or false.
-bool picture_on_array(const Model& m, int W, int H, double box[4])
+bool picture_on_array(const Model& m, double box[4])
 {
+    const int W = m.film.width, H = m.film.height;
     box[0] = box[1] = INFINITY;
     box[2] = box[3] = -INFINITY;
     const double corners[4][2] = {{0, 0}, {double(W), 0}, {0, double(H)}, {double(W), double(H)}};
     for (const auto& corner : corners) {
         Vec2 q;
-        if (!project_to_array(m, sensor_point(m, W, H, corner[0], corner[1]), &q))
+        if (!project_to_array(m, sensor_point(m, corner[0], corner[1]), &q))
             return false;
         box[0] = std::min(box[0], q.x);
         box[1] = std::min(box[1], q.y);
@@ -249,14 +249,15 @@ MicroimageOptions default_microimage_options()
     return options;
 }
 
-std::vector<MicroimageTruth> microimage_truth(const Model& m, int W, int H, const MicroimageOptions& options,
+std::vector<MicroimageTruth> microimage_truth(const Model& m, const MicroimageOptions& options,
                                               const MicroimageProgress& progress, const MicroimageCancel& cancelled)
 {
+    const int W = m.film.width, H = m.film.height;
     std::vector<MicroimageTruth> out;
     if (m.grid == GridType::None || !m.lens || W <= 0 || H <= 0)
         return out;
     double box[4];
-    if (!picture_on_array(m, W, H, box))
+    if (!picture_on_array(m, box))
         return out;
     const double p = m.pitch_mm, rows = row_spacing(m.grid, p);
     // Margins of lenses: a lattice centre in the picture may belong to a lens whose centre
@@ -270,7 +271,7 @@ std::vector<MicroimageTruth> microimage_truth(const Model& m, int W, int H, cons
         for (std::int64_t k = std::int64_t(k0); k <= std::int64_t(k1); ++k) {
             const LensIndex lens{k, l};
             double cu, cv;
-            if (!microimage_centre_px(m, W, H, lens, &cu, &cv) || !(cu >= -0.5 && cu < W - 0.5) ||
+            if (!microimage_centre_px(m, lens, &cu, &cv) || !(cu >= -0.5 && cu < W - 0.5) ||
                 !(cv >= -0.5 && cv < H - 0.5))
                 continue;  // the lattice centre is not in the picture
             MicroimageTruth truth = MicroimageTruth();
@@ -288,10 +289,10 @@ std::vector<MicroimageTruth> microimage_truth(const Model& m, int W, int H, cons
         for (int j = 0; j < n; ++j) {
             for (int i = 0; i < n; ++i) {
                 const double lens_u = thin ? (i + 0.5) / n : 0.5, lens_v = thin ? (j + 0.5) / n : 0.5;
-                const Guess guess = guess_region(m, W, H, truth.lens, lens_u, lens_v, centres[index]);
+                const Guess guess = guess_region(m, truth.lens, lens_u, lens_v, centres[index]);
                 if (!guess.possible)
                     continue;
-                const LensProbe probe(m, W, H, truth.lens, lens_u, lens_v);
+                const LensProbe probe(m, truth.lens, lens_u, lens_v);
                 // A start point anywhere in the disc is at most its diameter from the boundary.
                 const double search = guess.radius_px + 1, reach = 2.1 * guess.radius_px + 1;
                 const Moments region = region_moments(probe, guess.u, guess.v, search, reach, options);
@@ -303,7 +304,7 @@ std::vector<MicroimageTruth> microimage_truth(const Model& m, int W, int H, cons
         truth.lit = total.area > 0;
         truth.u_px = truth.lit ? total.mu / total.area - 0.5 : 0;
         truth.v_px = truth.lit ? total.mv / total.area - 0.5 : 0;
-        const double cell = microimage_cell_area_px(m, W, H, truth.lens);
+        const double cell = microimage_cell_area_px(m, truth.lens);
         truth.lit_fraction = cell > 0 ? total.area / cell : 0;
     };
 
@@ -410,7 +411,7 @@ Vec2 lattice_residual(const Model& m, const LatticeFit& fit, const MicroimageTru
                 lens.v_px - (fit.origin_px[1] + k * fit.basis_a_px[1] + l * fit.basis_b_px[1])};
 }
 
-MicroimageSummary summarise_microimages(const Model& m, int W, int H, const std::vector<MicroimageTruth>& truth,
+MicroimageSummary summarise_microimages(const Model& m, const std::vector<MicroimageTruth>& truth,
                                         const MicroimageOptions& options, const std::string& file)
 {
     MicroimageSummary summary;
@@ -422,7 +423,7 @@ MicroimageSummary summarise_microimages(const Model& m, int W, int H, const std:
     double sum2 = 0, largest = 0;
     for (const MicroimageTruth& t : truth) {
         double u, v;
-        if (!t.lit || !microimage_centre_px(m, W, H, t.lens, &u, &v))
+        if (!t.lit || !microimage_centre_px(m, t.lens, &u, &v))
             continue;
         ++summary.lit_lenses;
         const double r = std::hypot(t.u_px - u, t.v_px - v);

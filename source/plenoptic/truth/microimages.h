@@ -64,7 +64,7 @@ MicroimageOptions default_microimage_options();
 // lattice centre, or the centroid of a coarse search when that point is dark): the region
 // between that point and the first boundary crossing along each direction. Needs a main lens and
 // an array (empty otherwise). Deterministic.
-std::vector<MicroimageTruth> microimage_truth(const Model& model, int W, int H, const MicroimageOptions& options,
+std::vector<MicroimageTruth> microimage_truth(const Model& model, const MicroimageOptions& options,
                                               const MicroimageProgress& progress = MicroimageProgress(),
                                               const MicroimageCancel& cancelled = MicroimageCancel());
 
@@ -96,7 +96,7 @@ struct MicroimageSummary {
     double from_lattice_rms_px, from_lattice_max_px;
 };
 
-MicroimageSummary summarise_microimages(const Model& model, int W, int H, const std::vector<MicroimageTruth>& truth,
+MicroimageSummary summarise_microimages(const Model& model, const std::vector<MicroimageTruth>& truth,
                                         const MicroimageOptions& options, const std::string& file);
 
 // The CSV text: a header line "k,l,u,v,lit_fraction,residual_u,residual_v", then one line per

@@ -21,7 +21,7 @@
 namespace plenoptic {
 namespace {
 
-using test::kPi;
+
 using test::plenoptic_camera;
 
 struct ClosedFormCase {
@@ -40,7 +40,7 @@ TEST(MicroimageTruth, ThinLensMicroimagesAreThePupilDiscAboutTheLatticeCentres)
         params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = pixel;
         const Model m = make_model(params);
         const int W = 161, H = 121;
-        const std::vector<MicroimageTruth> truth = microimage_truth(m, W, H, default_microimage_options());
+        const std::vector<MicroimageTruth> truth = microimage_truth(with_film(m, W, H), default_microimage_options());
         ASSERT_GE(truth.size(), 6u);
         const double radius_px = 0.5 * A * d / D / pixel;
         const double cell_mm = c.grid == GridType::Hexagonal ? std::sqrt(3.0) / 2 * p * p : p * p;
@@ -48,7 +48,7 @@ TEST(MicroimageTruth, ThinLensMicroimagesAreThePupilDiscAboutTheLatticeCentres)
         const double fraction = kPi * radius_px * radius_px / cell_px;
         for (const MicroimageTruth& t : truth) {
             double u, v;
-            ASSERT_TRUE(microimage_centre_px(m, W, H, t.lens, &u, &v));
+            ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), t.lens, &u, &v));
             ASSERT_TRUE(t.lit);
             EXPECT_NEAR(t.u_px, u, 1e-3) << t.lens.k << "," << t.lens.l;
             EXPECT_NEAR(t.v_px, v, 1e-3) << t.lens.k << "," << t.lens.l;
@@ -60,7 +60,7 @@ TEST(MicroimageTruth, ThinLensMicroimagesAreThePupilDiscAboutTheLatticeCentres)
         for (int l = -40; l <= 40; ++l)
             for (int k = -40; k <= 40; ++k) {
                 double u, v;
-                if (microimage_centre_px(m, W, H, LensIndex{k, l}, &u, &v) && u >= -0.5 && u < W - 0.5 && v >= -0.5 &&
+                if (microimage_centre_px(with_film(m, W, H), LensIndex{k, l}, &u, &v) && u >= -0.5 && u < W - 0.5 && v >= -0.5 &&
                     v < H - 0.5)
                     ++inside;
             }
@@ -69,7 +69,7 @@ TEST(MicroimageTruth, ThinLensMicroimagesAreThePupilDiscAboutTheLatticeCentres)
         const LatticeFit fit = fit_microimage_lattice(m, truth);
         ASSERT_TRUE(fit.valid);
         EXPECT_LT(fit.max_residual_px, 1e-3);
-        const MicroimageLattice lattice = microimage_lattice(m, W, H);
+        const MicroimageLattice lattice = microimage_lattice(with_film(m, W, H));
         for (int i = 0; i < 2; ++i) {
             EXPECT_NEAR(fit.origin_px[i], lattice.origin_px[i], 1e-3);
             EXPECT_NEAR(fit.basis_a_px[i], lattice.basis_a_px[i], 1e-4);
@@ -95,7 +95,7 @@ TEST(MicroimageTruth, CatsEyesAgreeWithABruteForceCount)
     const Model m = make_model(params);
     ASSERT_EQ(test::lens_kind(m), "prescription");
     const int W = 120, H = 120;
-    const std::vector<MicroimageTruth> truth = microimage_truth(m, W, H, default_microimage_options());
+    const std::vector<MicroimageTruth> truth = microimage_truth(with_film(m, W, H), default_microimage_options());
     ASSERT_FALSE(truth.empty());
     // Brute force: every point of a fine grid around a lens's lattice centre, the renderer's ray
     // through the lens's pinhole (generate_ray takes corner-convention pixels).
@@ -110,7 +110,7 @@ TEST(MicroimageTruth, CatsEyesAgreeWithABruteForceCount)
         ASSERT_NE(found, nullptr) << want.k << "," << want.l;
         ASSERT_TRUE(found->lit);
         double u0, v0;
-        ASSERT_TRUE(microimage_centre_px(m, W, H, want, &u0, &v0));
+        ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), want, &u0, &v0));
         const int n = 600;
         const double half = 6, step = 2 * half / n;
         double count = 0, su = 0, sv = 0;
@@ -118,7 +118,7 @@ TEST(MicroimageTruth, CatsEyesAgreeWithABruteForceCount)
             for (int i = 0; i < n; ++i) {
                 const double u = u0 - half + (i + 0.5) * step, v = v0 - half + (j + 0.5) * step;
                 OpticsRay ray;
-                if (!generate_ray(m, W, H, 0, 0, CameraSample{u + 0.5, v + 0.5, 0.5, 0.5}, &want, &ray))
+                if (!generate_ray(with_film(m, W, H), 0, 0, CameraSample{u + 0.5, v + 0.5, 0.5, 0.5}, &want, &ray))
                     continue;
                 count += 1;
                 su += u;
@@ -159,9 +159,9 @@ TEST(MicroimageTruth, ThinMicrolensesConvergeInApertureAndThreadsDoNotMatter)
     fine.aperture_points = 8;
     one_thread.threads = 1;
     coarse.threads = 3;
-    const std::vector<MicroimageTruth> a = microimage_truth(m, W, H, coarse);
-    const std::vector<MicroimageTruth> b = microimage_truth(m, W, H, fine);
-    const std::vector<MicroimageTruth> c = microimage_truth(m, W, H, one_thread);
+    const std::vector<MicroimageTruth> a = microimage_truth(with_film(m, W, H), coarse);
+    const std::vector<MicroimageTruth> b = microimage_truth(with_film(m, W, H), fine);
+    const std::vector<MicroimageTruth> c = microimage_truth(with_film(m, W, H), one_thread);
     ASSERT_EQ(a.size(), b.size());
     ASSERT_EQ(a.size(), c.size());
     double worst_px = 0, worst_fraction = 0;
@@ -224,11 +224,10 @@ TEST(MicroimageTruth, CancellingStopsAtTheNextLensAndReturnsNothing)
     const Model m = make_model(params);
     MicroimageOptions options = default_microimage_options();
     options.threads = 2;
-    ASSERT_GT(microimage_truth(m, 401, 301, options).size(), 50u);
+    ASSERT_GT(microimage_truth(with_film(m, 401, 301), options).size(), 50u);
     int polls = 0;
     std::size_t reports = 0;
-    const std::vector<MicroimageTruth> none = microimage_truth(
-        m, 401, 301, options, [&](std::size_t done, std::size_t) { reports = done; }, [&]() { return ++polls > 5; });
+    const std::vector<MicroimageTruth> none = microimage_truth(with_film(m, 401, 301), options, [&](std::size_t done, std::size_t) { reports = done; }, [&]() { return ++polls > 5; });
     EXPECT_TRUE(none.empty());
     EXPECT_EQ(polls, 6);  // polled before each lens of the calling thread, stopped at the first true
     EXPECT_LT(reports, 50u);
@@ -237,12 +236,12 @@ TEST(MicroimageTruth, CancellingStopsAtTheNextLensAndReturnsNothing)
 TEST(MicroimageTruth, NothingWithoutAnArrayOrAMainLens)
 {
     const Model no_array = make_model(test::thin_lens_camera(50, 4, 52));
-    EXPECT_TRUE(microimage_truth(no_array, 100, 100, default_microimage_options()).empty());
+    EXPECT_TRUE(microimage_truth(with_film(no_array, 100, 100), default_microimage_options()).empty());
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52);
     p.main.given = false;
     p.main.type = MainLensType::None;
     const Model no_main = make_model(p);
-    EXPECT_TRUE(microimage_truth(no_main, 100, 100, default_microimage_options()).empty());
+    EXPECT_TRUE(microimage_truth(with_film(no_main, 100, 100), default_microimage_options()).empty());
 }
 
 } // namespace

@@ -37,11 +37,11 @@ double virtual_depth(const Model& m, Vec3 point)
     return std::isfinite(v) ? v : nan;
 }
 
-float pixel_virtual_depth(const Model& m, int W, int H, int i, int j, float distance_units)
+float pixel_virtual_depth(const Model& m, int i, int j, float distance_units)
 {
     if (!(distance_units >= 0))
         return std::numeric_limits<float>::quiet_NaN();
-    const OpticsRay ray = chief_ray(m, W, H, i, j);
+    const OpticsRay ray = chief_ray(m, i, j);
     const Vec3 origin{ray.origin_mm[0], ray.origin_mm[1], ray.origin_mm[2]};
     const Vec3 dir{ray.dir[0], ray.dir[1], ray.dir[2]};
     // At infinity: a point as far as a length can be (1e12 mm) images within 1e-10 of the

@@ -24,7 +24,7 @@ double virtual_depth(const Model& model, Vec3 point_mm);
 // The virtual depth of what pixel (i, j)'s chief ray meets at the depth map's distance
 // (scene units along the chief ray, truth/depth_map.h): +inf gives the virtual depth of the
 // point at infinity in the ray's direction; a negative distance (a blocked pixel) gives NaN.
-float pixel_virtual_depth(const Model& model, int W, int H, int i, int j, float distance_units);
+float pixel_virtual_depth(const Model& model, int i, int j, float distance_units);
 
 } // namespace plenoptic
 

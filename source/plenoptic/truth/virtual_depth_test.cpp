@@ -87,15 +87,15 @@ TEST(VirtualDepth, PixelsOfAFrontoParallelPlane)
     for (double z : {350.0, 800.0, 3000.0})
         for (int j = 0; j < H; j += 7)
             for (int i = 0; i < W; i += 5) {
-                const OpticsRay ray = chief_ray(m, W, H, i, j);
+                const OpticsRay ray = chief_ray(with_film(m, W, H), i, j);
                 const float distance = float((z - ray.origin_mm[2]) / ray.dir[2] / m.mm_per_unit);
-                EXPECT_NEAR(pixel_virtual_depth(m, W, H, i, j, distance), thin_lens_v(z, d),
+                EXPECT_NEAR(pixel_virtual_depth(with_film(m, W, H), i, j, distance), thin_lens_v(z, d),
                             2e-5 * std::fabs(thin_lens_v(z, d)) + 1e-5) << z << " " << i << " " << j;
             }
     // Nothing hit: the point at infinity images on the focal plane, v = (F - D) / d.
-    EXPECT_NEAR(pixel_virtual_depth(m, W, H, 10, 10, std::numeric_limits<float>::infinity()), (F - D) / d, 1e-5);
+    EXPECT_NEAR(pixel_virtual_depth(with_film(m, W, H), 10, 10, std::numeric_limits<float>::infinity()), (F - D) / d, 1e-5);
     // A blocked pixel (-1) has none.
-    EXPECT_TRUE(std::isnan(pixel_virtual_depth(m, W, H, 10, 10, -1.0f)));
+    EXPECT_TRUE(std::isnan(pixel_virtual_depth(with_film(m, W, H), 10, 10, -1.0f)));
 }
 
 }  // namespace
