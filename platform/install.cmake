@@ -80,10 +80,11 @@ forward-projection tool plenoptic-project and the light-field decoder plenoptic-
 set(CPACK_DEBIAN_PACKAGE_SECTION graphics)
 set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)  # povray-plenoptic_<version>_<arch>.deb
-# Shared libraries of the two binaries from dpkg-shlibdeps; the decoder's Python modules by hand
-# (python/plenoptic_lf imports numpy, PIL and OpenImageIO).
+# Shared libraries of the two binaries from dpkg-shlibdeps; the Python tools' modules by hand
+# (python/plenoptic_lf imports numpy, scipy, PIL, OpenImageIO and jsonschema; tomllib: 3.11).
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
-set(CPACK_DEBIAN_PACKAGE_DEPENDS "python3, python3-numpy, python3-scipy, python3-pil, python3-openimageio")
+set(CPACK_DEBIAN_PACKAGE_DEPENDS
+    "python3 (>= 3.11), python3-numpy, python3-scipy, python3-pil, python3-openimageio, python3-jsonschema")
 # Installed with the prefix /usr into a staging DESTDIR, so the configuration lands in /etc.
 set(CPACK_SET_DESTDIR ON)
 set(CPACK_INSTALL_PREFIX /usr)

@@ -10,6 +10,8 @@ import subprocess
 import sys
 import time
 
+from plenoptic_lf.povray import run_povray
+
 from .util import ROOT, log
 
 PYTHON = os.path.join(ROOT, "python")
@@ -46,7 +48,9 @@ def _bare(povray, out, spec_path):
     start = time.perf_counter()
     for record in records:
         cmd = [a if not a.startswith("+O") else "+O" + os.path.join(folder, record["image"]) for a in record["command"]]
-        subprocess.run(cmd, cwd=folder, capture_output=True, check=True)
+        run = run_povray(cmd, cwd=folder)
+        if not run.ok:
+            raise RuntimeError("povray failed (exit %d): %s\n%s" % (run.returncode, " ".join(cmd), run.output[-1500:]))
     return time.perf_counter() - start, len(records)
 
 

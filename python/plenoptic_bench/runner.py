@@ -4,9 +4,9 @@ comparisons; the scene worlds and cameras the sections share."""
 import os
 import re
 import statistics
-import subprocess
 import sys
-import time
+
+from plenoptic_lf.povray import povray_command, run_povray
 
 from .callgrind import callgrind_counts
 from .util import SCENE_INC
@@ -48,21 +48,16 @@ class Bench:
     def render(self, scene, w, h, out=None, extra=()):
         """One render; returns (seconds, peak RSS in MiB, output path)."""
         out = out or os.path.splitext(scene)[0] + ".png"
-        cmd = [self.povray, "+I" + scene, "+O" + out, "+W%d" % w, "+H%d" % h,
-               "-D", "-P", "+FN16"] + list(extra)
+        cmd = povray_command(self.povray, scene, out, w, h, ["-D", "-P", "+FN16"] + list(extra))
         # POV-Ray's messages go to a file: a pipe read only at the end would fill and stall it.
         log_path = os.path.join(self.work, "povray.log")
         rss_path = os.path.join(self.work, "povray.maxrss")
-        with open(log_path, "wb") as log_file:
-            t0 = time.perf_counter()
-            status = subprocess.run([sys.executable, "-S", "-E", "-c", SPAWN, rss_path] + cmd, cwd=self.work,
-                                    stdout=subprocess.DEVNULL, stderr=log_file).returncode
-            seconds = time.perf_counter() - t0
+        open(log_path, "wb").close()
+        run = run_povray([sys.executable, "-S", "-E", "-c", SPAWN, rss_path] + cmd, cwd=self.work, log=log_path)
+        status, seconds, err = run.returncode, run.seconds, run.output
         # The whole process on the clock: start-up, parsing, trace and what the camera writes after
         # it (metadata, depth map, microimage centres).
         self.last_wall_s = seconds
-        with open(log_path, "rb") as log_file:
-            err = log_file.read().decode(errors="replace")
         if status != 0:
             raise RuntimeError("povray failed on %s:\n%s" % (scene, err[-1500:]))
         with open(rss_path) as f:
@@ -109,11 +104,10 @@ class Bench:
         cmd = ["valgrind", "--tool=callgrind", "--callgrind-out-file=" + out, self.povray, "+I" + scene,
                "+O" + png, "+W%d" % w, "+H%d" % h, "-D", "-P", "+FN16", "+WT1"]
         log_path = os.path.join(self.work, "valgrind.log")
-        with open(log_path, "wb") as log_file:
-            status = subprocess.run(cmd, cwd=self.work, stdout=subprocess.DEVNULL, stderr=log_file).returncode
-        if status != 0:
-            with open(log_path, "rb") as log_file:
-                err = log_file.read().decode(errors="replace")
+        open(log_path, "wb").close()
+        run = run_povray(cmd, cwd=self.work, log=log_path)
+        if run.returncode != 0:
+            err = run.output
             raise RuntimeError("povray under callgrind failed on %s:\n%s" % (scene, err[-1500:]))
         counts = callgrind_counts(out, w * h)
         os.remove(out)
@@ -133,16 +127,10 @@ WHITE_WORLD = "#version 3.7;\nglobal_settings { assumed_gamma 1 }\nsky_sphere { 
 
 
 def read_linear(path):
-    import OpenImageIO as oiio
-    import numpy as np
-    # ImageInput, not ImageBuf: ImageBuf reads through OIIO's image cache, which hands back the
-    # old pixels of a file rewritten within the same second (the same scene rendered again with
-    # other settings: seen in 6 of 10 tries at 32x24).
-    inp = oiio.ImageInput.open(path)
-    if inp is None:
-        raise RuntimeError("cannot read %s: %s" % (path, oiio.geterror()))
+    """A linear render's RGB values (H, W, 3) float32, through the decoder package's one image
+    reader (OpenImageIO's ImageInput: a file rewritten within the same second is read anew)."""
+    from plenoptic_lf.images import ImageReadError, read_image
     try:
-        pixels = inp.read_image(oiio.FLOAT)
-    finally:
-        inp.close()
-    return np.asarray(pixels)[..., :3]
+        return read_image(path)[..., :3]
+    except ImageReadError as e:
+        raise RuntimeError(str(e)) from None

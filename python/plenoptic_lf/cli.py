@@ -6,20 +6,23 @@ Exit status 0 on success; 2 with one line 'plenoptic-decode: error: ...' on stde
 input or an option is refused (argparse's own usage errors too); 1 with one such line when
 OpenImageIO, which reads every raw image, is not installed."""
 
+from __future__ import annotations
+
 import argparse
 import math
 import os
 import re
 import shutil
 import sys
+from typing import Sequence
 
 import numpy as np
 
 from .errors import DecodeError, DependencyError, MetadataError
 from .hci import check_hci_camera, depth_map_path, export_hci
 from .focus import default_slopes, slopes_from_depth_map
-from .images import (check_encoding, inspect_raw, png_layout, read_depth_map, read_raw_image, require_openimageio,
-                     save_exr, save_png)
+from .images import (check_encoding, inspect_raw, png_layout, read_depth_map, read_raw_image, read_stored,
+                     require_openimageio, save_exr, save_png)
 from .lightfield import decode, plan_decode
 from .metadata import load_metadata, metadata_path_for
 from .outputs import write_outputs
@@ -33,7 +36,7 @@ from .contact_sheet import sheet_title
 SLOPES_FORM = "START:STOP:COUNT (two numbers and a whole number >= 2, e.g. -0.8:0.8:17)"
 
 
-def parse_slopes(text):
+def parse_slopes(text: str) -> np.ndarray:
     """--slopes START:STOP:COUNT -> the sweep's slopes (numpy.linspace(START, STOP, COUNT));
     ValueError with one sentence for the user, naming the option and the form."""
     parts = text.split(":")
@@ -73,17 +76,6 @@ def _attach_slopes_values(argv):
     return out
 
 
-def _stored_pixels(path):
-    """The image's values as stored (OpenImageIO's 0..1 for integers), (H, W, C) float, no decoding."""
-    oiio = require_openimageio()
-    buf = oiio.ImageBuf(path)
-    pixels = None if buf.has_error else buf.get_pixels(oiio.FLOAT)
-    if pixels is None or buf.has_error:
-        raise DecodeError("cannot read %s: %s" % (path, buf.geterror().strip() or "unknown format"))
-    pixels = np.asarray(pixels, dtype=np.float32)
-    return pixels[:, :, None] if pixels.ndim == 2 else pixels
-
-
 def read_picture(path, meta, encoding, progress, white=False, raw=False, white_values=None, white_scale=None,
                  reading=None, announced=False):
     """The picture (H, W, 3) linear. What the file is comes from the options, its name in the
@@ -101,7 +93,7 @@ def read_picture(path, meta, encoding, progress, white=False, raw=False, white_v
         print("plenoptic-decode: warning: %s" % reading.warning, file=sys.stderr)
     if reading.kind == "dn":
         read_out = reading.read_out
-        pixels = dn_to_linear(_stored_pixels(path), read_out, path)
+        pixels = dn_to_linear(read_stored(path), read_out, path)
         if read_out.get("bayer"):
             progress.stage("%s: %s mosaic: demosaiced (bilinear)" % (name, read_out["bayer"]) if announced else
                            "%s: %s, %s mosaic: demosaiced (bilinear)" % (name, reading.why, read_out["bayer"]))
@@ -113,7 +105,7 @@ def read_picture(path, meta, encoding, progress, white=False, raw=False, white_v
         # A linear white image: value x 65535 / scale, grey or RGB.
         if not announced:
             progress.stage("%s: %s" % (name, reading.why))
-        pixels = _stored_pixels(path) * np.float32(reading.scale)
+        pixels = read_stored(path) * np.float32(reading.scale)
         return np.ascontiguousarray(np.repeat(pixels[..., :1], 3, axis=2) if pixels.shape[2] < 3 else pixels[..., :3])
     return read_raw_image(path, encoding)[0]
 
@@ -181,7 +173,7 @@ def _argument_parser():
     return parser
 
 
-def main(argv=None):
+def main(argv: Sequence[str] | None = None) -> int:
     """The plenoptic-decode command; argv without the program name (default sys.argv[1:]).
     Returns the exit status."""
     args = _argument_parser().parse_args(_attach_slopes_values(sys.argv[1:] if argv is None else list(argv)))

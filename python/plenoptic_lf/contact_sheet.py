@@ -1,49 +1,54 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """The contact sheet: one labelled picture that shows the plenoptic effect."""
 
+from __future__ import annotations
+
 import math
 import os
+from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
 
 from .images import scaled_pil_image, to_8bit
+from .metadata import Metadata
 from .microimages import measured_centres, microimage_centre
+
+if TYPE_CHECKING:
+    from PIL import Image
+
+    from .lightfield import LightField
 
 
 def _main_lens_phrase(meta):
     """What is in front of the array: 'behind a traced prescription (lens.dat)', 'behind a thin
     main lens (f = 50 mm, f/2)', ..."""
-    lens = meta.raw.get("main_lens") if isinstance(meta.raw.get("main_lens"), dict) else {}
+    lens = meta.main_lens
     kind = meta.main_lens_type
     if kind in ("prescription", "thick_lens"):
-        prescription = lens.get("prescription") if isinstance(lens.get("prescription"), dict) else {}
-        name = prescription.get("lens_file")
-        surfaces = prescription.get("surfaces")
-        source = (name if isinstance(name, str) and name else
-                  "an inline prescription of %d surfaces" % len(surfaces) if isinstance(surfaces, list) else
+        source = (lens.lens_file if lens.lens_file else
+                  "an inline prescription of %d surfaces" % lens.surface_count if lens.surface_count is not None else
                   "an inline prescription")
         if kind == "prescription":
             return "behind a traced prescription (%s)" % source
         return "behind a thick lens, the paraxial equivalent of %s" % source
     if kind == "thin_lens":
-        f_number = lens.get("f_number")
+        f_number = lens.f_number
         return "behind a thin main lens (f = %g mm%s)" % (
-            meta.focal_length_mm, ", f/%g" % f_number if isinstance(f_number, (int, float)) else "")
+            meta.focal_length_mm, ", f/%g" % f_number if f_number is not None else "")
     if kind == "pinhole":
         return "behind a pinhole main lens"
     return "with no main lens"
 
 
-def sheet_title(name, meta):
+def sheet_title(name: str, meta: Metadata) -> str:
     """The contact sheet's title: the file, the array and its microlenses, the main lens, the size,
     e.g. 'r.raw.png: hexagonal array of thin-lens microlenses behind a traced prescription
     (lens.dat), 640 x 480 px'."""
-    array = meta.raw.get("microlens_array") if isinstance(meta.raw.get("microlens_array"), dict) else {}
-    lens = array.get("lens")
-    focal_lengths = array.get("focal_lengths_mm")
+    lens = meta.array.lens
+    focal_lengths = meta.array.focal_lengths_mm
     if lens == "pinhole":
         micro = "pinhole microlenses"
-    elif isinstance(focal_lengths, list) and len(focal_lengths) > 1:
+    elif len(focal_lengths) > 1:
         micro = "thin-lens microlenses of %d focal lengths" % len(focal_lengths)
     else:
         micro = "thin-lens microlenses"
@@ -51,7 +56,7 @@ def sheet_title(name, meta):
                                                   meta.width, meta.height)
 
 
-def crop_marks(meta, x0, y0, crop_w, crop_h):
+def crop_marks(meta: Metadata, x0: int, y0: int, crop_w: int, crop_h: int) -> tuple[np.ndarray, np.ndarray, str]:
     """The microimage centres to mark in the raw crop [x0, x0 + crop_w) x [y0, y0 + crop_h) and
     what they are: (u, v, caption words). The centres the decoder sampled around: the metadata's
     lattice where it is exact, the measured centres of the render's microimages file behind a
@@ -98,7 +103,8 @@ def _distance_label(distance):
     return "  (~%.3g units)" % distance
 
 
-def contact_sheet(raw, lf, slopes, refocused, near, far, epi_row, title=""):
+def contact_sheet(raw: np.ndarray, lf: LightField, slopes: Sequence[float] | np.ndarray,
+                  refocused: Sequence[np.ndarray], near: int, far: int, epi_row: int, title: str = "") -> Image.Image:
     """One picture that shows the plenoptic effect: raw crop with the microimage centres the
     decoder sampled around (crop_marks), centre view, views from opposite sides of the aperture, an EPI, near and far refocus.
 

@@ -23,20 +23,24 @@ planes with the exit pupil as its aperture: its views are pinhole cameras on the
 plane (HciGeometry). A traced prescription is refused: its views are not pinhole cameras.
 """
 
+from __future__ import annotations
+
 import configparser
 import datetime
 import math
 import os
 
 import numpy as np
+import numpy.typing as npt
 
 from .errors import DecodeError
 from .images import read_depth_map, save_png
 from .lightfield import angular_grid, decode, plan_decode
+from .metadata import Metadata
 from .progress import Progress
 
 
-def write_pfm(path, values):
+def write_pfm(path: str, values: npt.ArrayLike) -> None:
     """A single-channel float32 PFM (netpbm's format: 'Pf', width height, -1 for little-endian,
     rows from the bottom), as the benchmark's files are."""
     values = np.asarray(values, dtype="<f4")
@@ -46,11 +50,10 @@ def write_pfm(path, values):
         f.write(np.ascontiguousarray(values[::-1]).tobytes())
 
 
-def check_hci_camera(meta):
+def check_hci_camera(meta: Metadata) -> None:
     """DecodeError unless the render is a plenoptic 1.0 camera whose sub-aperture views form the
     benchmark's camera grid exactly: a thin main lens without distortion, one kind of thin
     microlens with d = f, an array aligned with the sensor (not turned, not tilted), square pixels."""
-    raw = meta.raw
     if meta.main_lens_type == "prescription":
         raise DecodeError("--hci's disparity ground truth assumes an ideal lens, whose sub-aperture views are "
                           "pinhole cameras on one grid; this render's main lens is a traced prescription, whose "
@@ -60,30 +63,30 @@ def check_hci_camera(meta):
     if meta.main_lens_type not in ("thin_lens", "thick_lens"):
         raise DecodeError("--hci needs a thin_lens or thick_lens main lens (its views are then an exact camera "
                           "grid); this render's main lens is %s" % meta.main_lens_type)
-    if isinstance(raw.get("main_lens"), dict) and raw["main_lens"].get("distortion") is not None:
+    if meta.main_lens.distorted:
         raise DecodeError("--hci needs a thin_lens without distortion: a distorted lens's views are not "
                           "pinhole cameras, so no single disparity per pixel exists")
-    array = raw["microlens_array"]
-    focal = array.get("focal_lengths_mm")
-    if array.get("lens") != "thin_lens" or not isinstance(focal, list) or len(focal) != 1:
+    array = meta.array
+    focal = array.focal_lengths_mm
+    if array.lens != "thin_lens" or len(focal) != 1:
         raise DecodeError("--hci needs one kind of thin microlens (plenoptic 1.0); this array has %s"
-                          % ("pinholes" if array.get("lens") == "pinhole" else "%d lens types" % len(focal or [])))
-    f = float(focal[0])
-    d = float(array["distance_mm"])
+                          % ("pinholes" if array.lens == "pinhole" else "%d lens types" % len(focal)))
+    f = focal[0]
+    d = array.distance_mm
+    F = meta.focal_length_mm
+    assert F is not None, "a thin_lens or thick_lens has a focal length (Metadata checks it)"
     if not math.isclose(meta.array_distance_mm, f, rel_tol=1e-6):
         raise DecodeError("--hci decodes plenoptic 1.0 cameras (array to sensor distance d = microlens focal "
                           "length f); this one has d = %g mm and f = %g mm, a focused (2.0) camera whose "
                           "microimages are not sub-aperture samples" % (d, f))
-    rotate = array.get("rotate_deg", [0, 0, 0])
-    if any(abs(float(r)) > 0 for r in rotate):
+    rotate = array.rotate_deg
+    if any(abs(r) > 0 for r in rotate):
         raise DecodeError("--hci needs an array aligned with the sensor (rotate <0, 0, 0>); this one is turned "
-                          "(rotate <%g, %g, %g>): its views' pixel axes are not the camera grid's axes"
-                          % tuple(float(r) for r in rotate))
+                          "(rotate <%g, %g, %g>): its views' pixel axes are not the camera grid's axes" % rotate)
     px, py = meta.pixel_size_mm
     if not math.isclose(px, py, rel_tol=1e-9):
         raise DecodeError("--hci needs square pixels (one baseline for both axes); pixel_size is %g x %g mm"
                           % (px, py))
-    F = meta.focal_length_mm
     D = meta.rear_principal_z + meta.main_distance_mm
     if not D > F:
         raise DecodeError("--hci needs the array beyond the focal length (D = %g mm from the %s, F = %g mm): "
@@ -109,8 +112,10 @@ class HciGeometry:
     principal planes; z0: the plane's from the entrance pupil). For a thin lens these are
     pixel step D/d and D/pitch."""
 
-    def __init__(self, meta, step):
-        self.F = F = meta.focal_length_mm
+    def __init__(self, meta: Metadata, step: float) -> None:
+        F = meta.focal_length_mm
+        assert F is not None, "check_hci_camera: a thin or thick lens has a focal length"
+        self.F = F
         self.D = meta.main_distance_mm
         self.d = meta.array_distance_mm
         self.pitch = meta.pitch_mm
@@ -129,7 +134,7 @@ class HciGeometry:
         self.focal_mm = self.z0 * s_i / s_o  # D for a thin lens
         self.focal_px = self.focal_mm / self.pitch
 
-    def disparity(self, depth_mm):
+    def disparity(self, depth_mm: np.ndarray | float) -> np.ndarray:
         """View pixels per view step of points at depth Z (mm from the entrance pupil's plane):
         +inf depth gives the finite disparity of infinity; NaN stays NaN."""
         with np.errstate(divide="ignore"):
@@ -148,7 +153,7 @@ def planar_depth_mm(meta, geometry, distance_units, pixel_u, pixel_v, centre_u, 
     Positions are taken on the sensor relative to the principal point (a reflection of the optics
     frame, which leaves the ray's length unchanged). +inf stays +inf; -1 (blocked) gives NaN."""
     px, py = meta.pixel_size_mm
-    pu, pv = meta.raw["principal_point_px"]
+    pu, pv = meta.principal_point_px or (0.0, 0.0)
     D, d = geometry.pupil_distance, geometry.d
     x = np.stack([(np.asarray(pixel_u, float) - pu) * px, (np.asarray(pixel_v, float) - pv) * py])
     m = np.stack([(np.asarray(centre_u, float) - pu) * px, (np.asarray(centre_v, float) - pv) * py])
@@ -163,7 +168,7 @@ def planar_depth_mm(meta, geometry, distance_units, pixel_u, pixel_v, centre_u, 
     return np.where(distance < 0, np.nan, depth)
 
 
-def _square_grid_count(meta, n, step):
+def _square_grid_count(meta: Metadata, n: int | None, step: float) -> int:
     """Views per side: the largest odd N whose N x N angular samples all lie in the usable
     microimage disc, or n checked against it."""
     du, _, mask = angular_grid(meta, None, step)
@@ -217,19 +222,19 @@ def _resample_rows(view, rows, nearest):
 def _blender_pose(meta):
     """The centre camera's place and XYZ Euler angles as the benchmark's Blender add-on writes
     them: POV-Ray's left-handed world (x, y, z) is Blender's (x, z, y); metres."""
-    frame = meta.raw["camera_frame"]
+    frame = meta.camera_frame
     to_blender = np.array([[1, 0, 0], [0, 0, 1], [0, 1, 0]], float)
     scale = meta.mm_per_unit / 1000.0
     # The centre view's centre of projection: the entrance pupil's centre (a thin lens's centre).
-    direction = np.asarray(frame["direction"], float)
-    pupil = np.asarray(frame["location"], float) + meta.entrance_pupil_z / meta.mm_per_unit * direction / np.linalg.norm(direction)
+    direction = np.asarray(frame.direction, float)
+    pupil = np.asarray(frame.location, float) + meta.entrance_pupil_z / meta.mm_per_unit * direction / np.linalg.norm(direction)
     location = to_blender @ pupil * scale
 
     def unit(v):
         v = to_blender @ np.asarray(v, float)
         return v / np.linalg.norm(v)
 
-    right, up, direction = unit(frame["right"]), unit(frame["up"]), unit(frame["direction"])
+    right, up, direction = unit(frame.right), unit(frame.up), unit(frame.direction)
     # A Blender camera looks along its local -z with +y up: columns right, up, -direction.
     rotation = np.column_stack([right, up, -direction])
     # R = Rz(rz) Ry(ry) Rx(rx) (Blender's 'XYZ' order).
@@ -309,14 +314,15 @@ def _write_parameters(path, meta, geometry, n, width, height, disp_range, scene)
         config.write(f)
 
 
-def depth_map_path(meta):
+def depth_map_path(meta: Metadata) -> str:
     """The render's depth map beside its metadata; DecodeError when the render wrote none."""
     return meta.required_sidecar("depth_map", "--hci", "depth map",
                                  "--hci computes the ground truth from the render's depth map, and this render "
                                  "wrote none: add depth_map to the camera and render again")
 
 
-def export_hci(raw, meta, outdir, n=None, step=1.0, all_views=False, progress=None):
+def export_hci(raw: np.ndarray, meta: Metadata, outdir: str, n: int | None = None, step: float = 1.0,
+               all_views: bool = False, progress: Progress | None = None) -> int:
     """Writes the benchmark's layout into outdir; returns the number of views per side."""
     if progress is None:
         progress = Progress(False)

@@ -3,12 +3,19 @@
 decoder requires), 8-bit sRGB PNGs out (through Pillow); colour encodings and bilinear sampling.
 Pixel (column i, row j) has its centre at (i, j)."""
 
+from __future__ import annotations
+
 import math
 import re
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from .errors import DecodeError, DependencyError
+
+# How an image's values encode light: 'srgb', 'linear', 'auto' or a gamma.
+Encoding = str | float
 
 MISSING_OPENIMAGEIO = ("OpenImageIO's Python module is not installed; the decoder reads every raw image "
                        "(8/16-bit PNG, EXR, ...) through it: on Debian 'apt install python3-openimageio', "
@@ -20,7 +27,7 @@ _NO_ENCODING_RECORD = {"jpeg": "JPEG", "pnm": "PPM/PNM", "bmp": "BMP"}
 _FORMAT_NAMES = dict(_NO_ENCODING_RECORD, png="PNG", openexr="EXR", hdr="Radiance HDR", targa="TGA", tiff="TIFF")
 
 
-def require_openimageio():
+def require_openimageio() -> Any:
     """The OpenImageIO module; DependencyError naming the Debian and pip packages without it."""
     try:
         import OpenImageIO as oiio  # noqa: N813 (Debian's python3-openimageio, pip's OpenImageIO)
@@ -29,17 +36,17 @@ def require_openimageio():
     return oiio
 
 
-def srgb_to_linear(x):
+def srgb_to_linear(x: npt.ArrayLike) -> np.ndarray:
     x = np.asarray(x, dtype=np.float32)
     return np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4).astype(np.float32)
 
 
-def linear_to_srgb(x):
+def linear_to_srgb(x: npt.ArrayLike) -> np.ndarray:
     x = np.clip(np.asarray(x, dtype=np.float32), 0.0, 1.0)
     return np.where(x <= 0.0031308, x * 12.92, 1.055 * np.power(x, 1 / 2.4) - 0.055).astype(np.float32)
 
 
-def check_encoding(encoding):
+def check_encoding(encoding: Encoding) -> Encoding:
     """'srgb', 'linear', 'auto' or a positive gamma (number or its text) -> the normalised value
     ('srgb', 'linear', 'auto' or a float); ValueError otherwise."""
     if isinstance(encoding, str) and encoding.lower() in ("auto", "srgb", "linear"):
@@ -59,7 +66,7 @@ class RawInfo:
     the decoder applies: 'srgb', 'linear' or a gamma (float; linear = value ** gamma), with
     encoding_source, a phrase saying where it comes from."""
 
-    def __init__(self, path, spec, file_format, encoding="auto"):
+    def __init__(self, path: str, spec: Any, file_format: str, encoding: Encoding = "auto") -> None:
         oiio = require_openimageio()
         self.path = path
         self.width, self.height, self.channels = spec.width, spec.height, spec.nchannels
@@ -101,7 +108,7 @@ class RawInfo:
         return "srgb", ("assumed: the file records no encoding OpenImageIO names (oiio:ColorSpace %r); sRGB is "
                         "POV-Ray's default File_Gamma" % self.colour_space)
 
-    def describe(self, encoding=True):
+    def describe(self, encoding: bool = True) -> str:
         """'96 x 72 PNG, 16-bit integer, encoding linear (the file's own, ...)'; without the
         encoding (for a file read as DN, whose colour encoding does not apply) when encoding is False."""
         layout = "%d x %d %s, %s" % (self.width, self.height, _FORMAT_NAMES.get(self.file_format, self.file_format),
@@ -143,7 +150,7 @@ class PngLayout:
                                              sbit, encoding)
 
 
-def png_layout(path):
+def png_layout(path: str) -> PngLayout | None:
     """The PngLayout of a PNG file, or None when the file is not a PNG. DecodeError when it
     starts as a PNG but its header chunks are broken."""
     import struct
@@ -184,24 +191,100 @@ def png_layout(path):
     return layout
 
 
-def _open_raw(path):
-    """OpenImageIO ImageBuf of the raw image with its header read (no pixels yet)."""
-    oiio = require_openimageio()
-    buf = oiio.ImageBuf(path)
-    spec = buf.spec()
-    if buf.has_error or spec.width == 0:
-        raise DecodeError("cannot read raw image %s: %s" % (path, buf.geterror().strip() or "unknown format"))
-    return buf
+class ImageReadError(OSError):
+    """An image OpenImageIO cannot open or read: path and reason (OpenImageIO's words, on one line)."""
+
+    def __init__(self, path: str, reason: str) -> None:
+        super().__init__("cannot read %s: %s" % (path, reason))
+        self.path = path
+        self.reason = reason
 
 
-def inspect_raw(path, encoding="auto"):
+def _one_line(text: str, default: str) -> str:
+    """OpenImageIO's error text (sometimes several lines) as one line."""
+    return "; ".join(line.strip() for line in (text or "").splitlines() if line.strip()) or default
+
+
+class ImageFile:
+    """An image file opened with OpenImageIO's ImageInput, its header read (spec, file_format:
+    OpenImageIO's format name such as 'png' or 'openexr'), its pixels not yet. The one way this
+    package (and the tests' helper) reads images: ImageInput reads the file itself each time,
+    where an ImageBuf reads through OpenImageIO's shared image cache, which hands back the pixels
+    first read from a path after the file was written again (the same name rendered twice in a
+    second). Use as a context manager, or call close()."""
+
+    def __init__(self, path: str, unassociated_alpha: bool = False) -> None:
+        oiio = require_openimageio()
+        self.path = path
+        config = None
+        if unassociated_alpha:  # alpha as stored: no premultiplying on reading (PNG's is unassociated)
+            config = oiio.ImageSpec()
+            config.attribute("oiio:UnassociatedAlpha", 1)
+        self._input = oiio.ImageInput.open(path, config) if config is not None else oiio.ImageInput.open(path)
+        if self._input is None:
+            raise ImageReadError(path, _one_line(oiio.geterror(), "unknown format"))
+        self.spec = self._input.spec()
+        self.file_format: str = self._input.format_name()
+        if self.spec.width <= 0 or self.spec.height <= 0:
+            self.close()
+            raise ImageReadError(path, "unknown format")
+
+    @property
+    def width(self) -> int:
+        return int(self.spec.width)
+
+    @property
+    def height(self) -> int:
+        return int(self.spec.height)
+
+    @property
+    def channels(self) -> int:
+        return int(self.spec.nchannels)
+
+    def read(self, native: bool = False) -> np.ndarray:
+        """The pixels as an (H, W, C) array: float32 (integers scaled to 0..1, as OpenImageIO
+        gives them) or, with native, in the file's own sample type."""
+        oiio = require_openimageio()
+        pixels = self._input.read_image(self.spec.format if native else oiio.FLOAT)
+        if pixels is None or not isinstance(pixels, np.ndarray) or pixels.size == 0:
+            raise ImageReadError(self.path, _one_line(self._input.geterror(), "no pixels"))
+        return np.asarray(pixels).reshape(self.height, self.width, self.channels)
+
+    def close(self) -> None:
+        if self._input is not None:
+            self._input.close()
+            self._input = None
+
+    def __enter__(self) -> ImageFile:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def read_image(path: str, native: bool = False, unassociated_alpha: bool = False) -> np.ndarray:
+    """The pixels of any image OpenImageIO reads, (H, W, C), as ImageFile.read gives them.
+    Raises ImageReadError, or DependencyError without OpenImageIO."""
+    with ImageFile(path, unassociated_alpha) as image:
+        return image.read(native)
+
+
+def _open_raw(path: str) -> ImageFile:
+    """The raw image's ImageFile (header read, no pixels yet); DecodeError naming the file."""
+    try:
+        return ImageFile(path)
+    except ImageReadError as e:
+        raise DecodeError("cannot read raw image %s: %s" % (path, e.reason)) from None
+
+
+def inspect_raw(path: str, encoding: Encoding = "auto") -> RawInfo:
     """The raw image's RawInfo from its header alone (size, sample type, encoding), without
     reading its pixels. Raises DecodeError, or DependencyError without OpenImageIO."""
-    buf = _open_raw(path)
-    return RawInfo(path, buf.spec(), buf.file_format_name, encoding)
+    with _open_raw(path) as image:
+        return RawInfo(path, image.spec, image.file_format, encoding)
 
 
-def to_linear(pixels, encoding):
+def to_linear(pixels: npt.ArrayLike, encoding: Encoding) -> np.ndarray:
     """Encoded values -> linear light, for encoding 'srgb', 'linear' or a gamma (float)."""
     if encoding == "srgb":
         return srgb_to_linear(pixels)
@@ -210,21 +293,19 @@ def to_linear(pixels, encoding):
     return np.power(np.clip(pixels, 0, None), float(encoding)).astype(np.float32)
 
 
-def read_raw_image(path, encoding="auto"):
+def read_raw_image(path: str, encoding: Encoding = "auto") -> tuple[np.ndarray, RawInfo]:
     """The raw image as float32 (H, W, 3) linear light, and its RawInfo.
 
     encoding: 'auto' (the file's own encoding: a PNG's sRGB or gAMA chunk as OpenImageIO reports
     it, linear for float files such as EXR, sRGB for formats that record none), or an override:
     'srgb', 'linear', or a number (a pure power-law gamma: linear = value ** gamma).
     Raises DecodeError, or DependencyError without OpenImageIO."""
-    oiio = require_openimageio()
-    buf = _open_raw(path)
-    info = RawInfo(path, buf.spec(), buf.file_format_name, encoding)
-    pixels = np.asarray(buf.get_pixels(oiio.FLOAT), dtype=np.float32)
-    if buf.has_error or pixels.ndim < 2 or pixels.size == 0:
-        raise DecodeError("cannot read raw image %s: %s" % (path, buf.geterror().strip() or "no pixels"))
-    if pixels.ndim == 2:
-        pixels = pixels[:, :, None]
+    with _open_raw(path) as image:
+        info = RawInfo(path, image.spec, image.file_format, encoding)
+        try:
+            pixels = image.read()
+        except ImageReadError as e:
+            raise DecodeError("cannot read raw image %s: %s" % (path, e.reason)) from None
     if pixels.shape[2] == 1:
         pixels = np.repeat(pixels, 3, axis=2)
     elif pixels.shape[2] == 2:  # grey + alpha
@@ -233,30 +314,35 @@ def read_raw_image(path, encoding="auto"):
     return np.ascontiguousarray(pixels, dtype=np.float32), info
 
 
-def read_raw(path, encoding="auto"):
+def read_raw(path: str, encoding: Encoding = "auto") -> np.ndarray:
     """The raw image as float32 (H, W, 3), linear light (see read_raw_image for `encoding`)."""
     return read_raw_image(path, encoding)[0]
 
 
-def read_depth_map(path):
+def read_stored(path: str) -> np.ndarray:
+    """The image's values as stored (OpenImageIO's 0..1 for integers), (H, W, C) float32, no
+    decoding; DecodeError naming the file when it cannot be read."""
+    try:
+        return np.asarray(read_image(path), dtype=np.float32)
+    except ImageReadError as e:
+        raise DecodeError(str(e)) from None
+
+
+def read_depth_map(path: str) -> np.ndarray | None:
     """The first channel of a depth map (EXR) as a float array, or None when it cannot be read
     (or OpenImageIO is missing)."""
     try:
-        import OpenImageIO as oiio
-        buf = oiio.ImageBuf(path)
-        if buf.has_error:
-            return None
-        return np.asarray(buf.get_pixels(oiio.FLOAT))[..., 0]
+        return read_image(path)[..., 0]
     except (ImportError, OSError):
         return None
 
 
-def to_8bit(image):
+def to_8bit(image: npt.ArrayLike) -> np.ndarray:
     """Linear float image -> 8-bit sRGB array."""
     return (linear_to_srgb(image) * 255.0 + 0.5).astype(np.uint8)
 
 
-def save_png(path, image):
+def save_png(path: str, image: npt.ArrayLike) -> None:
     from PIL import Image
     srgb = to_8bit(image)
     if srgb.ndim == 3 and srgb.shape[2] == 1:
@@ -264,7 +350,7 @@ def save_png(path, image):
     Image.fromarray(srgb).save(path)
 
 
-def save_exr(path, image):
+def save_exr(path: str, image: npt.ArrayLike) -> None:
     """A linear float image (H, W, C) as a float OpenEXR file (OpenImageIO)."""
     oiio = require_openimageio()
     image = np.ascontiguousarray(image, dtype=np.float32)
@@ -278,7 +364,8 @@ def save_exr(path, image):
         raise OSError("cannot write %s: %s" % (path, out.geterror()))
 
 
-def scaled_pil_image(image, width=None, height=None, aspect=1.0):
+def scaled_pil_image(image: npt.ArrayLike, width: int | None = None, height: int | None = None,
+                     aspect: float = 1.0) -> Any:
     """Linear image -> PIL image scaled (nearest neighbour: every lens stays a visible cell) to
     fit width x height, with rows stretched by `aspect` (cell height / width)."""
     from PIL import Image
@@ -290,7 +377,7 @@ def scaled_pil_image(image, width=None, height=None, aspect=1.0):
     return im.resize(size, Image.NEAREST)
 
 
-def bilinear(image, x, y):
+def bilinear(image: np.ndarray, x: npt.ArrayLike, y: npt.ArrayLike) -> np.ndarray:
     """Samples image (H, W, C) at continuous pixel positions x, y (centre convention), clamped
     to the image; result has shape x.shape + (C,)."""
     h, w = image.shape[:2]

@@ -16,12 +16,16 @@ half a lens to the side, so its values are interpolated linearly between its two
 in that row.
 """
 
+from __future__ import annotations
+
 import math
 
 import numpy as np
+import numpy.typing as npt
 
 from .errors import DecodeError, MetadataError
 from .images import bilinear
+from .metadata import Metadata
 from .microimages import microimage_centre
 from .progress import Progress
 
@@ -39,7 +43,8 @@ class LightField:
     dark:     bool [t, s], True at grid points whose lens gets no light (measured centres)
     """
 
-    def __init__(self, data, du, dv, mask, A, R, origin_st, meta, step):
+    def __init__(self, data: np.ndarray, du: np.ndarray, dv: np.ndarray, mask: np.ndarray, A: np.ndarray,
+                 R: np.ndarray, origin_st: tuple[float, float], meta: Metadata, step: float) -> None:
         self.data = data
         self.du = du
         self.dv = dv
@@ -54,37 +59,37 @@ class LightField:
         self.dark = np.zeros(data.shape[:2], bool)
 
     @property
-    def shape(self):
+    def shape(self) -> tuple[int, ...]:
         return self.data.shape
 
-    def centre_index(self):
+    def centre_index(self) -> tuple[int, int]:
         return len(self.dv) // 2, len(self.du) // 2
 
-    def view(self, iv, iu):
+    def view(self, iv: int, iu: int) -> np.ndarray:
         """Sub-aperture view (T, S, C) at angular sample (iv, iu)."""
         return self.data[:, :, iv, iu, :]
 
-    def grid_position(self, s, t):
+    def grid_position(self, s: npt.ArrayLike, t: npt.ArrayLike) -> np.ndarray:
         """Raw-image pixel position of grid point (s, t) (indices into data)."""
         s0, t0 = self.origin_st
         s = (s0 + np.asarray(s, float))[..., None]
         t = (t0 + np.asarray(t, float))[..., None]
         return self.meta.origin + s * self.A + t * self.R
 
-    def kappa(self, slope):
+    def kappa(self, slope: float) -> float:
         """Refocus slope (lenses along s per angular step) -> microimage-centre pixels per pixel."""
         return slope * np.hypot(*self.A) / self.step
 
-    def slope_from_kappa(self, kappa):
+    def slope_from_kappa(self, kappa: float) -> float:
         return kappa * self.step / np.hypot(*self.A)
 
-    def shift_for(self, slope, iv, iu):
+    def shift_for(self, slope: float, iv: int, iu: int) -> tuple[float, float]:
         """(ds, dt) grid shift of view (iv, iu) that aligns a point with this slope."""
         kappa = self.kappa(slope)
         ds, dt = self.M_inv @ (kappa * np.array([self.du[iu], self.dv[iv]]))
         return ds, dt
 
-    def refocus(self, slope):
+    def refocus(self, slope: float) -> np.ndarray:
         """Shift-and-add over all usable views: the picture focused where points move by
         `slope` lenses along s per angular step (0: the plane imaged onto the array)."""
         T, S = self.data.shape[:2]
@@ -103,7 +108,7 @@ class LightField:
                 weight += inside
         return total / np.maximum(weight, 1e-6)
 
-    def epi(self, t, iv=None):
+    def epi(self, t: int, iv: int | None = None) -> tuple[np.ndarray, list[int]]:
         """Horizontal epipolar-plane image at lens row t and angular row iv (default centre):
         array (n_u, S, C), u down, s across, only the usable u samples; and the list of those
         u sample indices."""
@@ -112,10 +117,10 @@ class LightField:
         usable_u = [iu for iu in range(len(self.du)) if self.mask[iv, iu]]
         return np.stack([self.data[t, :, iv, iu, :] for iu in usable_u], axis=0), usable_u
 
-    def slope_to_distance(self, slope):
+    def slope_to_distance(self, slope: float) -> float | None:
         return self.meta.slope_to_distance(self.kappa(slope))
 
-    def display_aspect(self):
+    def display_aspect(self) -> float:
         """Height/width of one (s, t) grid cell on the sensor (sqrt(3)/2 for hexagonal grids)."""
         return np.hypot(*self.R) / np.hypot(*self.A)
 
@@ -151,7 +156,7 @@ def _usable_radius(meta):
     return radius - 1.0
 
 
-def _angular_count(usable, n, step):
+def _angular_count(usable: float, n: int | None, step: float) -> int:
     """Samples per axis: n (checked) or as many `step`-pixel steps as fit the usable radius."""
     if n is None:
         ratio = usable / step + 1e-9
@@ -166,7 +171,7 @@ def _angular_offsets(n, step):
     return (np.arange(n) - n // 2) * float(step)
 
 
-def angular_grid(meta, n=None, step=1.0):
+def angular_grid(meta: Metadata, n: int | None = None, step: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Offsets (pixels) of the angular samples and the usable-disc mask: (du, dv, mask).
 
     The usable radius is the smaller of the main-aperture disc (microimage_diameter_px / 2) and
@@ -191,7 +196,8 @@ class DecodePlan:
     grid (A, R, its skew coefficients), the kept lenses (k0, frac, l: T x S arrays) and
     origin_st, shape (T, S, n, n, C) and nbytes of L in float32."""
 
-    def __init__(self, meta, n=None, step=1.0, channels=3, limit_bytes=LIGHT_FIELD_LIMIT_BYTES):
+    def __init__(self, meta: Metadata, n: int | None = None, step: float = 1.0, channels: int = 3,
+                 limit_bytes: int = LIGHT_FIELD_LIMIT_BYTES) -> None:
         W, H = meta.width, meta.height
         self.step = float(step)
         if not (self.step > 0 and math.isfinite(self.step)):
@@ -212,7 +218,7 @@ class DecodePlan:
                 "between rows, more than the %d x %d px image spans (%.2f x %.2f spacings; microlens_array.pitch_mm "
                 "%s, sensor.pixel_size_mm %s): at most one lens per row or column, no light field to decode"
                 % (np.hypot(*A), np.hypot(*R), W, H, extent_s, extent_t,
-                   _number(meta.raw, "microlens_array.pitch_mm"), _number(meta.raw, "sensor.pixel_size_mm")))
+                   "%g" % meta.pitch_mm, "%g" % meta.pixel_size_mm[0]))
         if extent_s * extent_t > 4.0 * W * H:
             raise DecodeError("the metadata lattice puts no sensible grid of microimages on the %d x %d image" % (W, H))
 
@@ -274,26 +280,15 @@ class DecodePlan:
                 % (T, S, n, n, channels, _gib(self.nbytes), _gib(limit_bytes), self.step))
 
 
-def _number(raw, path):
-    """The value at a dotted path of the metadata, for messages ('?' when absent)."""
-    node = raw
-    for part in path.split("."):
-        if not isinstance(node, dict) or part not in node:
-            return "?"
-        node = node[part]
-    if isinstance(node, list) and node:
-        node = node[0]
-    return "%g" % node if isinstance(node, (int, float)) and not isinstance(node, bool) else "?"
-
-
-def plan_decode(meta, n=None, step=1.0, channels=3):
+def plan_decode(meta: Metadata, n: int | None = None, step: float = 1.0, channels: int = 3) -> DecodePlan:
     """The DecodePlan of decode(raw, meta, n, step) from the metadata alone: the light field's
     shape and size, checked. Raises DecodeError when the microimage spacing exceeds the image,
     no microimage fits, or L would exceed LIGHT_FIELD_LIMIT_BYTES."""
     return DecodePlan(meta, n, step, channels)
 
 
-def decode(raw, meta, n=None, step=1.0, progress=None):
+def decode(raw: np.ndarray, meta: Metadata, n: int | None = None, step: float = 1.0,
+           progress: Progress | None = None) -> LightField:
     """Raw image (H, W, C float) + Metadata -> LightField.
 
     n: angular samples per axis (odd; default as many `step`-pixel steps as fit the usable
@@ -347,7 +342,7 @@ def decode(raw, meta, n=None, step=1.0, progress=None):
     return lf
 
 
-def mosaic(lf, gap=2):
+def mosaic(lf: LightField, gap: int = 2) -> np.ndarray:
     """All views of LightField lf side by side, v down, u across; unusable angular samples left
     black."""
     T, S, n_v, n_u, C = lf.data.shape

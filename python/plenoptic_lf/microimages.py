@@ -24,17 +24,7 @@ UNLISTED, LIT, DARK = 0, 1, 2
 def _lattice_fit(meta):
     """(origin, a, b) of the metadata's microimages.lattice_fit, or None when it has none (fewer
     than three lit lenses) or it is malformed."""
-    fit = (meta.raw.get("microimages") or {}).get("lattice_fit")
-    if not isinstance(fit, dict):
-        return None
-    try:
-        origin = np.array(fit["origin_px"], dtype=float)
-        basis = np.array(fit["basis_px"], dtype=float)
-    except (KeyError, TypeError, ValueError):
-        return None
-    if origin.shape != (2,) or basis.shape != (2, 2) or not (np.isfinite(origin).all() and np.isfinite(basis).all()):
-        return None
-    return origin, basis[0], basis[1]
+    return meta.microimages.lattice_fit
 
 
 class MeasuredCentres:
@@ -161,9 +151,8 @@ def microimages_candidates(meta):
     microimages.file beside the metadata, then <metadata stem>.microimages.csv (the name the
     renderer would give it, for a render whose files were renamed). Empty when the metadata says
     the render wrote none."""
-    entry = meta.raw.get("microimages")
-    name = entry.get("file") if isinstance(entry, dict) else None
-    if not isinstance(name, str) or not name:
+    name = meta.microimages.file
+    if name is None:
         return []
     candidates = [(os.path.join(os.path.dirname(os.path.abspath(meta.path)), name),
                    "the metadata's microimages.file")]
@@ -178,9 +167,8 @@ def check_centres_belong(meta, centres):
     metadata's microimages.lenses, or it does not list exactly the lenses whose microimage_lattice
     centre lies in the picture, as the renderer writes it (docs/metadata.md, "Microimage centres")."""
     path = centres.path
-    entry = meta.raw.get("microimages")
-    counted = entry.get("lenses") if isinstance(entry, dict) else None
-    if isinstance(counted, int) and not isinstance(counted, bool) and centres.lenses != counted:
+    counted = meta.microimages.lenses
+    if counted is not None and centres.lenses != counted:
         raise DecodeError("%s lists %d lenses, but this render's metadata counts %d (microimages.lenses): the centres "
                           "belong to another render, or the file was cut" % (path, centres.lenses, counted))
     W, H, tol = meta.width, meta.height, _EDGE_TOLERANCE_PX

@@ -2,16 +2,20 @@
 """The decoder's output folder: views, mosaic, refocus sweep, EPI, contact sheet, the light field
 as .npy and its description as JSON (docs/ground-truth.md lists the files)."""
 
+from __future__ import annotations
+
 import json
 import math
 import os
 import sys
+from typing import Sequence
 
 import numpy as np
 
 from .contact_sheet import contact_sheet
 from .focus import pick_epi_row, pick_near_far, sharpest_slope_map
 from .images import save_png, scaled_pil_image, to_8bit
+from .lightfield import LightField
 from .progress import Progress
 
 
@@ -27,7 +31,8 @@ def _mosaic_8bit(lf, gap=2):
     return out
 
 
-def write_outputs(raw, lf, outdir, slopes, gif=True, npy=True, progress=None, title=""):
+def write_outputs(raw: np.ndarray, lf: LightField, outdir: str, slopes: Sequence[float] | np.ndarray, gif: bool = True,
+                  npy: bool = True, progress: Progress | None = None, title: str = "") -> str:
     """Writes views, mosaic, refocus sweep (+ GIF), EPI, contact sheet and a JSON description.
     Returns the path of the contact sheet."""
     from PIL import Image
@@ -91,12 +96,12 @@ def write_outputs(raw, lf, outdir, slopes, gif=True, npy=True, progress=None, ti
         "grid_position_rule": "raw pixel of data[t, s] = microimage_lattice.origin_px + (s0 + s) A + (t0 + t) R",
         "microimage_centres": ("the metadata's microimage_lattice" if lf.meta.lattice_is_exact else
                                "measured, per lens (%s); the lattice fit for lenses it does not list"
-                               % (lf.meta.raw.get("microimages") or {}).get("file")),
+                               % lf.meta.microimages.file),
         "dark_mask": lf.dark.astype(int).tolist(),
         "slopes": [float(s) for s in slopes],
         "slope_unit": "lenses along s per angular step (0 = plane imaged onto the array)",
-        "slope_distances": [lf.slope_to_distance(s) if lf.slope_to_distance(s) is None or
-                            math.isfinite(lf.slope_to_distance(s)) else None for s in slopes],
+        "slope_distances": [z if z is None or math.isfinite(z) else None
+                            for z in (lf.slope_to_distance(s) for s in slopes)],
         "near_far_slope_index": [near, far],
         "views": view_names,
         "epi_lens_row": epi_row,

@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Progress messages on stderr."""
 
+from __future__ import annotations
+
 import sys
 import time
 
@@ -8,20 +10,20 @@ import time
 class Progress:
     """Stage messages and, for stages longer than a second, percentages on stderr."""
 
-    def __init__(self, enabled=True, prefix="plenoptic-decode"):
+    def __init__(self, enabled: bool = True, prefix: str = "plenoptic-decode") -> None:
         self.enabled = enabled
         self.prefix = prefix
-        self._label = None
+        self._label: str | None = None
         self._stage_start = 0.0
         self._last_report = 0.0
 
-    def stage(self, label):
+    def stage(self, label: str) -> None:
         self._label = label
         self._stage_start = self._last_report = time.monotonic()
         if self.enabled:
             print("%s: %s" % (self.prefix, label), file=sys.stderr, flush=True)
 
-    def update(self, done, total):
+    def update(self, done: float, total: float) -> None:
         if not self.enabled or total <= 0:
             return
         now = time.monotonic()

@@ -1,8 +1,11 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
 """Forward projection (world point -> pixel positions) through the compiled plenoptic-project."""
 
+from __future__ import annotations
+
 import os
 import subprocess
+from typing import Sequence
 
 
 def _install_prefix_bin(package_dir):
@@ -17,7 +20,7 @@ def _install_prefix_bin(package_dir):
     return None
 
 
-def find_project_tool():
+def find_project_tool() -> str:
     """Path of plenoptic-project: $PLENOPTIC_PROJECT, beside this package, in the bin/ of the
     prefix the package is installed in (PREFIX/lib/python3/dist-packages/plenoptic_lf ->
     PREFIX/bin), or on PATH."""
@@ -35,7 +38,8 @@ def find_project_tool():
     return "plenoptic-project"
 
 
-def project_points(metadata_path, points, tool=None, blur=False):
+def project_points(metadata_path: str, points: Sequence[Sequence[float]], tool: str | None = None,
+                   blur: bool = False) -> list[tuple[int | float, ...]]:
     """World points (scene units, N x 3) -> list of (point_index, lens_k, lens_l, u, v), one per
     image of each point, by running plenoptic-project; with blur, each tuple also holds the
     image's signed blur radius in pixels (plenoptic-project --blur). Raises RuntimeError with its

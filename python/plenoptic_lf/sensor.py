@@ -15,7 +15,10 @@ to the read-out's bit depth, one channel for a mosaic, and no colour-encoding ch
 white image has sBIT 16; the render's PNG picture always carries gAMA.
 """
 
+from __future__ import annotations
+
 import numpy as np
+import numpy.typing as npt
 
 from .errors import DecodeError
 
@@ -24,12 +27,8 @@ _CELLS = {"rggb": "RGGB", "bggr": "BGGR", "grbg": "GRBG", "gbrg": "GBRG"}
 
 
 def white_image_of(meta, white_path):
-    """The metadata's white_images entry of this file (its "values": "linear" or "dn"), or None."""
-    import os
-    for entry in meta.raw.get("white_images") or []:
-        if isinstance(entry, dict) and entry.get("file") == os.path.basename(white_path):
-            return entry
-    return None
+    """The metadata's white_images entry of this file (its values: "linear" or "dn"), or None."""
+    return meta.white_image(white_path)
 
 
 WHITE_VALUES = ("dn", "linear")
@@ -101,8 +100,7 @@ def _found(layout):
 
 
 def _metadata_read_out(meta):
-    read_out = meta.raw.get("sensor", {}).get("read_out")
-    return read_out if isinstance(read_out, dict) else None
+    return meta.read_out
 
 
 def picture_reading(meta, path, layout, raw=False, encoding_given=False):
@@ -120,7 +118,7 @@ def picture_reading(meta, path, layout, raw=False, encoding_given=False):
         if read_out is None:
             raise DecodeError("--raw: the metadata records no read-out (its sensor.read_out is null), so there is "
                               "no raw in DN to decode; give the rendered picture without --raw")
-        if entry is not None and entry.get("values") == "linear":
+        if entry is not None and entry.values == "linear":
             raise DecodeError("--raw: %s is the metadata's linear white image (white_images), not a raw in DN" % name)
         if not _fits_dn(layout, read_out, need_sbit=False):
             raise DecodeError("--raw: %s is not the sensor's raw in DN: expected %s; found %s"
@@ -164,20 +162,17 @@ def white_reading(meta, path, layout, values=None, scale=None):
     if values is not None and values not in WHITE_VALUES:
         raise DecodeError("--white-values must be dn or linear, found %r" % (values,))
     if entry is not None:
-        told = entry.get("values")
+        told = entry.values
         if told not in WHITE_VALUES:
             raise DecodeError("the metadata's white_images entry of %s has values %r: dn or linear expected"
                               % (name, told))
         if values is not None and values != told:
             raise DecodeError("--white-values %s contradicts the metadata, whose white_images entry says %s is %s"
                               % (values, name, told))
-        try:
-            told_scale = float(entry.get("scale", 1))
-        except (TypeError, ValueError):
-            told_scale = float("nan")
+        told_scale = entry.scale
         if told == "linear" and not (told_scale > 0 and told_scale < float("inf")):
             raise DecodeError("the metadata's white_images entry of %s has scale %r: a positive number expected"
-                              % (name, entry.get("scale")))
+                              % (name, entry.raw_scale))
         if scale is not None and (told == "dn" or scale != told_scale):
             raise DecodeError("--white-scale %g contradicts the metadata, whose white_images entry of %s says %s"
                               % (scale, name, "values dn (no scale)" if told == "dn" else "scale %g" % told_scale))
@@ -224,8 +219,7 @@ def white_reading(meta, path, layout, values=None, scale=None):
         raise DecodeError("%s is not a linear white image (%s): expected %s; found %s"
                           % (path, source, EXPECTED_LINEAR, _found(layout)))
     if scale is None:
-        known = sorted({"%g" % float(e.get("scale", 1)) for e in meta.raw.get("white_images") or []
-                        if isinstance(e, dict) and e.get("values") == "linear"})
+        known = sorted({"%g" % e.scale for e in meta.white_images if e.values == "linear"})
         raise DecodeError("%s is a linear white image (%s) whose name is not in the metadata's white_images, so its "
                           "scale (stored value x scale = irradiance) is unknown: give --white-scale S%s"
                           % (path, source, " (the metadata's linear white images have scale %s)" % ", ".join(known)
@@ -290,7 +284,7 @@ def dn_to_linear(pixels, read_out, path=None):
     return ((dn - black) / (gain * exposure)).astype(np.float32)
 
 
-def demosaic_bilinear(mosaic, pattern):
+def demosaic_bilinear(mosaic: npt.ArrayLike, pattern: str) -> np.ndarray:
     """(H, W) single-colour sites of a Bayer `pattern` ('rggb', 'bggr', 'grbg', 'gbrg') -> (H, W, 3).
 
     Each colour: its sites kept, the others the mean of the nearest sites of that colour (the two
@@ -317,7 +311,7 @@ def demosaic_bilinear(mosaic, pattern):
     return out
 
 
-def devignette(picture, white, threshold=0.1):
+def devignette(picture: npt.ArrayLike, white: npt.ArrayLike, threshold: float = 0.1) -> np.ndarray:
     """picture / white where the white image exceeds `threshold` times its 99.9th percentile (the
     light's reach), 0 elsewhere: what every lens passes becomes what the scene sent."""
     picture = np.asarray(picture, dtype=np.float32)

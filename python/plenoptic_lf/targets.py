@@ -35,10 +35,14 @@ import os
 import random
 import subprocess
 import sys
+from typing import Sequence
 
 import numpy as np
 
+from .errors import DependencyError, MetadataError
 from .locate import PREFIX, REPOSITORY, find_povray, find_project
+from .metadata import REAL_LENS_TYPES, RenderMetadata, read_metadata
+from .povray import povray_command, run_povray
 
 
 def rotation_xyz(degrees):
@@ -110,19 +114,18 @@ DEFAULT_PLACEMENT = {"location": [0.0, 0.0, 0.0], "right": [1.0, 0.0, 0.0], "up"
                      "direction": [0.0, 0.0, 1.0]}
 
 
-def camera_placement(meta):
+def camera_placement(meta: RenderMetadata) -> dict[str, list[float]]:
     """The camera's placement in the world from its metadata: its `location` (the main-lens centre;
     a real lens's front vertex, front_vertex_z_mm ahead of the optics frame's origin, the rear
     vertex, along the viewing direction) and the unit vectors right, up and direction. The
     default placement exactly when it is that within 1e-12."""
-    frame = meta["camera_frame"]
-    location = np.array(frame["location"], dtype=float)
-    direction = np.array(frame["direction"], dtype=float)
-    lens = meta.get("main_lens") or {}
-    if lens.get("type") in ("thick_lens", "prescription"):
-        location = location + lens["paraxial"]["front_vertex_z_mm"] / meta["mm_per_unit"] * direction
-    placement = {"location": location.tolist(), "right": [float(v) for v in frame["right"]],
-                 "up": [float(v) for v in frame["up"]], "direction": direction.tolist()}
+    frame = meta.camera_frame
+    location = np.array(frame.location, dtype=float)
+    direction = np.array(frame.direction, dtype=float)
+    if meta.main_lens.type in REAL_LENS_TYPES:
+        location = location + meta.main_lens.front_vertex_z_mm / meta.mm_per_unit * direction
+    placement = {"location": location.tolist(), "right": [float(v) for v in frame.right],
+                 "up": [float(v) for v in frame.up], "direction": direction.tolist()}
     if all(abs(a - b) <= 1e-12 for key in DEFAULT_PLACEMENT for a, b in zip(placement[key], DEFAULT_PLACEMENT[key])):
         return dict(DEFAULT_PLACEMENT)
     return placement
@@ -156,7 +159,7 @@ def _include_dir():
     raise FileNotFoundError("calibration_targets.inc not found beside the plenoptic_lf package")
 
 
-def main(argv=None):
+def main(argv: Sequence[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="plenoptic-targets", description=__doc__.split("\n\n")[0])
     p.add_argument("camera", help="a file holding camera { plenoptic ... } (the poses are relative to it)")
     p.add_argument("--out", required=True, help="output folder")
@@ -211,11 +214,11 @@ def main(argv=None):
             meta = os.path.join(args.out, name + ".plenoptic.json")
             if os.path.exists(meta):  # an earlier run's: the render below must write its own
                 os.remove(meta)
-            cmd = [povray, "+I" + pov, "+O" + png, "+W%d" % args.width, "+H%d" % args.height, "-D", "-P",
-                   "+L" + include, "+FN16", "File_Gamma=1.0"] + list(args.povray_options)
-            run = subprocess.run(cmd, capture_output=True, text=True)
+            cmd = povray_command(povray, pov, png, args.width, args.height,
+                                 ["-D", "-P", "+L" + include, "+FN16", "File_Gamma=1.0"] + list(args.povray_options))
+            run = run_povray(cmd, separate=True)
             if run.returncode != 0 or not os.path.exists(png):
-                return fail("the render of view %d failed (%s):\n%s" % (k, " ".join(cmd), run.stderr[-2000:]))
+                return fail("the render of view %d failed (%s):\n%s" % (k, " ".join(cmd), (run.stderr or "")[-2000:]))
             if not os.path.exists(meta):
                 for leftover in os.listdir(args.out):
                     if leftover.startswith(name + "."):
@@ -224,9 +227,8 @@ def main(argv=None):
                             "needs a file holding camera { plenoptic ... }" % args.camera)
             if placement is None:
                 try:
-                    with open(meta) as f:
-                        placement = camera_placement(json.load(f))
-                except (OSError, ValueError, KeyError, TypeError) as e:
+                    placement = camera_placement(read_metadata(meta))
+                except (MetadataError, DependencyError) as e:
                     return fail("%s: cannot read the camera's placement (camera_frame): %s" % (meta, e))
                 if placement != DEFAULT_PLACEMENT:
                     print("plenoptic-targets: the camera is placed at <%s>, looking along <%s>: the targets are posed "

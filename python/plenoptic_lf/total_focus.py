@@ -21,18 +21,20 @@ wholly lit, the nearest lens is read); v comes from the virtual depth map at the
 from the microimage centre's), or is the constant given.
 """
 
+from __future__ import annotations
+
 import math
 
 import numpy as np
 
 from .errors import DecodeError
 from .images import bilinear, read_depth_map
+from .metadata import Metadata
 
 
-def check_total_focus_camera(meta):
+def check_total_focus_camera(meta: Metadata) -> None:
     """DecodeError unless the render is a focused camera behind a thin or thick main lens, array
     parallel to the sensor."""
-    raw = meta.raw
     if meta.main_lens_type == "prescription":
         raise DecodeError("--total-focus reads each point from the microimages where an ideal lens's straight chief "
                           "ray through the exit pupil's centre puts it; this render's main lens is a traced "
@@ -42,19 +44,19 @@ def check_total_focus_camera(meta):
     if meta.main_lens_type not in ("thin_lens", "thick_lens"):
         raise DecodeError("--total-focus needs a thin_lens or thick_lens main lens; this render's is %s"
                           % meta.main_lens_type)
-    array = raw["microlens_array"]
-    focal = array.get("focal_lengths_mm") or []
-    if array.get("lens") != "thin_lens" or all(math.isclose(f, meta.array_distance_mm, rel_tol=1e-9) for f in focal):
+    array = meta.array
+    focal = array.focal_lengths_mm
+    if array.lens != "thin_lens" or all(math.isclose(f, meta.array_distance_mm, rel_tol=1e-9) for f in focal):
         raise DecodeError("--total-focus decodes focused (2.0) cameras (thin microlenses with d != f); this one is %s"
-                          % ("a pinhole array" if array.get("lens") != "thin_lens" else "a plenoptic 1.0 camera (d = f): "
+                          % ("a pinhole array" if array.lens != "thin_lens" else "a plenoptic 1.0 camera (d = f): "
                              "use its sub-aperture views"))
-    rotate = array.get("rotate_deg", [0, 0, 0])
-    if any(abs(float(r)) > 0 for r in rotate[:2]):
+    rotate = array.rotate_deg
+    if any(abs(r) > 0 for r in rotate[:2]):
         raise DecodeError("--total-focus needs an array parallel to the sensor; this one is tilted (rotate <%g, %g, %g>)"
-                          % tuple(float(r) for r in rotate))
+                          % rotate)
 
 
-def virtual_depth_path(meta):
+def virtual_depth_path(meta: Metadata) -> str:
     """The render's virtual depth map beside its metadata; DecodeError when it wrote none."""
     return meta.required_sidecar("virtual_depth_map", "--total-focus", "virtual depth map",
                                  "--total-focus needs the virtual depth: render the focused camera with depth_map "
@@ -88,7 +90,7 @@ def _nearest_lattice(meta, P):
     return best_k, best_l
 
 
-def default_step(meta, virtual):
+def default_step(meta: Metadata, virtual: np.ndarray | float) -> float:
     """Output sample spacing (pixels of the picture) that reads the raw about one pixel apart at
     the scene's typical virtual depth: (1 + d/D) / k, k the median over the map of |1/v + d/D|
     (the scale from picture to raw at v)."""
@@ -99,9 +101,12 @@ def default_step(meta, virtual):
     return (1 + d / D) / max(scale, 1e-6)
 
 
-def total_focus(raw, meta, virtual=None, step=None, iterations=4):
+def total_focus(raw: np.ndarray, meta: Metadata, virtual: np.ndarray | float | None = None, step: float | None = None,
+                iterations: int = 4) -> tuple[np.ndarray, float]:
     """raw (H, W, C) linear; virtual: the virtual depth map (H, W) or a number. Returns the image
     (rows, columns, C) and the step used (picture pixels between samples)."""
+    if virtual is None:
+        raise DecodeError("the total focus needs the virtual depth: the render's map (H, W) or one number")
     check_total_focus_camera(meta)
     # D: the exit pupil's centre (a thin lens's centre) to the array, from which the microimage
     # lattice projects the lens centres; the aperture below is the exit pupil's diameter.
@@ -151,13 +156,14 @@ def total_focus(raw, meta, virtual=None, step=None, iterations=4):
     # (a small cone), the nearest lens (whose cell holds q) is read.
     safe_v = np.where(np.isnan(v), 1e9, v)
     aperture = meta.exit_pupil_mm
+    assert aperture is not None, "check_total_focus_camera: a thin or thick lens has an exit pupil"
     pixel = float(np.mean(meta.pixel_size_mm))
     circumradius = meta.pitch_mm / (math.sqrt(3) if meta.grid == "hexagonal" else math.sqrt(2))
     a = -safe_v * d
     cone = 0.5 * aperture * np.abs(a) / np.abs(D - a)
     total = np.zeros(P.shape[:-1] + (raw.shape[2],), np.float64)
     count = np.zeros(P.shape[:-1], np.float64)
-    nearest = None
+    nearest: np.ndarray | None = None
     for dk in (-1, 0, 1):
         for dl in (-1, 0, 1):
             centre = centre_of(k0 + dk, l0 + dl)
@@ -172,6 +178,7 @@ def total_focus(raw, meta, virtual=None, step=None, iterations=4):
             values = bilinear(raw, position[..., 0], position[..., 1])
             total += np.where(lit[..., None], values, 0)
             count += lit
+    assert nearest is not None  # the lens itself (dk = dl = 0) is always read
     total = np.where((count == 0)[..., None], nearest, total)
     count = np.maximum(count, 1)
     image = total / np.maximum(count, 1)[..., None]

@@ -16,16 +16,16 @@ the central half of the sensor, the share of black pixels.
 """
 import argparse
 import glob
-import json
 import os
-import subprocess
 import sys
-import time
 
 import numpy as np
 import OpenImageIO as oiio
 
-from plenoptic_lf.images import linear_to_srgb
+from plenoptic_lf.errors import DependencyError, MetadataError
+from plenoptic_lf.images import ImageReadError, linear_to_srgb, read_image
+from plenoptic_lf.metadata import read_metadata
+from plenoptic_lf.povray import povray_command, run_povray
 
 REFERENCE = "full_d1_8"
 
@@ -33,30 +33,28 @@ REFERENCE = "full_d1_8"
 def render(povray, scene, work, size):
     name = os.path.splitext(os.path.basename(scene))[0]
     exr = os.path.join(work, name + ".exr")
-    cmd = [povray, "+I" + scene, "+L" + os.path.dirname(scene), "+O" + exr, "+FE",
-           "+W%d" % size, "+H%d" % size, "-D", "-GS", "-GR", "-GD"]
-    start = time.monotonic()
-    run = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                         stdin=subprocess.DEVNULL)
-    seconds = time.monotonic() - start
+    cmd = povray_command(povray, scene, exr, size, size, ["+L" + os.path.dirname(scene), "+FE", "-D", "-GS", "-GR",
+                                                          "-GD"])
+    run = run_povray(cmd)
+    seconds = run.seconds
     if run.returncode != 0:
-        text = run.stdout.decode("utf-8", "replace").replace("\r", "\n").strip().splitlines()
+        text = run.output.replace("\r", "\n").strip().splitlines()
         raise RuntimeError("%s: povray exited %d:\n%s" % (scene, run.returncode,
                                                           "\n".join(text[-15:])))
-    source = oiio.ImageInput.open(exr)   # not ImageBuf: its shared cache keeps old pixels
-    if source is None:
-        raise RuntimeError("cannot read %s: %s" % (exr, oiio.geterror()))
-    image = source.read_image(oiio.FLOAT)[:, :, :3]
-    source.close()
-    with open(os.path.join(work, name + ".plenoptic.json"), encoding="utf-8") as f:
-        meta = json.load(f)
+    try:
+        image = read_image(exr)[:, :, :3]
+    except ImageReadError as e:
+        raise RuntimeError(str(e)) from None
+    try:
+        meta = read_metadata(os.path.join(work, name + ".plenoptic.json"))
+    except (MetadataError, DependencyError) as e:
+        raise RuntimeError("%s: %s" % (os.path.join(work, name + ".plenoptic.json"), e)) from None
     return name, image, meta, seconds
 
 
 def solid_angle(meta):
     """C of an irradiance render, None for a flat one."""
-    radiometry = meta["sensor"]["radiometry"]
-    return radiometry["projected_solid_angle_sr"] if radiometry["model"] == "irradiance" else None
+    return meta.projected_solid_angle_sr if meta.radiometry_model == "irradiance" else None
 
 
 def to_srgb8(linear):
@@ -121,7 +119,7 @@ def main(argv=None):
             shown = image * (c / c_ref) if c is not None else image
             rgb8 = to_srgb8(shown)
             write_png(os.path.join(a.out, name + ".png"), rgb8)
-            if "microlens_array" in meta and meta["microlens_array"]:
+            if meta.array is not None:
                 write_png(os.path.join(a.out, name + "_zoom.png"), zoom(rgb8, a.zoom_px, a.zoom_scale))
             black = float((image.max(axis=2) <= 0.0).mean())
             print("%-28s %6.1f s  mean %s %.3f  black %.3f" % (

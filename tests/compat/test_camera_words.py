@@ -21,7 +21,6 @@ import os
 import re
 
 import numpy as np
-import OpenImageIO as oiio
 import pytest
 
 import plenoptic_testing as pt
@@ -49,8 +48,7 @@ def render(povray, scene_text, name, work, width=96, height=72, extra=()):
     out = res.output
     if res.returncode != 0 or res.timed_out or not os.path.exists(image):
         return None, out
-    buf = oiio.ImageBuf(image)
-    return buf.get_pixels(oiio.UINT8).astype(np.int16), out
+    return pt.read_pixels(image, native=True).astype(np.int16), out  # an 8-bit PNG (+FN8): its values
 
 
 def identifiers_scene(words):

@@ -105,8 +105,9 @@ def png_chunks(path):
 
 
 def oiio_attributes(path):
-    import OpenImageIO as oiio
-    spec = oiio.ImageBuf(path).spec()
+    from plenoptic_lf.images import ImageFile
+    with ImageFile(path) as image:
+        spec = image.spec
     return spec.get_string_attribute("oiio:ColorSpace", ""), spec.get_float_attribute("oiio:Gamma", 0.0)
 
 

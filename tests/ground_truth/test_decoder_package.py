@@ -1,17 +1,19 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""The decoder is one Python package, python/plenoptic_lf, with its dependencies declared.
+"""The Python tools are one package, python/plenoptic_lf, with its dependencies declared and
+its commands in one table.
 
 Checks, without rendering anything:
   - python/pyproject.toml: name plenoptic-lf, the project's version (CMake's PROJECT_VERSION,
-    also plenoptic_lf.__version__), licence, Python >= 3.9, the plenoptic-decode console script;
+    also plenoptic_lf.__version__), licence, Python >= 3.11 (tomllib), the console scripts
+    plenoptic-decode and plenoptic-dataset;
   - its dependencies are exactly the third-party modules the package imports;
   - every file starts with the SPDX header;
   - with only python/ on sys.path every module imports and the public API (__all__) is there;
     `python3 -m plenoptic_lf --help` and the in-tree launcher tools/plenoptic-decode print the
     same usage;
   - `pip install --no-deps --no-build-isolation` of a copy of python/ into a throwaway venv
-    gives a working plenoptic-decode command (needs Debian's python3-venv; said and skipped
-    without it).
+    gives both commands and the metadata's schema (needs Debian's python3-venv;
+    said and skipped without it).
 """
 
 import ast
@@ -25,7 +27,10 @@ import pytest
 import plenoptic_testing as pt
 
 # Import name -> distribution name on PyPI, for every third-party module the package may import.
-DISTRIBUTIONS = {"numpy": "numpy", "scipy": "scipy", "PIL": "Pillow", "OpenImageIO": "OpenImageIO"}
+DISTRIBUTIONS = {"numpy": "numpy", "scipy": "scipy", "PIL": "Pillow", "OpenImageIO": "OpenImageIO",
+                 "jsonschema": "jsonschema"}
+# The console scripts (python/pyproject.toml).
+SCRIPTS = {"plenoptic-decode": "plenoptic_lf.cli:main", "plenoptic-dataset": "plenoptic_lf.dataset.cli:main"}
 
 
 def requirement_name(requirement):
@@ -36,12 +41,16 @@ def requirement_name(requirement):
     return name.strip()
 
 
+def package_modules(package_dir):
+    """The package's .py files (its subpackages' too), relative to package_dir."""
+    return sorted(os.path.relpath(os.path.join(d, n), package_dir) for d, _, files in os.walk(package_dir)
+                  for n in files if n.endswith(".py") and "__pycache__" not in d)
+
+
 def third_party_imports(package_dir):
     """Top-level names of the absolute imports in the package's modules that are not stdlib."""
     found = {}
-    for name in sorted(os.listdir(package_dir)):
-        if not name.endswith(".py"):
-            continue
+    for name in package_modules(package_dir):
         tree = ast.parse(open(os.path.join(package_dir, name)).read(), name)
         for node in ast.walk(tree):
             if isinstance(node, ast.Import):
@@ -72,9 +81,8 @@ def test_decoder_package(args):
                  % (project.get("name"), project.get("version"), args.version))
     licence = project.get("license")
     licence = licence.get("text") if isinstance(licence, dict) else licence
-    assert (licence == "AGPL-3.0-or-later" and project.get("requires-python") == ">=3.9"), "pyproject.toml: license %r, requires-python %r" % (licence, project.get("requires-python"))
-    want = {"plenoptic-decode": "plenoptic_lf.cli:main", "plenoptic-dataset": "plenoptic_lf.dataset.cli:main"}
-    assert project.get("scripts") == want, "pyproject.toml: scripts %r (want %r)" % (project.get("scripts"), want)
+    assert (licence == "AGPL-3.0-or-later" and project.get("requires-python") == ">=3.11"), "pyproject.toml: license %r, requires-python %r" % (licence, project.get("requires-python"))
+    assert project.get("scripts") == SCRIPTS, "pyproject.toml: scripts %r (want %r)" % (project.get("scripts"), SCRIPTS)
     assert pyproject.get("build-system", {}).get("build-backend") == "setuptools.build_meta", "pyproject.toml: build backend %r" % pyproject.get("build-system", {}).get("build-backend")
 
     imports = third_party_imports(package_dir)
@@ -85,7 +93,7 @@ def test_decoder_package(args):
                  % (declared, imported, "; imports without a known distribution: %s (in %s)"
                     % (unknown, {m: sorted(imports[m]) for m in unknown}) if unknown else ""))
 
-    files = [os.path.join(package_dir, n) for n in sorted(os.listdir(package_dir)) if n.endswith(".py")]
+    files = [os.path.join(package_dir, n) for n in package_modules(package_dir)]
     files += [os.path.join(python_dir, "pyproject.toml"), os.path.join(args.tools, "plenoptic-decode")]
     missing_header = [os.path.relpath(p, os.path.dirname(python_dir)) for p in files
                       if "SPDX-License-Identifier: AGPL-3.0-or-later" not in "".join(open(p).readlines()[:2])]
@@ -93,8 +101,8 @@ def test_decoder_package(args):
                  % (len(files), missing_header))
 
     # A fresh interpreter with only python/ added: every module, the API, the version.
-    modules = ["plenoptic_lf." + os.path.basename(p)[:-3] for p in files if p.endswith(".py")
-               and os.path.basename(p) not in ("__init__.py", "__main__.py")]
+    modules = ["plenoptic_lf." + os.path.relpath(p, package_dir)[:-3].replace(os.sep, ".") for p in files
+               if p.endswith(".py") and os.path.basename(p) not in ("__init__.py", "__main__.py")]
     probe = ("import importlib, sys; sys.path.insert(0, %r); import plenoptic_lf as p\n"
              "for m in %r: importlib.import_module(m)\n"
              "missing = [n for n in p.__all__ if not hasattr(p, n)]\n"
@@ -142,8 +150,16 @@ def test_pip_install_into_a_venv(args):
     assert (run.returncode == 0 and run.stdout == launcher.stdout
                  and where.stdout.strip().startswith(venv + os.sep)), ("the venv's plenoptic-decode --help (exit %d) prints the usage; the package loads from %s"
                  % (run.returncode, where.stdout.strip() or where.stderr.strip()[-300:]))
-    dataset = subprocess.run([os.path.join(venv, "bin", "plenoptic-dataset"), "--help"], capture_output=True, text=True,
-                             cwd=args.work)
-    assert dataset.returncode == 0 and dataset.stdout.startswith("usage: plenoptic-dataset"), (
-        "the venv's plenoptic-dataset --help (exit %d): %s" % (dataset.returncode, dataset.stderr[-300:]))
+    for tool in SCRIPTS:
+        run = subprocess.run([os.path.join(venv, "bin", tool), "--help"], capture_output=True, text=True, cwd=args.work)
+        assert run.returncode == 0 and run.stdout.startswith("usage: " + tool), (
+            "the venv's %s --help (exit %d): %s" % (tool, run.returncode, run.stderr[-300:]))
+    # The metadata's schema is installed with the package (a link to docs/ in the source tree).
+    schema = subprocess.run([os.path.join(venv, "bin", "python"), "-c", "import plenoptic_lf.metadata as m\n"
+                             "print(m.schema_path(), len(m.schema_problems({'format': 1})))"],
+                            capture_output=True, text=True, cwd=args.work)
+    assert schema.returncode == 0 and schema.stdout.startswith(venv + os.sep), (
+        "the venv's package validates against its own copy of the schema: %r %r"
+        % (schema.stdout.strip(), schema.stderr.strip()[-300:]))
+    assert not os.path.islink(schema.stdout.split()[0]) and int(schema.stdout.split()[1]) > 0, schema.stdout
 

@@ -98,12 +98,13 @@ def test_depth_map(args):
     assert meta["depth_map"] == "depth_planes.depth.exr", "metadata depth_map names the EXR beside the image: %r" % meta["depth_map"]
 
     import OpenImageIO as oiio
-    buf = oiio.ImageBuf(depth_path)
-    spec = buf.spec()
-    assert (not buf.has_error and spec.width == W and spec.height == H and tuple(spec.channelnames) == ("Z",)
-                 and spec.format == oiio.TypeDesc("float")), ("depth EXR: %d x %d, channels %s, %s (want %d x %d, ('Z',), float)"
-                 % (spec.width, spec.height, tuple(spec.channelnames), spec.format, W, H))
-    measured = np.asarray(buf.get_pixels(oiio.FLOAT))[:, :, 0].astype(np.float64)
+    from plenoptic_lf.images import ImageFile
+    with ImageFile(depth_path) as depth:
+        spec = depth.spec
+        assert (spec.width == W and spec.height == H and tuple(spec.channelnames) == ("Z",)
+                     and spec.format == oiio.TypeDesc("float")), ("depth EXR: %d x %d, channels %s, %s (want %d x %d, ('Z',), float)"
+                     % (spec.width, spec.height, tuple(spec.channelnames), spec.format, W, H))
+        measured = depth.read()[:, :, 0].astype(np.float64)
     image = pt.read_linear(png)
 
     expected, unsure, m_radius, A, D, d = expected_depth()

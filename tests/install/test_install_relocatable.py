@@ -36,6 +36,7 @@ LAYOUT = [
     "lib/python3/dist-packages/plenoptic_lf/dataset/cli.py",
     "lib/python3/dist-packages/plenoptic_lf/__init__.py",
     "lib/python3/dist-packages/plenoptic_lf/cli.py",
+    "lib/python3/dist-packages/plenoptic_lf/metadata.schema.json",
     "share/povray-plenoptic/include/colors.inc",
     "share/povray-plenoptic/ini/quickres.ini",
     "share/povray-plenoptic/scenes/demo.pov",

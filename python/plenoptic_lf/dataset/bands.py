@@ -5,7 +5,6 @@ other rows black (and the plenoptic depth maps with -1 there), so band k's rows 
 band k's files; the files that do not depend on the rows (metadata, white images, microimage
 centres) must be byte-identical across bands and are taken from the first."""
 
-import json
 import os
 
 # Files written beside the image that hold one value per pixel, merged by rows.
@@ -23,21 +22,14 @@ def band_rows(height, count):
 
 
 def _read(path):
-    import numpy as np
-    import OpenImageIO as oiio
+    from ..images import ImageFile, ImageReadError
     # Alpha as stored (a PNG's is unassociated): OpenImageIO would otherwise premultiply it on
-    # reading and divide on writing, which is lossy.
-    config = oiio.ImageSpec()
-    config.attribute("oiio:UnassociatedAlpha", 1)
-    image = oiio.ImageInput.open(path, config)
-    if image is None:
-        raise BandError("cannot read %s: %s" % (path, oiio.geterror()))
-    spec = image.spec()
-    pixels = image.read_image(spec.format)
-    image.close()
-    if pixels is None:
-        raise BandError("cannot read %s" % path)
-    return spec, np.asarray(pixels).reshape(spec.height, spec.width, spec.nchannels)
+    # reading and divide on writing, which is lossy. Values in the file's own sample type.
+    try:
+        with ImageFile(path, unassociated_alpha=True) as image:
+            return image.spec, image.read(native=True)
+    except ImageReadError as e:
+        raise BandError(str(e)) from None
 
 
 def _write(path, spec, pixels):
@@ -56,11 +48,15 @@ def _write(path, spec, pixels):
 def check_mergeable(folder, stem):
     """BandError when the render applied something across rows (diffraction convolves the whole
     picture), which a merge by rows cannot reproduce."""
+    from ..errors import DependencyError, MetadataError
+    from ..metadata import read_metadata
     path = os.path.join(folder, stem + ".plenoptic.json")
     if os.path.exists(path):
-        with open(path) as f:
-            meta = json.load(f)
-        if meta.get("diffraction") is not None:
+        try:
+            diffraction = read_metadata(path).diffraction
+        except (MetadataError, DependencyError) as e:
+            raise BandError("%s: %s" % (path, e)) from None
+        if diffraction:
             raise BandError("the camera applies diffraction, which convolves across rows: its bands cannot be "
                             "merged into the image one render gives; render this data set without bands")
 

@@ -12,12 +12,15 @@ DIR holding another spec's data set (without --replace); 130 interrupted (finish
 finished; run again to resume). `items` piped into a command that stops reading (head) ends as
 Unix tools do, by SIGPIPE, without a message."""
 
+from __future__ import annotations
+
 import argparse
 import fcntl
 import json
 import os
 import signal
 import sys
+from typing import Sequence
 
 from ..locate import find_povray
 from .runner import run_local
@@ -58,7 +61,7 @@ def _interrupt(signum, frame):
     raise KeyboardInterrupt
 
 
-def main(argv=None):
+def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(sys.argv[1:] if argv is None else argv)
     # kill, a closed terminal or Slurm's scancel stop the run as Ctrl-C does: POV-Ray (in its own
     # session) is stopped too, and no partial folder stays.

@@ -2,11 +2,9 @@
 """One POV-Ray run of a data set: an item, or one row band of it, into a folder of its own."""
 
 import os
-import resource
-import signal
 import socket
-import subprocess
-import time
+
+from ..povray import povray_command as _povray_command, run_povray
 
 
 def image_extension(spec):
@@ -28,8 +26,8 @@ def povray_command(povray, spec, item, out_path, band=None):
     """The command that renders `item` (or rows band = (first, last), 0-based, of it) to
     out_path. Defaults first (16-bit linear PNG, no display, no pause), then the spec's options,
     then the item's values: DECLARATIONS beside out_path, read before the scene (Include_Header)."""
-    cmd = [povray, "+I" + spec.scene, "+O" + out_path, "+W%d" % spec.width, "+H%d" % spec.height,
-           "-D", "-P", "+L" + os.path.dirname(spec.scene), "+FN16", "File_Gamma=1.0"]
+    cmd = _povray_command(povray, spec.scene, out_path, spec.width, spec.height,
+                          ["-D", "-P", "+L" + os.path.dirname(spec.scene), "+FN16", "File_Gamma=1.0"])
     cmd += spec.povray_options
     cmd += ["Include_Header=" + os.path.join(os.path.dirname(out_path), DECLARATIONS)]
     if band is not None:
@@ -59,27 +57,11 @@ def render(povray, spec, item, folder, band=None):
         f.write("// plenoptic-dataset: item %s's values\n" % item.id + item.declarations())
     cmd = povray_command(povray, spec, item, out, band)
     log_path = os.path.join(folder, "render.log")
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    start = time.monotonic()
     with open(log_path, "w") as log:
         log.write("$ %s\n" % " ".join(cmd))
-        log.flush()
-        process = subprocess.Popen(cmd, cwd=folder, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
-        try:
-            status = process.wait()
-        except KeyboardInterrupt:
-            try:
-                os.killpg(process.pid, signal.SIGINT)
-                process.wait(timeout=30)
-            except (ProcessLookupError, subprocess.TimeoutExpired):
-                os.killpg(process.pid, signal.SIGKILL)
-                process.wait()
-            raise
-    seconds = time.monotonic() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    with open(log_path) as f:
-        text = f.read()
+    # Ctrl-C: POV-Ray (in its own session) is sent SIGINT and waited for, then this goes on.
+    run = run_povray(cmd, cwd=folder, log=log_path)
+    seconds, cpu, text, status = run.seconds, run.cpu_seconds, run.output, run.returncode
     ok = status == 0 and os.path.exists(out)
     if status == 0 and not ok:
         text += "\nplenoptic-dataset: POV-Ray exited 0 but wrote no %s\n" % os.path.basename(out)

@@ -230,8 +230,8 @@ def run_slurm(store, spec, povray, bands, spec_path, quiet=False):
             continue
         records.append(record)
     store.write_manifest(records)
-    for failure in failures:
-        print("plenoptic-dataset: %s\n    (log: %s)" % (failure, failure.log_path), file=sys.stderr)
+    for failed in failures:
+        print("plenoptic-dataset: %s\n    (log: %s)" % (failed, failed.log_path), file=sys.stderr)
     return len(records), failures
 
 

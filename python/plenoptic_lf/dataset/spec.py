@@ -4,6 +4,8 @@ scene's #declare'd identifiers, seeded random draws, per-item options and Slurm 
 (docs/datasets.md). load_spec checks every value and says which key is wrong and what is allowed;
 Spec.items() lists the items, each with the values declared for its render."""
 
+from __future__ import annotations
+
 import hashlib
 import json
 import math
@@ -13,6 +15,9 @@ import re
 import subprocess
 import tempfile
 import tomllib
+from typing import Any, NoReturn
+
+from ..povray import run_povray
 
 IDENTIFIER = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 # The identifiers the per-item options are passed as (the scene reads them, docs/datasets.md).
@@ -44,13 +49,13 @@ class Item:
     options; so a changed spec or scene never reuses an old item's folder), declares (identifier
     -> number)."""
 
-    def __init__(self, index, declares, context):
+    def __init__(self, index: int, declares: dict[str, float], context: Any) -> None:
         self.index = index
         self.declares = declares
         text = json.dumps({"declares": declares, "context": context}, sort_keys=True)
         self.id = "%05d-%s" % (index, hashlib.sha256(text.encode()).hexdigest()[:8])
 
-    def declarations(self):
+    def declarations(self) -> str:
         """The item's values as POV-Ray #declare lines, exact (the scene's Include_Header): POV-Ray
         keeps a Declare= option's value as a 32-bit float (about 7 digits), which would round
         large seeds and indices and record values other than those rendered."""
@@ -93,11 +98,11 @@ def _is_number(value):
 
 
 class Spec:
-    def __init__(self, path, data):
+    def __init__(self, path: str, data: dict[str, Any]) -> None:
         self.path = os.path.abspath(path)
         here = os.path.dirname(self.path)
 
-        def fail(key, message):
+        def fail(key: str, message: str) -> NoReturn:
             raise SpecError("%s: %s: %s" % (path, key, message))
 
         unknown = sorted(set(data) - TOP_KEYS)
@@ -221,7 +226,7 @@ class Spec:
         if name.startswith("Dataset_"):
             fail(where, "identifiers starting with Dataset_ are plenoptic-dataset's own ([options])")
 
-    def check_reserved_words(self, povray):
+    def check_reserved_words(self, povray: str) -> None:
         """Refuses (SpecError) a swept or drawn identifier that is one of the renderer's reserved
         words (x, pi, clock, sphere, plenoptic, ...), which every item's render would refuse. Asks
         the renderer itself: it parses `#declare NAME = 0;` for each of them (no image), and
@@ -234,25 +239,26 @@ class Spec:
             with open(scene, "w") as f:
                 f.write("".join("#declare %s = 0;\n" % name for name in names))
             try:
-                run = subprocess.run([povray, "+I" + os.path.basename(scene), "+W1", "+H1", "-F", "-D", "-P"], cwd=folder,
-                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace",
-                                     timeout=120)
+                command = [povray, "+I" + os.path.basename(scene), "+W1", "+H1", "-F", "-D", "-P"]
+                run = run_povray(command, cwd=folder, timeout=120)
+                if run.timed_out:
+                    raise subprocess.TimeoutExpired(command, 120)
             except (OSError, subprocess.TimeoutExpired) as e:
                 raise SpecError("%s: cannot check the identifiers with %s: %s" % (self.path, povray, e)) from None
         if run.returncode == 0:
             return
         # POV-Ray wraps its messages at 80 columns.
-        refused = re.search(r"line (\d+): Parse Error: Expected 'undeclared identifier'", " ".join(run.stdout.split()))
+        refused = re.search(r"line (\d+): Parse Error: Expected 'undeclared identifier'", " ".join(run.output.split()))
         if refused and 1 <= int(refused.group(1)) <= len(names):
             name = names[int(refused.group(1)) - 1]
             raise SpecError("%s: %s.%s: %r is a reserved word of POV-Ray (the renderer refuses to #declare it); "
                             "choose another identifier for the scene" % (self.path, "sweep" if name in self.sweep
                                                                           else "random", name, name))
-        tail = " | ".join(line.strip() for line in run.stdout.strip().splitlines()[-3:])
+        tail = " | ".join(line.strip() for line in run.output.strip().splitlines()[-3:])
         raise SpecError("%s: cannot check the identifiers: %s exits %s on a scene that only declares them: %s"
                         % (self.path, povray, run.returncode, tail))
 
-    def item_count(self):
+    def item_count(self) -> int:
         combos = 1
         for values in self.sweep.values():
             combos *= len(values)
@@ -271,7 +277,7 @@ class Spec:
             return rng.randint(int(params[0]), int(params[1]))
         return params[rng.randrange(len(params))]
 
-    def item(self, index):
+    def item(self, index: int) -> Item:
         """Item `index` (0-based): the sweep's combination index // count (the last swept
         identifier varying fastest) and draw index % count."""
         if not 0 <= index < self.item_count():
@@ -294,13 +300,13 @@ class Spec:
         declares["Dataset_Item"] = index
         return Item(index, declares, self.context)
 
-    def items(self):
+    def items(self) -> list[Item]:
         if getattr(self, "_items", None) is None:
             self._items = [self.item(i) for i in range(self.item_count())]
         return self._items
 
 
-def load_spec(path):
+def load_spec(path: str) -> Spec:
     """The Spec in the TOML file at `path`; SpecError naming the file, the key and what is allowed."""
     try:
         with open(path, "rb") as f:

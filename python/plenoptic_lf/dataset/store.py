@@ -64,7 +64,7 @@ def replace_folder(new, final):
 
 
 class Store:
-    def __init__(self, root):
+    def __init__(self, root: str) -> None:
         self.root = os.path.abspath(root)
         self.items_dir = os.path.join(self.root, "items")
         self.failed_dir = os.path.join(self.root, "failed")

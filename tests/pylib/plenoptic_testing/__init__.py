@@ -8,6 +8,9 @@ What it holds, in sections:
   - reading images and OpenEXR files with OpenImageIO, writing a PNG to look at, idiff;
   - the render's metadata (<image>.plenoptic.json): strict JSON (UTF-8 only, no lone surrogate,
     no duplicate key, no NaN or Infinity) validated against docs/metadata.schema.json;
+Running a process, reading an image and reading the metadata go through the decoder package's
+one runner (plenoptic_lf.povray), image reader (plenoptic_lf.images) and metadata reader
+(plenoptic_lf.metadata): python/ is on sys.path (tests/conftest.py puts it there).
   - the optics of docs/specification.md written out again, independently of the code under
     test (thin lens, lattices, poses, sensor <-> pixel);
   - image measurements on scipy.ndimage: connected components, centroids, dilation, box blur;
@@ -21,16 +24,13 @@ import math
 import os
 import re
 import shutil
-import signal
 import subprocess
 import sys
-import time
 
 import numpy as np
 
 TESTS_DIR = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 SOURCE_DIR = os.path.dirname(TESTS_DIR)
-SCHEMA_PATH = os.path.join(SOURCE_DIR, "docs", "metadata.schema.json")
 DEBIAN_POVRAY = "/usr/bin/povray"
 
 
@@ -55,30 +55,21 @@ class Run:
 
 
 def run_process(cmd, cwd=None, timeout=60, env=None, separate=False, binary=False):
-    """Runs cmd in its own process group and kills the whole group at the time limit.
-    Output is decoded as UTF-8 (errors replaced) unless binary=True."""
-    start = time.monotonic()
-    proc = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE if separate else subprocess.STDOUT,
-                            stdin=subprocess.DEVNULL, start_new_session=True)
-    try:
-        out, err = proc.communicate(timeout=timeout)
-        timed_out = False
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
-        out, err = proc.communicate()
-        timed_out = True
-    seconds = time.monotonic() - start
-    dec = (lambda b: b) if binary else (lambda b: (b or b"").decode("utf-8", errors="replace"))
-    if separate:
-        return Run(proc.returncode, dec(out) + dec(err), seconds, timed_out, dec(out), dec(err))
-    return Run(proc.returncode, dec(out), seconds, timed_out)
+    """Runs cmd in its own process group and kills the whole group at the time limit, through
+    the decoder package's one POV-Ray runner (plenoptic_lf.povray.run_povray). Output is decoded
+    as UTF-8 (errors replaced) unless binary=True."""
+    from plenoptic_lf.povray import run_povray as _run
+    run = _run(cmd, cwd=cwd, timeout=timeout, env=env, separate=separate)
+    if binary:
+        return Run(run.returncode, run.output_bytes, run.seconds, run.timed_out, run.stdout_bytes, run.stderr_bytes)
+    return Run(run.returncode, run.output, run.seconds, run.timed_out, run.stdout, run.stderr)
 
 
 def run_povray(povray, scene, out, width, height, extra=(), timeout=60, cwd=None, options=("-D", "-P", "-GS", "-GR")):
     """Runs povray on the scene file `scene` writing `out` (`+I +O +W +H`, then `options`, then
     `extra`); kills the whole process group at the time limit. Returns a Run."""
-    cmd = [povray, "+I" + scene, "+O" + out, "+W%d" % width, "+H%d" % height] + list(options) + list(extra)
+    from plenoptic_lf.povray import povray_command
+    cmd = povray_command(povray, scene, out, width, height, list(options) + list(extra))
     return run_process(cmd, cwd=cwd or os.path.dirname(os.path.abspath(out)), timeout=timeout)
 
 
@@ -205,8 +196,9 @@ def render(povray, work, name, scene, width, height, ext="png", extra=(), expect
     remove_outputs(work, name, ext)
     if options is None:
         options = {"png": LINEAR16, "exr": HALF_EXR}[ext]
-    cmd = [povray, "+I" + (name + ".pov" if relative else pov), "+O" + (name + "." + ext if relative else out),
-           "+W%d" % width, "+H%d" % height] + list(options) + list(extra)
+    from plenoptic_lf.povray import povray_command
+    cmd = povray_command(povray, name + ".pov" if relative else pov, name + "." + ext if relative else out,
+                         width, height, list(options) + list(extra))
     run = run_process(cmd, cwd=work, timeout=timeout)
     if expect_failure:
         return run.returncode, run.output
@@ -279,23 +271,16 @@ def write_scene(path, camera_block):
 # ============================================================================================
 # Images
 
-def read_pixels(path):
+def read_pixels(path, native=False):
     """The pixels (H, W, channels) of any image OpenImageIO reads, as it gives them (float32;
-    PNG as 0..1). Raises RenderError when the file cannot be read."""
-    import OpenImageIO as oiio
-    # ImageInput, not ImageBuf: an ImageBuf reads through OpenImageIO's shared cache, which
-    # returns the first pixels read from a path even after the file was written again.
-    image = oiio.ImageInput.open(path)
-    if image is None:
-        raise RenderError("cannot read %s: %s" % (path, oiio.geterror()))
-    pixels = image.read_image(oiio.FLOAT)
-    problem = image.geterror() if pixels is None else ""
-    image.close()
-    if pixels is None:
-        raise RenderError("cannot read %s: %s" % (path, problem))
-    if pixels.ndim == 2:
-        pixels = pixels[:, :, None]
-    return pixels
+    PNG as 0..1; with native, in the file's own sample type), through the decoder package's one
+    image reader (OpenImageIO's ImageInput, which reads the file anew each time). Raises
+    RenderError when the file cannot be read."""
+    from plenoptic_lf.images import ImageReadError, read_image
+    try:
+        return read_image(path, native=native)
+    except ImageReadError as e:
+        raise RenderError(str(e)) from None
 
 
 def load(path):
@@ -315,10 +300,11 @@ def save_png(path, array):
     if a.ndim == 2:
         a = a[:, :, None]
     spec = oiio.ImageSpec(a.shape[1], a.shape[0], a.shape[2], oiio.UINT8)
-    buf = oiio.ImageBuf(spec)
-    buf.set_pixels(oiio.ROI(0, a.shape[1], 0, a.shape[0], 0, 1, 0, a.shape[2]),
-                   (a * 255 + 0.5).astype(np.uint8))
-    buf.write(path)
+    out = oiio.ImageOutput.create(path)
+    if out is None or not out.open(path, spec):
+        raise RenderError("cannot write %s: %s" % (path, oiio.geterror()))
+    out.write_image(np.ascontiguousarray((a * 255 + 0.5).astype(np.uint8)))
+    out.close()
 
 
 def idiff_command():
@@ -341,115 +327,42 @@ def idiff(ref, new, args=(), diff_out=None):
 # ============================================================================================
 # Metadata and JSON, strictly
 
-class MetadataError(ValueError):
-    pass
-
-
-_validator = None
-
-
-def validator():
-    """The Draft 2020-12 validator of docs/metadata.schema.json (built once)."""
-    global _validator
-    if _validator is None:
-        try:
-            import jsonschema
-        except ImportError:
-            raise MetadataError("cannot validate metadata: Python's jsonschema is missing "
-                                "(Debian package python3-jsonschema; tools/install-deps installs it)")
-        with open(SCHEMA_PATH, encoding="utf-8") as f:
-            schema = json.load(f)
-        jsonschema.Draft202012Validator.check_schema(schema)
-        _validator = jsonschema.Draft202012Validator(schema)
-    return _validator
-
-
-def _where(error):
-    parts = []
-    for p in error.absolute_path:
-        if isinstance(p, int):
-            parts.append("[%d]" % p)
-        else:
-            parts.append(("." if parts else "") + str(p))
-    return "".join(parts) or "(top level)"
-
-
-def _leaves(error):
-    if not error.context:
-        return [error]
-    return [leaf for c in error.context for leaf in _leaves(c)]
+# The decoder package's one metadata reader (python/plenoptic_lf/metadata.py) does the reading:
+# strict JSON and the schema through jsonschema. Its messages are the tools' own.
+from plenoptic_lf.errors import MetadataError  # noqa: E402
+from plenoptic_lf import metadata as _metadata  # noqa: E402
 
 
 def schema_errors(doc):
     """The schema's complaints about a document, as "field: message" strings (empty: valid)."""
-    errors = sorted(validator().iter_errors(doc), key=lambda e: list(map(str, e.absolute_path)))
-    out = []
-    for e in errors:
-        # "null, or an object such that ..." (oneOf): the deepest reason of the object branch says
-        # more than "is not valid under any of the given schemas".
-        leaves = [l for l in _leaves(e) if not (l.validator == "type" and l.validator_value == "null")] or [e]
-        deepest = max(len(l.absolute_path) for l in leaves)
-        out.extend("%s: %s" % (_where(l), l.message[:200]) for l in leaves if len(l.absolute_path) == deepest)
-    return out
+    return _metadata.schema_problems(doc)
 
 
 def validate(doc, where="metadata"):
     """Raises MetadataError when `doc` does not match docs/metadata.schema.json."""
-    problems = schema_errors(doc)
-    if problems:
-        raise MetadataError("%s does not match docs/metadata.schema.json (%d problem(s)): %s"
-                            % (where, len(problems), "; ".join(problems[:5])))
-
-
-def _refuse_constant(token):
-    raise MetadataError("non-finite number %s" % token)
-
-
-def _unique_keys(pairs):
-    doc = {}
-    for key, value in pairs:
-        if key in doc:
-            raise MetadataError("duplicate key %r" % key)
-        doc[key] = value
-    return doc
-
-
-def _check_strings(value):
-    """A lone surrogate (\\ud800) parses in Python's json but is not Unicode text."""
-    if isinstance(value, str):
-        value.encode("utf-8")  # UnicodeEncodeError for a lone surrogate
-    elif isinstance(value, dict):
-        for k, v in value.items():
-            _check_strings(k)
-            _check_strings(v)
-    elif isinstance(value, list):
-        for v in value:
-            _check_strings(v)
+    try:
+        _metadata.check_schema(doc)
+    except MetadataError as e:
+        raise MetadataError("%s %s" % (where, e)) from None
 
 
 def parse_json_strict(data, where="metadata"):
     """The document in `data` (bytes or str), read strictly (UTF-8 only, no lone surrogate, no
     duplicate key, no NaN or Infinity); MetadataError naming `where`."""
     try:
-        text = data.decode("utf-8") if isinstance(data, bytes) else data
-        doc = json.loads(text, object_pairs_hook=_unique_keys, parse_constant=_refuse_constant)
-        _check_strings(doc)
+        doc = _metadata.parse_json(data)
+        _metadata.check_finite(doc)
     except MetadataError as e:
-        raise MetadataError("%s: %s" % (where, e))
-    except UnicodeError as e:
-        raise MetadataError("%s: not UTF-8 text (%s)" % (where, e))
-    except json.JSONDecodeError as e:
-        raise MetadataError("%s: not valid JSON (%s)" % (where, e))
+        raise MetadataError("%s: %s" % (where, e)) from None
     return doc
 
 
 def load_metadata(path, check_schema=True):
     """The metadata file at `path`, read strictly and (by default) validated against the schema."""
-    with open(path, "rb") as f:
-        doc = parse_json_strict(f.read(), path)
-    if check_schema:
-        validate(doc, path)
-    return doc
+    try:
+        return _metadata.read_document(path, schema=check_schema)
+    except MetadataError as e:
+        raise MetadataError("%s: %s" % (path, e)) from None
 
 
 def metadata_of(image_path):
@@ -707,9 +620,10 @@ def render_golden(povray, name, s, out_dir, extra=()):
     os.makedirs(out_dir, exist_ok=True)
     png = os.path.join(out_dir, name + ".png")
     remove_outputs(out_dir, name)
-    cmd = [povray, "+I" + os.path.join(GOLDEN_SCENES_DIR, name + ".pov"), "+O" + png,
-           "+W%d" % s["width"], "+H%d" % s["height"], "-D", "-P", "+FN8", "-GS", "-GR",
-           "+L" + GOLDEN_SCENES_DIR] + list(s.get("options", [])) + list(extra)
+    from plenoptic_lf.povray import povray_command
+    cmd = povray_command(povray, os.path.join(GOLDEN_SCENES_DIR, name + ".pov"), png, s["width"], s["height"],
+                         ["-D", "-P", "+FN8", "-GS", "-GR", "+L" + GOLDEN_SCENES_DIR] + list(s.get("options", []))
+                         + list(extra))
     run = run_process(cmd, cwd=out_dir, timeout=600)
     if run.timed_out or run.returncode != 0 or not os.path.exists(png):
         raise RenderError("render of %s failed (exit %s%s):\n  %s\n%s"
