@@ -7,10 +7,10 @@
 #
 #   P/bin/povray-plenoptic                       the renderer (build/povray in the build tree)
 #   P/bin/plenoptic-project                      forward projection (source/tools/)
-#   P/bin/plenoptic-decode                       the decoder's launcher (source/tools/)
-#   P/bin/plenoptic-targets                      calibration targets with ground truth (source/tools/)
-#   P/bin/plenoptic-dataset                      data sets, here or on Slurm (source/tools/)
-#   P/lib/python3/dist-packages/plenoptic_lf/    the decoder (python/plenoptic_lf/)
+#   P/bin/plenoptic-decode                       the decoder's launcher (source/tools/python_tools.cmake)
+#   P/bin/plenoptic-targets                      calibration targets with ground truth (the same)
+#   P/bin/plenoptic-dataset                      data sets, here or on Slurm (the same)
+#   P/lib/python3/dist-packages/plenoptic_lf/    the Python tools' package (python/plenoptic_lf/)
 #   P/share/povray-plenoptic/include/, ini/      POV-Ray's own include and ini files
 #   P/share/povray-plenoptic/scenes/             the repository's scenes/
 #   P/share/povray-plenoptic/lenses/             the repository's lenses/ (main-lens prescriptions)

@@ -4,15 +4,20 @@ its commands in one table.
 
 Checks, without rendering anything:
   - python/pyproject.toml: name plenoptic-lf, the project's version (CMake's PROJECT_VERSION,
-    also plenoptic_lf.__version__), licence, Python >= 3.11 (tomllib), the console scripts
-    plenoptic-decode and plenoptic-dataset;
+    also plenoptic_lf.__version__), licence, Python >= 3.11 (tomllib), the table of tools
+    ([project.scripts]: plenoptic-decode, plenoptic-dataset, plenoptic-targets; the source
+    tree's bench and report2018-figures apart);
   - its dependencies are exactly the third-party modules the package imports;
   - every file starts with the SPDX header;
   - with only python/ on sys.path every module imports and the public API (__all__) is there;
     `python3 -m plenoptic_lf --help` and the in-tree launcher tools/plenoptic-decode print the
     same usage;
+  - the in-tree launchers tools/<tool> are source/tools/launcher.py.in filled in from the table
+    for /usr/bin/python3, one per tool and no other, and run under /usr/bin/python3 although the
+    python3 first on PATH lacks numpy (it used to be `#!/usr/bin/env python3`, which then failed
+    with "this Python lacks numpy");
   - `pip install --no-deps --no-build-isolation` of a copy of python/ into a throwaway venv
-    gives both commands and the metadata's schema (needs Debian's python3-venv;
+    gives every command of the table and the metadata's schema (needs Debian's python3-venv;
     said and skipped without it).
 """
 
@@ -29,8 +34,13 @@ import plenoptic_testing as pt
 # Import name -> distribution name on PyPI, for every third-party module the package may import.
 DISTRIBUTIONS = {"numpy": "numpy", "scipy": "scipy", "PIL": "Pillow", "OpenImageIO": "OpenImageIO",
                  "jsonschema": "jsonschema"}
-# The console scripts (python/pyproject.toml).
-SCRIPTS = {"plenoptic-decode": "plenoptic_lf.cli:main", "plenoptic-dataset": "plenoptic_lf.dataset.cli:main"}
+# The table of tools (python/pyproject.toml).
+SCRIPTS = {"plenoptic-decode": "plenoptic_lf.cli:main", "plenoptic-dataset": "plenoptic_lf.dataset.cli:main",
+           "plenoptic-targets": "plenoptic_lf.targets:main"}
+SOURCE_TREE_SCRIPTS = {"bench": "plenoptic_bench.cli:main", "report2018-figures": "plenoptic_report2018.figures:main"}
+# A python3 that lacks numpy (site-packages off), first on PATH.
+NO_NUMPY_PYTHON = '#!/bin/sh\n# Written by tests/ground_truth/test_decoder_package.py: a python3 without numpy.\n' \
+                  'exec /usr/bin/python3 -S "$@"\n'
 
 
 def requirement_name(requirement):
@@ -83,6 +93,8 @@ def test_decoder_package(args):
     licence = licence.get("text") if isinstance(licence, dict) else licence
     assert (licence == "AGPL-3.0-or-later" and project.get("requires-python") == ">=3.11"), "pyproject.toml: license %r, requires-python %r" % (licence, project.get("requires-python"))
     assert project.get("scripts") == SCRIPTS, "pyproject.toml: scripts %r (want %r)" % (project.get("scripts"), SCRIPTS)
+    tree_only = pyproject.get("tool", {}).get("plenoptic", {}).get("source-tree-scripts")
+    assert tree_only == SOURCE_TREE_SCRIPTS, "pyproject.toml: tool.plenoptic.source-tree-scripts %r" % (tree_only,)
     assert pyproject.get("build-system", {}).get("build-backend") == "setuptools.build_meta", "pyproject.toml: build backend %r" % pyproject.get("build-system", {}).get("build-backend")
 
     imports = third_party_imports(package_dir)
@@ -94,7 +106,8 @@ def test_decoder_package(args):
                     % (unknown, {m: sorted(imports[m]) for m in unknown}) if unknown else ""))
 
     files = [os.path.join(package_dir, n) for n in package_modules(package_dir)]
-    files += [os.path.join(python_dir, "pyproject.toml"), os.path.join(args.tools, "plenoptic-decode")]
+    files += [os.path.join(python_dir, "pyproject.toml")] + [os.path.join(args.tools, t) for t in
+                                                             list(SCRIPTS) + list(SOURCE_TREE_SCRIPTS)]
     missing_header = [os.path.relpath(p, os.path.dirname(python_dir)) for p in files
                       if "SPDX-License-Identifier: AGPL-3.0-or-later" not in "".join(open(p).readlines()[:2])]
     assert (not missing_header), ("%d files start with the SPDX header; without it: %s"
@@ -162,4 +175,50 @@ def test_pip_install_into_a_venv(args):
         "the venv's package validates against its own copy of the schema: %r %r"
         % (schema.stdout.strip(), schema.stderr.strip()[-300:]))
     assert not os.path.islink(schema.stdout.split()[0]) and int(schema.stdout.split()[1]) > 0, schema.stdout
+
+
+def test_in_tree_launchers_come_from_the_table(args):
+    """tools/<tool> is source/tools/launcher.py.in filled in from python/pyproject.toml's table
+    (write_launchers.py --source-tree --check), for every tool of it; its first line is
+    /usr/bin/python3, not /usr/bin/env python3."""
+    source = os.path.dirname(os.path.abspath(args.tools))
+    writer = os.path.join(source, "source", "tools", "write_launchers.py")
+    check = subprocess.run([sys.executable, writer, "--source-tree", "--check"], capture_output=True, text=True)
+    assert check.returncode == 0, check.stderr
+    for tool, entry in list(SCRIPTS.items()) + list(SOURCE_TREE_SCRIPTS.items()):
+        with open(os.path.join(args.tools, tool)) as f:
+            text = f.read()
+        module, function = entry.split(":")
+        assert text.startswith("#!/usr/bin/python3\n") and "from %s import %s " % (module, function) in text, (
+            "tools/%s: first line %r, runs %s" % (tool, text.splitlines()[0], entry))
+
+
+@pytest.mark.parametrize("tool", list(SCRIPTS) + list(SOURCE_TREE_SCRIPTS))
+def test_in_tree_launcher_ignores_the_python_on_path(args, tool):
+    """With a python3 that lacks numpy first on PATH, tools/<tool> --help still runs (under
+    /usr/bin/python3); the PATH's python3 does lack numpy (a control), and so does the launcher run
+    by it explicitly, which says so in one line."""
+    if not os.access("/usr/bin/python3", os.X_OK):
+        pytest.skip("no /usr/bin/python3")
+    folder = os.path.join(args.work, "no_numpy_bin")
+    os.makedirs(folder, exist_ok=True)
+    fake = os.path.join(folder, "python3")
+    with open(fake, "w") as f:
+        f.write(NO_NUMPY_PYTHON)
+    os.chmod(fake, 0o755)
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    env["PATH"] = folder + os.pathsep + os.environ.get("PATH", "/usr/bin:/bin")
+    env["PYTHONDONTWRITEBYTECODE"] = "1"
+    control = subprocess.run(["python3", "-c", "import numpy"], capture_output=True, text=True, env=env)
+    assert control.returncode != 0 and "numpy" in control.stderr, "the python3 first on PATH lacks numpy (control)"
+    launcher = os.path.join(args.tools, tool)
+    run = subprocess.run([launcher, "--help"], capture_output=True, text=True, env=env, cwd=args.work, timeout=120)
+    assert run.returncode == 0 and run.stdout.startswith("usage:"), (
+        "tools/%s --help with a python3 without numpy first on PATH: exit %d, %r"
+        % (tool, run.returncode, (run.stdout[:80] + run.stderr[-400:])))
+    by_fake = subprocess.run(["python3", launcher, "--help"], capture_output=True, text=True, env=env, cwd=args.work)
+    lines = [l for l in by_fake.stderr.splitlines() if l.strip()]
+    assert (by_fake.returncode == 1 and len(lines) == 1 and lines[0].startswith(tool + ": error: this Python")
+            and "lacks numpy" in lines[0] and "python3-numpy" in lines[0]), (
+        "python3 tools/%s under a python3 without numpy: exit %d, %r" % (tool, by_fake.returncode, by_fake.stderr[-400:]))
 

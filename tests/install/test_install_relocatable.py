@@ -5,7 +5,8 @@
    there, no installed path is one of Debian's povray or povray-includes packages (when dpkg
    knows them), and the installed povray.ini/povray.conf name neither the build nor the prefix.
 2. The prefix is moved to WORK/moved/elsewhere; everything below runs from WORK/run (another
-   directory) with HOME=WORK/home, no POVINI/POVINC, and the installed binaries only.
+   directory) with HOME=WORK/home, no POVINI/POVINC, and the installed binaries only; the
+   python3 first on PATH lacks numpy (the Python tools run under the Python the build found).
 3. The installed scenes/demo.pov (it includes colors.inc) renders, pixel for pixel, as
    build/povray renders the source tree's scenes/demo.pov; so does a stock-camera scene that
    includes colors.inc and textures.inc.
@@ -140,7 +141,12 @@ def test_install_relocatable(args):
     env = {k: v for k, v in os.environ.items() if k not in ("POVINI", "POVINC", "PLENOPTIC_PROJECT",
                                                             "PYTHONPATH")}
     env["HOME"] = home
-    env["PATH"] = "/usr/bin:/bin"
+    no_numpy = os.path.join(work, "bin-no-numpy")  # a python3 without numpy, first on PATH
+    os.makedirs(no_numpy)
+    with open(os.path.join(no_numpy, "python3"), "w") as f:
+        f.write('#!/bin/sh\nexec /usr/bin/python3 -S "$@"\n')
+    os.chmod(os.path.join(no_numpy, "python3"), 0o755)
+    env["PATH"] = no_numpy + ":/usr/bin:/bin"
     env["PYTHONDONTWRITEBYTECODE"] = "1"
     pov = os.path.join(moved, "bin", "povray-plenoptic")
     data = os.path.join(moved, "share", "povray-plenoptic")
