@@ -358,8 +358,8 @@ void model_is_sane(const Model& m)
 
 void check_ray(const Model& m, const OpticsRay& r, const char* what, int i, int j)
 {
-    const Vec3 o{r.origin_mm[0], r.origin_mm[1], r.origin_mm[2]};
-    const Vec3 d{r.dir[0], r.dir[1], r.dir[2]};
+    const Vec3 o{r.origin_mm.x, r.origin_mm.y, r.origin_mm.z};
+    const Vec3 d{r.dir.x, r.dir.y, r.dir.z};
     FUZZ_ASSERT(is_finite(o) && is_finite(d), "%s of pixel (%d, %d): origin (%g, %g, %g) dir (%g, %g, %g)", what, i, j,
                 o.x, o.y, o.z, d.x, d.y, d.z);
     FUZZ_ASSERT(std::fabs(length(d) - 1) <= 1e-12, "%s of pixel (%d, %d): |dir| = %.17g", what, i, j, length(d));
@@ -371,7 +371,7 @@ void check_ray(const Model& m, const OpticsRay& r, const char* what, int i, int 
 
 void check_origin(const Model& m, const OpticsRay& r, int i, int j)
 {
-    const Vec3 o{r.origin_mm[0], r.origin_mm[1], r.origin_mm[2]};
+    const Vec3 o{r.origin_mm.x, r.origin_mm.y, r.origin_mm.z};
     if (lens_kind(m) == "pinhole") {
         FUZZ_ASSERT(o.x == 0 && o.y == 0 && o.z == 0, "pixel (%d, %d): origin (%g, %g, %g) is not the pinhole", i, j,
                     o.x, o.y, o.z);
@@ -488,7 +488,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         const int count = std::max(in.samples, std::min(m.samples_max, 8));
         for (int n = 0; n < in.samples; ++n) {
             OpticsRay r;
-            if (generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, count), nullptr, &r)) {
+            if ((r = generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, count), nullptr)).passed) {
                 check_ray(m, r, "generate_ray", i, j);
                 check_origin(m, r, i, j);
             }
@@ -499,14 +499,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         FUZZ_ASSERT(lens_count >= 0 && lens_count <= kMaxOverlapLenses, "overlap_lenses gave %d", lens_count);
         for (int l = 0; l < lens_count && l < 4; ++l) {
             OpticsRay r;
-            if (generate_ray(with_film(m, W, H), i, j, make_sample(i, j, l, 4), &lenses[l], &r)) {
+            if ((r = generate_ray(with_film(m, W, H), i, j, make_sample(i, j, l, 4), &lenses[l])).passed) {
                 check_ray(m, r, "generate_ray through an overlap lens", i, j);
                 check_origin(m, r, i, j);
             }
         }
         if (m.samples_max <= 16) {
             const Rgbt v = shade_pixel(with_film(m, W, H), i, j, [](const OpticsRay& r) {
-                return Rgbt{r.dir[0], r.dir[1], r.dir[2], 0.5};
+                return Rgbt{r.dir.x, r.dir.y, r.dir.z, 0.5};
             });
             FUZZ_ASSERT(std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b) && std::isfinite(v.t),
                         "shade_pixel (%d, %d) = (%g, %g, %g, %g)", i, j, v.r, v.g, v.b, v.t);

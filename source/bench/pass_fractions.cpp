@@ -156,9 +156,9 @@ void count_pixel(const Model& m, int i, int j, int samples, double rear_radius_m
 {
     for (int n = 0; n < samples; ++n) {
         const CameraSample s = make_sample(i, j, n, samples);
-        OpticsRay ray;
         ++c->generated;
-        if (generate_ray(m, i, j, s, nullptr, &ray))
+        const OpticsRay ray = generate_ray(m, i, j, s);
+        if (ray.passed)
             ++c->passed;
         if (m.grid == GridType::None && rear_radius_mm > 0) {
             const Vec3 p = sensor_point(m, i + s.pixel_u, j + s.pixel_v);

@@ -73,7 +73,7 @@ std::vector<OpticsRay> rays_of_point(const Model& m, int i, int j, int count)
         CameraSample s = make_sample(i, j, n, count);
         s.pixel_u = s.pixel_v = 0.5;
         OpticsRay ray;
-        if (generate_ray(with_film(m, W, H), i, j, s, nullptr, &ray))
+        if ((ray = generate_ray(with_film(m, W, H), i, j, s, nullptr)).passed)
             rays.push_back(ray);
     }
     return rays;
@@ -285,14 +285,14 @@ TEST(OpticsExtremes, PinholeMainLensRaysAllLeaveThroughThePinhole)
                     for (int i = 0; i < W; i += 3) {
                         for (int n = 0; n < 8; ++n) {
                             OpticsRay r;
-                            if (!generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, 8), nullptr, &r))
+                            if (!(r = generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, 8), nullptr)).passed)
                                 continue;
                             ++unblocked;
-                            if (!(r.origin_mm[0] == 0 && r.origin_mm[1] == 0 && r.origin_mm[2] == 0))
+                            if (!(r.origin_mm.x == 0 && r.origin_mm.y == 0 && r.origin_mm.z == 0))
                                 ++off_pinhole;
                             if (!is_finite(dir_of(r)) || std::fabs(length(dir_of(r)) - 1) > 1e-12)
                                 ++not_unit;
-                            if (!(r.dir[2] > 0)) {
+                            if (!(r.dir.z > 0)) {
                                 if (backwards++ == 0)
                                     example = r;
                             }
@@ -328,7 +328,7 @@ void check_invariants(const CameraParams& params, int W, int H, int* models, lon
         const int i = px[0], j = px[1];
         for (int n = 0; n < 6; ++n) {
             OpticsRay r;
-            if (!generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, 6), nullptr, &r))
+            if (!(r = generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, 6), nullptr)).passed)
                 continue;
             ++*rays;
             const Vec3 o = origin_of(r), d = dir_of(r);

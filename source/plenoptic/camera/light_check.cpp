@@ -37,8 +37,8 @@ double lit_fraction_near_axis(const Model& camera)
     for (int j = j0; j < j0 + patch; ++j)
         for (int i = i0; i < i0 + patch; ++i)
             for (int n = 0; n < kSamplesPerPixel; ++n, ++total) {
-                OpticsRay ray;
-                if (generate_ray(model, i, j, make_sample(i, j, n, kSamplesPerPixel), nullptr, &ray))
+                const OpticsRay ray = generate_ray(model, i, j, make_sample(i, j, n, kSamplesPerPixel));
+                if (ray.passed)
                     ++passing;
             }
     return total > 0 ? double(passing) / total : 0;

@@ -100,8 +100,8 @@ inline int passing_samples(const Model& model, int i, int j, int from, int to, i
     int passing = 0;
     *first = -1;
     for (int n = from; n < to; ++n) {
-        OpticsRay ray;
-        if (generate_ray(model, i, j, make_sample(i, j, n, to), nullptr, &ray)) {
+        const OpticsRay ray = generate_ray(model, i, j, make_sample(i, j, n, to));
+        if (ray.passed) {
             ++passing;
             if (*first < 0)
                 *first = n;
@@ -123,8 +123,7 @@ Rgbt vignetted_value(const Model& model, int i, int j, int n, int passed, double
     // Samples 0 .. n-1 were generated already: only the points after them are new.
     const int passing = passed + passing_samples(model, i, j, n, probes, &first_untraced);
     if (passed == 0 && first_untraced >= 0) {
-        OpticsRay ray;
-        generate_ray(model, i, j, make_sample(i, j, first_untraced, probes), nullptr, &ray);
+        const OpticsRay ray = generate_ray(model, i, j, make_sample(i, j, first_untraced, probes));
         const Rgbt c = detail::traced(trace, ray);
         sum[0] = c.r;
         sum[1] = c.g;
@@ -172,8 +171,8 @@ Rgbt lit_area_value(const Model& model, int i, int j, int n, int passed, const d
     }
     const int points = n * kVignettingProbesPerSample;
     for (int k = n; k < points; ++k) {
-        OpticsRay ray;
-        if (generate_ray(model, i, j, make_sample(i, j, k, points), nullptr, &ray)) {
+        const OpticsRay ray = generate_ray(model, i, j, make_sample(i, j, k, points));
+        if (ray.passed) {
             const Rgbt c = trace(ray);
             return Rgbt{c.r * lit, c.g * lit, c.b * lit, c.t * lit};
         }
@@ -209,8 +208,8 @@ Rgbt shade_pixel(const Model& model, int i, int j, TraceFn trace)
         double sum[4] = {0, 0, 0, 0};
         int passed = 0;
         for (int n = 0; n < count; ++n) {
-            OpticsRay ray;
-            if (generate_ray(model, i, j, make_sample(i, j, n, count), nullptr, &ray)) {
+            const OpticsRay ray = generate_ray(model, i, j, make_sample(i, j, n, count));
+            if (ray.passed) {
                 // With a lit-area table the colours are summed without the ray weight: the
                 // pixel's lit area scales their mean (detail::lit_area_value).
                 const Rgbt c = lit_area ? trace(ray) : detail::traced(trace, ray);
@@ -249,9 +248,9 @@ Rgbt shade_pixel(const Model& model, int i, int j, TraceFn trace)
         for (; n < stop; ++n) {
             int slot = 0;
             const CameraSample sample = detail::lens_sample(i, j, n, count, lens_count, &slot);
-            OpticsRay ray;
+            const OpticsRay ray = generate_ray(model, i, j, sample, model.model_overlap ? &lenses[slot] : nullptr);
             Rgbt colour{0, 0, 0, 0};
-            if (generate_ray(model, i, j, sample, model.model_overlap ? &lenses[slot] : nullptr, &ray)) {
+            if (ray.passed) {
                 const Rgbt raw = trace(ray);
                 colour = Rgbt{raw.r * ray.weight, raw.g * ray.weight, raw.b * ray.weight, raw.t * ray.weight};
                 plain[0] += raw.r;

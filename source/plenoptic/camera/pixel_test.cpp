@@ -17,8 +17,8 @@ using test::plenoptic_camera;
 // A scene whose radiance depends on the ray: enough structure to tell samples apart.
 Rgbt textured(const OpticsRay& ray)
 {
-    const double a = std::sin(40 * ray.dir[0]) * std::cos(30 * ray.dir[1]);
-    return Rgbt{0.5 + 0.5 * a, 0.25 + 0.1 * ray.origin_mm[0], 0.5 - 0.5 * a, 0.0};
+    const double a = std::sin(40 * ray.dir.x) * std::cos(30 * ray.dir.y);
+    return Rgbt{0.5 + 0.5 * a, 0.25 + 0.1 * ray.origin_mm.x, 0.5 - 0.5 * a, 0.0};
 }
 
 // Plenoptic 1.0 with f-number-matched hexagonal microlenses (f/4), 20 um pixels: tools/bench's
@@ -91,7 +91,7 @@ TEST(Pixel, AdaptiveSamplingStopsEarlyOnFlatScenesAndGoesOnOnNoisyOnes)
     calls = 0;
     auto noisy = [&](const OpticsRay& ray) {
         ++calls;
-        return Rgbt{ray.origin_mm[0] > 0 ? 1.0 : 0.0, 0, 0, 0};
+        return Rgbt{ray.origin_mm.x > 0 ? 1.0 : 0.0, 0, 0, 0};
     };
     shade_pixel(with_film(m, 64, 64), 10, 10, noisy);
     EXPECT_GT(calls, 8);
@@ -118,7 +118,7 @@ TEST(Pixel, AdaptiveSamplingDoesNotTakeAnUnluckyBlockedStartForADarkPixel)
             bool first_lit = false;
             for (int n = 0; n < minimum && !first_lit; ++n) {
                 OpticsRay ray;
-                first_lit = generate_ray(with_film(m_adaptive, W, H), i, j, make_sample(i, j, n, maximum), nullptr, &ray);
+                first_lit = (ray = generate_ray(with_film(m_adaptive, W, H), i, j, make_sample(i, j, n, maximum), nullptr)).passed;
             }
             const bool lit = shade_pixel(with_film(m_fixed, W, H), i, j, white).r > 0;
             const Rgbt value = shade_pixel(with_film(m_adaptive, W, H), i, j, white);
@@ -278,7 +278,7 @@ TEST(Pixel, OverlapPixelsAreUnbiasedEstimatesOfEachLensIntegral)
     const int W = 30, H = 30;
     const double A = F / 2.5;
     auto scene = [A](const OpticsRay& ray) {
-        return Rgbt{ray.origin_mm[0] / A + 0.5, ray.origin_mm[1] / A + 0.5, 10 * ray.dir[0] + 0.5, 0.0};
+        return Rgbt{ray.origin_mm.x / A + 0.5, ray.origin_mm.y / A + 0.5, 10 * ray.dir.x + 0.5, 0.0};
     };
     const int grid = 12;
     int compared = 0;
@@ -298,7 +298,7 @@ TEST(Pixel, OverlapPixelsAreUnbiasedEstimatesOfEachLensIntegral)
                                 const CameraSample sample{(a + 0.5) / grid, (b + 0.5) / grid, (c + 0.5) / grid,
                                                           (e + 0.5) / grid};
                                 OpticsRay ray;
-                                if (!generate_ray(with_film(m, W, H), i, j, sample, &lenses[s], &ray))
+                                if (!(ray = generate_ray(with_film(m, W, H), i, j, sample, &lenses[s])).passed)
                                     continue;
                                 const Rgbt v = scene(ray);
                                 sum[0] += v.r;

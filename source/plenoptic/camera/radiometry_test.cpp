@@ -177,7 +177,7 @@ TEST(Radiometry, AnIdealArrayPassesTheEtendueOfItsCellThroughTheMainPupil)
             double sum = 0;
             for (int n = 0; n < count; ++n) {
                 OpticsRay ray;
-                if (generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, count), &centre, &ray))
+                if ((ray = generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, count), &centre)).passed)
                     sum += ray.weight;
             }
             rendered += sum / count * 0.01 * 0.01;

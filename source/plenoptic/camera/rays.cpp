@@ -51,12 +51,8 @@ bool emit(const SceneRay& ray, OpticsRay* out)
 {
     if (!ray.passed)
         return false;
-    out->origin_mm[0] = ray.origin.x;
-    out->origin_mm[1] = ray.origin.y;
-    out->origin_mm[2] = ray.origin.z;
-    out->dir[0] = ray.dir.x;
-    out->dir[1] = ray.dir.y;
-    out->dir[2] = ray.dir.z;
+    out->origin_mm = ray.origin;
+    out->dir = ray.dir;
     out->weight = 1;
     return true;
 }
@@ -255,11 +251,12 @@ bool own_lens(const Model& m, Vec3 p, LensIndex* lens)
     return true;
 }
 
-bool generate_ray(const Model& m, int i, int j, const CameraSample& sample, const LensIndex* lens,
-                  OpticsRay* out)
+OpticsRay generate_ray(const Model& m, int i, int j, const CameraSample& sample, const LensIndex* lens)
 {
     const Vec3 p = sensor_point(m, i + sample.pixel_u, j + sample.pixel_v);
-    return trace_sensor_point(m, p, lens, sample.lens_u, sample.lens_v, true, out);
+    OpticsRay ray;
+    ray.passed = trace_sensor_point(m, p, lens, sample.lens_u, sample.lens_v, true, &ray);
+    return ray;
 }
 
 int overlap_lenses(const Model& m, int i, int j, LensIndex* out, int capacity)
@@ -294,20 +291,21 @@ int overlap_lenses(const Model& m, int i, int j, LensIndex* out, int capacity)
     return count;
 }
 
-bool chief_ray_through(const Model& m, double pu, double pv, const LensIndex* lens, OpticsRay* out)
+OpticsRay chief_ray_through(const Model& m, double pu, double pv, const LensIndex* lens)
 {
-    return trace_sensor_point(m, sensor_point(m, pu, pv), lens, 0.5, 0.5, false, out);
+    OpticsRay ray;
+    ray.passed = trace_sensor_point(m, sensor_point(m, pu, pv), lens, 0.5, 0.5, false, &ray);
+    return ray;
 }
 
 OpticsRay chief_ray(const Model& m, int i, int j)
 {
-    OpticsRay ray;
-    if (chief_ray_through(m, i + 0.5, j + 0.5, nullptr, &ray))
+    OpticsRay ray = chief_ray_through(m, i + 0.5, j + 0.5);
+    if (ray.passed)
         return ray;
     const Vec3 p = sensor_point(m, i + 0.5, j + 0.5);
     const Vec3 e = m.lens ? m.lens->exit_pupil_centre() : Vec3{0, 0, 0};
-    if (!finish(e, e - p, &ray))
-        finish(e, Vec3{0, 0, 1}, &ray);
+    ray.passed = finish(e, e - p, &ray) || finish(e, Vec3{0, 0, 1}, &ray);
     return ray;
 }
 

@@ -14,8 +14,8 @@ namespace plenoptic {
 // A ray leaving the last optical element (the main-lens plane z = 0; the array when there is
 // no main lens), in the optics frame, millimetres. The caller converts to scene units.
 struct OpticsRay {
-    double origin_mm[3];
-    double dir[3];  // unit length, towards the scene (+z component)
+    Vec3 origin_mm;
+    Vec3 dir;  // unit length, towards the scene (+z component)
     // What the ray's colour counts for in its pixel: 1, except for a real lens without an array,
     // whose samples cover a region of its exit pupil's plane (PupilBounds) rather than the paraxial
     // pupil: the region's area over the paraxial pupil's, so that a pixel's value does not depend
@@ -23,6 +23,9 @@ struct OpticsRay {
     // the region's lit part over the paraxial pupil's, and the pixel averages its passing
     // samples only (shade_pixel).
     double weight;
+    // false: an aperture blocks the ray (it then carries no light), or the geometry has no such
+    // ray; the other fields are then meaningless.
+    bool passed;
 };
 
 // Point on the sensor (optics frame, mm) at continuous pixel coordinates (pu, pv), where pixel
@@ -46,11 +49,10 @@ Vec3 lens_centre_mm(const Model& model, LensIndex lens);
 bool own_lens(const Model& model, Vec3 sensor_point_mm, LensIndex* lens);
 
 // The ray of one sample of pixel (i, j). `lens` forces the microlens the light passes through
-// (overlap modelling); nullptr uses the own lens of the sample's sensor point. Returns false when
+// (overlap modelling); nullptr uses the own lens of the sample's sensor point. Not passed when
 // an aperture blocks the ray (it then carries no light: black, opaque). No allocation, no
 // search over lenses, no trigonometry except the concentric disc map of a bare main lens.
-bool generate_ray(const Model& model, int i, int j, const CameraSample& sample,
-                  const LensIndex* lens, OpticsRay* out);
+OpticsRay generate_ray(const Model& model, int i, int j, const CameraSample& sample, const LensIndex* lens = nullptr);
 
 // The lenses whose light can reach pixel (i, j) when the model models overlap: the pixel
 // centre's own lens first, then every neighbour within model.overlap_rings rings that passes a
@@ -67,9 +69,8 @@ int overlap_lenses(const Model& model, int i, int j, LensIndex* out, int capacit
 OpticsRay chief_ray(const Model& model, int i, int j);
 
 // The same at continuous pixel coordinates (sensor_point's convention), optionally through a
-// given lens. False when the geometry has no such ray.
-bool chief_ray_through(const Model& model, double pu, double pv, const LensIndex* lens,
-                       OpticsRay* out);
+// given lens. Not passed when the geometry has no such ray.
+OpticsRay chief_ray_through(const Model& model, double pu, double pv, const LensIndex* lens = nullptr);
 
 } // namespace plenoptic
 

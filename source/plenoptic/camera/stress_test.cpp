@@ -96,14 +96,14 @@ TEST(Stress, ExtremeParametersGiveFiniteUnitDirections)
             for (int i = 0; i < W; ++i) {
                 for (int n = 0; n < 4; ++n) {
                     OpticsRay ray;
-                    if (generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, 4), nullptr, &ray)) {
+                    if ((ray = generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, 4), nullptr)).passed) {
                         ++unblocked;
                         expect_unit_and_finite(ray, c.name + " generate_ray");
                     }
                 }
                 expect_unit_and_finite(chief_ray(with_film(m, W, H), i, j), c.name + " chief_ray");
                 const Rgbt value = shade_pixel(with_film(m, W, H), i, j, [](const OpticsRay& r) {
-                    return Rgbt{r.dir[0], r.dir[1], r.dir[2], 0};
+                    return Rgbt{r.dir.x, r.dir.y, r.dir.z, 0};
                 });
                 ASSERT_TRUE(std::isfinite(value.r) && std::isfinite(value.g) && std::isfinite(value.b) &&
                             std::isfinite(value.t))
@@ -133,7 +133,7 @@ TEST(Stress, HugeCoordinatesDoNotOverflowTheLattice)
     const Model m = make_model(p);
     for (int n = 0; n < 16; ++n) {
         OpticsRay ray;
-        if (generate_ray(with_film(m, 8, 8), 0, 0, make_sample(0, 0, n, 16), nullptr, &ray))
+        if ((ray = generate_ray(with_film(m, 8, 8), 0, 0, make_sample(0, 0, n, 16), nullptr)).passed)
             expect_unit_and_finite(ray, "tiny pitch");
     }
     const double point[3] = {1, 2, 1000};

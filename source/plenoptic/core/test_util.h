@@ -42,8 +42,8 @@ inline Prescription vignetting_triplet()
 // The kind of a model's main lens, as the metadata names it ("none" without one).
 inline std::string lens_kind(const Model& m) { return m.lens ? m.lens->kind_name() : "none"; }
 
-inline Vec3 origin_of(const OpticsRay& r) { return Vec3{r.origin_mm[0], r.origin_mm[1], r.origin_mm[2]}; }
-inline Vec3 dir_of(const OpticsRay& r) { return Vec3{r.dir[0], r.dir[1], r.dir[2]}; }
+inline Vec3 origin_of(const OpticsRay& r) { return Vec3{r.origin_mm.x, r.origin_mm.y, r.origin_mm.z}; }
+inline Vec3 dir_of(const OpticsRay& r) { return Vec3{r.dir.x, r.dir.y, r.dir.z}; }
 
 // A thin main lens with no array.
 inline CameraParams thin_lens_camera(double focal_mm, double f_number, double distance_mm)

@@ -86,7 +86,7 @@ void check_forward_then_chief(const char* name, CameraParams params, int min_mul
             EXPECT_GE(hit.u, -0.5);
             EXPECT_LT(hit.u, W - 0.5);
             OpticsRay ray;
-            ASSERT_TRUE(chief_ray_through(with_film(m, W, H), hit.u + 0.5, hit.v + 0.5, &hit.lens, &ray)) << name;
+            ASSERT_TRUE((ray = chief_ray_through(with_film(m, W, H), hit.u + 0.5, hit.v + 0.5, &hit.lens)).passed) << name;
             const Vec3 x{point[0], point[1], point[2]};
             const double miss = test::distance_to_line(x, origin_of(ray), dir_of(ray));
             // A thin microlens that the point's cone of light covers only in part images it at

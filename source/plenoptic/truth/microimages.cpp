@@ -46,8 +46,8 @@ public:
     bool lit(double u, double v) const
     {
         const CameraSample sample{u, v, lens_u_, lens_v_};
-        OpticsRay ray;
-        if (!generate_ray(m_, 0, 0, sample, &lens_, &ray))
+        const OpticsRay ray = generate_ray(m_, 0, 0, sample, &lens_);
+        if (!ray.passed)
             return false;
         if (m_.model_overlap)
             return true;

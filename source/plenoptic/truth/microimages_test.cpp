@@ -118,7 +118,7 @@ TEST(MicroimageTruth, CatsEyesAgreeWithABruteForceCount)
             for (int i = 0; i < n; ++i) {
                 const double u = u0 - half + (i + 0.5) * step, v = v0 - half + (j + 0.5) * step;
                 OpticsRay ray;
-                if (!generate_ray(with_film(m, W, H), 0, 0, CameraSample{u + 0.5, v + 0.5, 0.5, 0.5}, &want, &ray))
+                if (!(ray = generate_ray(with_film(m, W, H), 0, 0, CameraSample{u + 0.5, v + 0.5, 0.5, 0.5}, &want)).passed)
                     continue;
                 count += 1;
                 su += u;

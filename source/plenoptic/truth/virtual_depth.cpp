@@ -42,8 +42,8 @@ float pixel_virtual_depth(const Model& m, int i, int j, float distance_units)
     if (!(distance_units >= 0))
         return std::numeric_limits<float>::quiet_NaN();
     const OpticsRay ray = chief_ray(m, i, j);
-    const Vec3 origin{ray.origin_mm[0], ray.origin_mm[1], ray.origin_mm[2]};
-    const Vec3 dir{ray.dir[0], ray.dir[1], ray.dir[2]};
+    const Vec3 origin{ray.origin_mm.x, ray.origin_mm.y, ray.origin_mm.z};
+    const Vec3 dir{ray.dir.x, ray.dir.y, ray.dir.z};
     // At infinity: a point as far as a length can be (1e12 mm) images within 1e-10 of the
     // focal plane, below a float's resolution of v.
     const double along = std::isinf(distance_units) ? kMaxLengthMm : double(distance_units) * m.mm_per_unit;

@@ -88,7 +88,7 @@ TEST(VirtualDepth, PixelsOfAFrontoParallelPlane)
         for (int j = 0; j < H; j += 7)
             for (int i = 0; i < W; i += 5) {
                 const OpticsRay ray = chief_ray(with_film(m, W, H), i, j);
-                const float distance = float((z - ray.origin_mm[2]) / ray.dir[2] / m.mm_per_unit);
+                const float distance = float((z - ray.origin_mm.z) / ray.dir.z / m.mm_per_unit);
                 EXPECT_NEAR(pixel_virtual_depth(with_film(m, W, H), i, j, distance), thin_lens_v(z, d),
                             2e-5 * std::fabs(thin_lens_v(z, d)) + 1e-5) << z << " " << i << " " << j;
             }
