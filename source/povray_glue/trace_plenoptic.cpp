@@ -28,9 +28,9 @@ void To_Scene(const plenoptic::Render& render, const plenoptic::OpticsRay& in, R
 	const double units_per_mm = 1.0 / render.model().mm_per_unit;
 	for (int i = 0; i < 3; i++)
 	{
-		out.Origin[i] = frame.location[i] + (in.origin_mm[0] * frame.right[i] + in.origin_mm[1] * frame.up[i] +
-		                                     in.origin_mm[2] * frame.direction[i]) * units_per_mm;
-		out.Direction[i] = in.dir[0] * frame.right[i] + in.dir[1] * frame.up[i] + in.dir[2] * frame.direction[i];
+		out.Origin[i] = frame.location[i] + (in.origin_mm.x * frame.right[i] + in.origin_mm.y * frame.up[i] +
+		                                     in.origin_mm.z * frame.direction[i]) * units_per_mm;
+		out.Direction[i] = in.dir.x * frame.right[i] + in.dir.y * frame.up[i] + in.dir.z * frame.direction[i];
 	}
 	if (!render.frame_orthonormal())
 		VNormalizeEq(out.Direction);
