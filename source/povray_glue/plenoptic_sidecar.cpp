@@ -336,7 +336,7 @@ bool sidecar_write(const std::string& image_path, const pov_base::Image& image, 
             const double f_number = own ? model.f_number : white.f_numbers[size_t(k)];
             std::unique_ptr<Model> other;
             if (!own)
-                other.reset(new Model(with_film(make_model(at_f_number(params, f_number)), W, H)));
+                other.reset(new Model(with_f_number(model, f_number)));
             const Model& optics = own ? model : *other;
             const std::vector<float> values = white_image(optics, render_cancel_requested);
             if (values.empty())

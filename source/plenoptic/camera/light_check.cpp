@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "plenoptic/optics.h"
+#include "plenoptic/camera/rays.h"
 #include "plenoptic/camera/params.h"
 #include "plenoptic/core/sampling.h"
 

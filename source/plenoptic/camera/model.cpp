@@ -93,9 +93,15 @@ Model with_film(Model model, int width, int height)
     return model;
 }
 
+Model with_f_number(const Model& camera, double f_number)
+{
+    return with_film(make_model(at_f_number(camera.spec, f_number)), camera.film.width, camera.film.height);
+}
+
 Model make_model(const CameraParams& params)
 {
     Model m = Model();
+    m.spec = params;
     m.mm_per_unit = params.mm_per_unit;
     m.radiometry = params.radiometry;
     m.irradiance_k_mm2 = 0;  // set once the geometry is known, below

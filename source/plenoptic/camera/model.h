@@ -44,6 +44,7 @@ struct Film {
 // Optics frame: origin at the main-lens centre (a real lens's rear vertex; the array centre when
 // there is no main lens), +z towards the scene, +x right, +y up; millimetres throughout.
 struct Model {
+    CameraParams spec;           // the checked parameters the camera was made from
     double mm_per_unit;
     // What a pixel measures (camera/radiometry.h); under Irradiance each passing sample's colour
     // is weighted by irradiance_weight with K = irradiance_k_mm2 (0 under Flat).
@@ -110,6 +111,10 @@ Model make_model(const CameraParams& params);
 
 // The same camera taking a picture of width x height pixels.
 Model with_film(Model model, int width, int height);
+// The same camera, film included, with its main lens's aperture set for f-number N (a thin lens's
+// A = F / N; a real lens's stop sized for it): what a white image at N is taken with. N must be
+// one the lens can take (check_white_image_f_numbers).
+Model with_f_number(const Model& camera, double f_number);
 
 // Legal but implausible parameters, one sentence each (empty when nothing is odd).
 std::vector<std::string> warnings(const Model& model);

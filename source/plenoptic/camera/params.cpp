@@ -11,21 +11,6 @@
 
 namespace plenoptic {
 
-std::string format_number(double value)
-{
-    if (std::isnan(value))
-        return "nan";
-    if (std::isinf(value))
-        return value > 0 ? "inf" : "-inf";
-    char buffer[40];
-    // The shortest of %.15g .. %.17g that reads back exactly: "0.1", not "0.10000000000000001".
-    for (int precision = 15; precision <= 17; ++precision) {
-        std::snprintf(buffer, sizeof buffer, "%.*g", precision, value);
-        if (std::strtod(buffer, nullptr) == value)
-            break;
-    }
-    return buffer;
-}
 
 namespace {
 
@@ -302,34 +287,17 @@ std::string check_aperture_reach(const MainLensParams& main, double mm_per_unit)
     return message;
 }
 
-Prescription effective_prescription(const MainLensParams& main)
+CameraParams at_f_number(const CameraParams& params, double f_number)
 {
-    Prescription lens = main.prescription;
-    lens.blades = main.blades;
-    lens.blade_rotation_deg = main.blade_rotation_deg;
-    double stop_mm = 0;
-    if (main.has_aperture)
-        stop_mm = main.aperture_mm;
-    else if (main.has_f_number)
-        stop_mm = stop_diameter_for_f_number(main.prescription, main.f_number);
-    if (stop_mm > 0)
-        for (LensSurface& surface : lens.surfaces)
-            if (surface.stop)
-                surface.aperture_mm = stop_mm;
-    return lens;
+    CameraParams p = params;
+    p.main.has_f_number = true;
+    p.main.f_number = f_number;
+    p.main.has_aperture = false;
+    p.main.aperture_mm = 0;
+    return p;
 }
 
-double main_lens_distance_mm(const MainLensParams& main, double mm_per_unit)
-{
-    if (!main.has_focus_distance)
-        return main.distance_mm;
-    const double z_mm = main.focus_distance_units * mm_per_unit;
-    if (is_prescription_type(main.type))
-        return paraxial_image_distance(main.prescription, z_mm).mm;
-    // 1/F = 1/z + 1/D, written so that a huge z gives D -> F without overflow.
-    const double f = main.focal_length_mm;
-    return f / (1.0 - f / z_mm);
-}
+
 
 std::string check_main_lens(const MainLensParams& main, double mm_per_unit)
 {

@@ -6,16 +6,13 @@
 
 #include <string>
 
-#include "plenoptic/lens/distortion.h"
-#include "plenoptic/lens/prescription.h"
+#include "plenoptic/core/format.h"
+#include "plenoptic/core/lattice.h"
+#include "plenoptic/lens/main_lens_params.h"
 #include "plenoptic/sensor/sensor_chain.h"
 
 namespace plenoptic {
 
-// Pinhole and ThinLens are ideal; ThickLens is a prescription's paraxial equivalent;
-// Prescription is the real lens, traced surface by surface.
-enum class MainLensType { None, Pinhole, ThinLens, ThickLens, Prescription };
-enum class GridType { None, Rectangular, Hexagonal };
 enum class MicrolensType { Pinhole, ThinLens };
 // What a pixel's value measures (camera/radiometry.h): Flat, the radiance times the share of
 // the sampled aperture that passes (the first phase's camera, equal to the stock cameras); or
@@ -44,57 +41,6 @@ const int kMaxSamples = 1000000;
 // squares of lengths would leave double precision.
 const double kMinLengthMm = 1e-12;
 const double kMaxLengthMm = 1e12;
-
-// Most blades of a polygonal iris.
-const int kMaxBlades = 1000;
-
-// main_lens { ... }. `given` is false when the scene has no main_lens block (type stays None).
-struct MainLensParams {
-    bool given = false;
-    // None inside a given block until a thin_lens, pinhole or thick_lens keyword is read; a
-    // lens_file or prescription { } without one of them makes it Prescription when the block closes.
-    MainLensType type = MainLensType::None;
-    bool has_prescription = false;          // lens_file or prescription { } was read
-    Prescription prescription;              // its surfaces (blades below are applied by the model)
-    std::string lens_file;                  // the name as the scene wrote it; "" for an inline prescription
-    int blades = 0;                         // polygonal iris at the stop; 0: round
-    double blade_rotation_deg = 0;
-    bool has_focal_length = false;
-    double focal_length_mm = 0;             // F
-    bool has_f_number = false;
-    double f_number = 0;                    // N = F / A
-    bool has_aperture = false;
-    double aperture_mm = 0;                 // A, diameter (of the stop, for a prescription)
-    bool has_focus_distance = false;
-    double focus_distance_units = 0;        // scene units in front of the lens (its front vertex)
-    bool has_distance = false;
-    double distance_mm = 0;                 // D: main lens (rear vertex) -> array (-> sensor without array)
-    // distortion { radial <k1, k2, k3> tangential <p1, p2> } (thin lens only; lens/distortion.h)
-    bool has_distortion = false;
-    DistortionParams distortion = {{0, 0, 0}, {0, 0}};
-};
-
-// Whether the main lens is given by a prescription (traced exactly, or as its thick lens).
-inline bool is_prescription_type(MainLensType type)
-{
-    return type == MainLensType::ThickLens || type == MainLensType::Prescription;
-}
-
-// Whether a main lens is given and is a pinhole (no aperture of a size), and whether it has an
-// aperture of a size (a thin lens or a real one).
-inline bool is_pinhole(const MainLensParams& main) { return main.given && main.type == MainLensType::Pinhole; }
-inline bool has_sized_aperture(const MainLensParams& main)
-{
-    return main.given && (main.type == MainLensType::ThinLens || is_prescription_type(main.type));
-}
-
-// A prescription main lens as the camera uses it: its surfaces with the iris applied and the
-// stop at the diameter that `aperture` or `f_number` asks for (as written when neither is given).
-Prescription effective_prescription(const MainLensParams& main);
-
-// D for a main lens whose block passed check_main_lens: as given, or the paraxial image distance
-// of focus_distance (thin lens: F z / (z - F); prescription: from its rear vertex).
-double main_lens_distance_mm(const MainLensParams& main, double mm_per_unit);
 
 // microlens_array { ... }. `given` is false when the scene has no array (grid stays None).
 struct ArrayParams {
@@ -152,6 +98,9 @@ struct CameraParams {
     SamplingParams sampling;
 };
 
+// The camera's parameters with the main lens at f-number N (aperture from N, as `f_number N`).
+CameraParams at_f_number(const CameraParams& params, double f_number);
+
 // ---- Per-value checks, called by the parser while the token is current. ----
 // Each returns "" when the value is fine, else a complete message naming the keyword,
 // the value and the valid range.
@@ -200,8 +149,6 @@ std::string check_placement(const double right[3], const double up[3], const dou
 // Rays per pixel for a camera whose scene omits `samples` (see kDefaultSamplesApertures).
 int default_samples(const CameraParams& camera);
 
-// Shortest text that reads back as the same double ("0.5", "1e-300", "nan").
-std::string format_number(double value);
 
 } // namespace plenoptic
 

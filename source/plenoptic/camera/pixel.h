@@ -6,7 +6,7 @@
 
 #include <algorithm>
 
-#include "plenoptic/optics.h"
+#include "plenoptic/camera/rays.h"
 
 namespace plenoptic {
 

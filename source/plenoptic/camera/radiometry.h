@@ -32,23 +32,13 @@
 #include <cmath>
 
 #include "plenoptic/camera/model.h"
+#include "plenoptic/core/irradiance.h"
 #include "plenoptic/core/vec.h"
 
 namespace plenoptic {
 
 // K = A / C of the model's sampled aperture domain (mm^2), for make_model; 0 under flat radiometry.
 double irradiance_constant_mm2(const Model& model);
-
-// The weight of a sample whose ray leaves sensor point s towards point q of an aperture plane
-// with unit normal n (towards the scene): K cos(t_s) cos(t_q) / |q - s|^2, times cos^e(t_s) for
-// the pixel's angular response (sensor angular_response e; 0: none).
-inline double irradiance_weight(double k_mm2, double exponent, Vec3 s, Vec3 q, Vec3 n)
-{
-    const Vec3 v = q - s;
-    const double r2 = dot(v, v);
-    const double weight = k_mm2 * v.z * dot(v, n) / (r2 * r2);
-    return exponent > 0 ? weight * std::pow(v.z * v.z / r2, 0.5 * exponent) : weight;
-}
 
 // C, the projected solid angle (sr) by which irradiance values are divided: E = value * C * L.
 // 0 under flat radiometry and where C is a pinhole's limit (a pinhole main lens without an

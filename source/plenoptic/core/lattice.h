@@ -6,10 +6,12 @@
 
 #include <cstdint>
 
-#include "plenoptic/camera/params.h"
 #include "plenoptic/core/vec.h"
 
 namespace plenoptic {
+
+// The microlens array's grid (None: no array).
+enum class GridType { None, Rectangular, Hexagonal };
 
 // Lens indices in the row form of docs/specification.md (section 2):
 //   rectangular: centre (k p, l p)

@@ -9,6 +9,7 @@
 
 #include "plenoptic/lens/distortion.h"
 #include "plenoptic/lens/main_lens.h"
+#include "plenoptic/lens/main_lens_params.h"
 
 namespace plenoptic {
 namespace {

@@ -14,7 +14,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "plenoptic/camera/radiometry.h"
+#include "plenoptic/core/irradiance.h"
 #include "plenoptic/core/setup_progress.h"
 
 namespace plenoptic {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plenoptic/core/format.h"
 #include "plenoptic/core/sampling.h"
 
 namespace plenoptic {
@@ -332,6 +333,16 @@ std::shared_ptr<const MainLens> make_prescription_lens(const Prescription& lens,
     return std::make_shared<ExactMainLens>(sized, length, thick);
 }
 
+std::shared_ptr<const MainLens> make_pinhole_lens() { return std::make_shared<PinholeMainLens>(); }
+
+std::shared_ptr<const MainLens> make_thin_lens(double focal_length_mm, double aperture_mm, double f_number,
+                                               const DistortionParams* distortion, double plane_z)
+{
+    if (distortion)
+        return std::make_shared<ThinMainLens>(focal_length_mm, aperture_mm, f_number, *distortion, plane_z);
+    return std::make_shared<ThinMainLens>(focal_length_mm, aperture_mm, f_number);
+}
+
 SceneRay scene_ray(Vec3 origin, Vec3 direction)
 {
     const Vec3 unit = normalized(direction);
@@ -346,27 +357,5 @@ ImageRay image_ray(Vec3 origin, Vec3 direction)
     return ImageRay{origin, unit, ok};
 }
 
-std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& p, double distance_mm)
-{
-    if (!p.given)
-        return nullptr;
-    switch (p.type) {
-    case MainLensType::Pinhole:
-        return std::make_shared<PinholeMainLens>();
-    case MainLensType::ThinLens: {
-        const double aperture = p.has_aperture ? p.aperture_mm : p.focal_length_mm / p.f_number;
-        const double f_number = p.has_f_number ? p.f_number : p.focal_length_mm / aperture;
-        if (p.has_distortion)
-            return std::make_shared<ThinMainLens>(p.focal_length_mm, aperture, f_number, p.distortion, -distance_mm);
-        return std::make_shared<ThinMainLens>(p.focal_length_mm, aperture, f_number);
-    }
-    case MainLensType::ThickLens:
-    case MainLensType::Prescription:
-        return make_prescription_lens(effective_prescription(p), 0, p.type == MainLensType::Prescription, distance_mm);
-    case MainLensType::None:
-        break;
-    }
-    return nullptr;
-}
 
 } // namespace plenoptic

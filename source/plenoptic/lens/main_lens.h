@@ -9,8 +9,8 @@
 
 #include <cmath>
 #include <memory>
+#include <string>
 
-#include "plenoptic/camera/params.h"
 #include "plenoptic/core/vec.h"
 #include "plenoptic/lens/distortion.h"
 #include "plenoptic/lens/prescription.h"
@@ -106,6 +106,14 @@ public:
     virtual HomogeneousPoint paraxial_image(Vec3 point) const = 0;
 };
 
+// A pinhole at the origin.
+std::shared_ptr<const MainLens> make_pinhole_lens();
+// An ideal thin lens in the plane z = 0: focal length F, aperture diameter A, f-number N (as the
+// scene gave it, or F / A); with a parametric distortion acting on the plane z = plane_z (the
+// array, or the sensor), or none (nullptr).
+std::shared_ptr<const MainLens> make_thin_lens(double focal_length_mm, double aperture_mm, double f_number,
+                                               const DistortionParams* distortion, double plane_z);
+
 // A prescription lens in the optics frame: its rear vertex at the origin, its front vertex at
 // z = the lens's length (towards the scene), the stop at its written diameter unless stop_mm > 0.
 // `exact`: rays are traced surface by surface (Snell, every clear aperture, the stop or iris);
@@ -117,12 +125,6 @@ public:
 // nullptr when the prescription has no paraxial data (afocal, or a pupil at infinity).
 std::shared_ptr<const MainLens> make_prescription_lens(const Prescription& lens, double stop_mm, bool exact,
                                                        double image_distance_mm = NAN);
-
-// The main lens of checked parameters (nullptr for none). A lens knows only itself, and D
-// (distance_mm: main lens to array, or sensor) only for a thin lens's distortion, which acts on
-// the plane z = -D, and for a real lens's pupils (the images of the aperture that limits the
-// axial beam converging at z = -D).
-std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& params, double distance_mm);
 
 // The unit-direction ray (origin, direction); passed false when it is not finite or does not head
 // into the scene (a strong lens or a steep tilt can bend a ray back into the camera body).

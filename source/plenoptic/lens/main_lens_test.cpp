@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "plenoptic/lens/main_lens.h"
+#include "plenoptic/lens/main_lens_params.h"
 #include "plenoptic/lens/prescription.h"
 
 namespace plenoptic {

@@ -12,7 +12,7 @@
 #include <boost/random/normal_distribution.hpp>
 #include <boost/random/poisson_distribution.hpp>
 
-#include "plenoptic/camera/params.h"
+#include "plenoptic/core/format.h"
 
 namespace plenoptic {
 

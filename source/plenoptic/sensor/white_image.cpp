@@ -53,16 +53,6 @@ std::string repeated_white_f_number(const WhiteImageRequest& request)
     return "";
 }
 
-CameraParams at_f_number(const CameraParams& params, double f_number)
-{
-    CameraParams p = params;
-    p.main.has_f_number = true;
-    p.main.f_number = f_number;
-    p.main.has_aperture = false;
-    p.main.aperture_mm = 0;
-    return p;
-}
-
 std::vector<float> white_image(const Model& model, const std::function<bool()>& cancelled, int threads)
 {
     const int W = model.film.width, H = model.film.height;

@@ -38,9 +38,6 @@ std::string check_white_image_f_numbers(const WhiteImageRequest& request, const 
 // "" unless an f-number is listed twice (then the message: a refusal, since each names its file).
 std::string repeated_white_f_number(const WhiteImageRequest& request);
 
-// The camera's parameters with the main lens at f-number N (aperture from N, as `f_number N`).
-CameraParams at_f_number(const CameraParams& params, double f_number);
-
 // The W x H white image of `model`, rows from the top (pixel (i, j) at j W + i): each pixel's value
 // in a world of radiance 1. Rows are shared among `threads` threads (0: every hardware thread); the
 // result does not depend on their number. Returns an empty vector when `cancelled` says so.
