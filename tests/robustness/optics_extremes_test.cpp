@@ -188,8 +188,9 @@ TEST(OpticsExtremes, PlenopticRaysOfASensorPointMeetAtTheSystemConjugate)
             int met = 0;
             for (const auto& px : pixels) {
                 const Vec3 p = sensor_point(with_film(m, W, H), px[0] + 0.5, px[1] + 0.5);
-                LensIndex lens;
-                ASSERT_TRUE(own_lens(m, p, &lens));
+                const OwnLens lens_lookup = own_lens(m, p);
+                ASSERT_TRUE(lens_lookup.found);
+                const LensIndex lens = lens_lookup.lens;
                 const Vec3 c = lens_centre_mm(m, lens);
                 const Homog X = system_conjugate(p, c, sc.f, sc.d, sc.D, sc.F);
                 for (const OpticsRay& r : rays_of_point(with_film(m, W, H), px[0], px[1], 128)) {
@@ -225,9 +226,10 @@ TEST(OpticsExtremes, BareArrayRaysMeetAtTheMicrolensConjugateEvenTiltedNearlyEdg
                 for (int i : {5, 20, 37}) {
                     const int j = (i * 7) % H;
                     const Vec3 p = sensor_point(with_film(m, W, H), i + 0.5, j + 0.5);
-                    LensIndex lens;
-                    if (!own_lens(m, p, &lens))
+                    const OwnLens lens_lookup = own_lens(m, p);
+                    if (!lens_lookup.found)
                         continue;
+                    const LensIndex lens = lens_lookup.lens;
                     // In the array's own frame (reference rotation): p at height -s below lens c.
                     const Vec2 c2 = lens_centre(GridType::Hexagonal, 0.1, lens);
                     const Vec3 c_local{c2.x, c2.y, 0};

@@ -221,19 +221,18 @@ Vec3 sensor_point(const Model& m, double pu, double pv)
                 (pv - 0.5 * H) * m.pixel_size_mm[1] + m.sensor_offset_mm[1], m.sensor_z_mm};
 }
 
-bool sensor_to_pixel(const Model& m, double x_mm, double y_mm, double* u, double* v)
+PixelPoint sensor_to_pixel(const Model& m, double x_mm, double y_mm)
 {
     const int W = m.film.width, H = m.film.height;
-    *u = 0.5 * W - 0.5 - (x_mm - m.sensor_offset_mm[0]) / m.pixel_size_mm[0];
-    *v = 0.5 * H - 0.5 + (y_mm - m.sensor_offset_mm[1]) / m.pixel_size_mm[1];
-    return *u >= -0.5 && *u < W - 0.5 && *v >= -0.5 && *v < H - 0.5;
+    const double u = 0.5 * W - 0.5 - (x_mm - m.sensor_offset_mm[0]) / m.pixel_size_mm[0];
+    const double v = 0.5 * H - 0.5 + (y_mm - m.sensor_offset_mm[1]) / m.pixel_size_mm[1];
+    return PixelPoint{u, v, u >= -0.5 && u < W - 0.5 && v >= -0.5 && v < H - 0.5};
 }
 
 Vec2 principal_point_px(const Model& m)
 {
-    Vec2 p;
-    sensor_to_pixel(m, 0, 0, &p.x, &p.y);
-    return p;
+    const PixelPoint p = sensor_to_pixel(m, 0, 0);
+    return Vec2{p.u, p.v};
 }
 
 Vec3 lens_centre_mm(const Model& m, LensIndex lens)
@@ -242,13 +241,12 @@ Vec3 lens_centre_mm(const Model& m, LensIndex lens)
     return to_optics(m, Vec3{c.x, c.y, 0});
 }
 
-bool own_lens(const Model& m, Vec3 p, LensIndex* lens)
+OwnLens own_lens(const Model& m, Vec3 p)
 {
     Vec2 q;
     if (!project_to_array(m, p, &q))
-        return false;
-    *lens = nearest_lens(m.grid, m.pitch_mm, q.x, q.y);
-    return true;
+        return OwnLens{LensIndex{0, 0}, false};
+    return OwnLens{nearest_lens(m.grid, m.pitch_mm, q.x, q.y), true};
 }
 
 OpticsRay generate_ray(const Model& m, int i, int j, const CameraSample& sample, const LensIndex* lens)
@@ -264,9 +262,10 @@ int overlap_lenses(const Model& m, int i, int j, LensIndex* out, int capacity)
     if (capacity < 1 || m.grid == GridType::None)
         return 0;
     const Vec3 p = sensor_point(m, i + 0.5, j + 0.5);
-    LensIndex own;
-    if (!own_lens(m, p, &own))
+    const OwnLens lookup = own_lens(m, p);
+    if (!lookup.found)
         return 0;
+    const LensIndex own = lookup.lens;
     out[0] = own;
     int count = 1;
     if (!m.model_overlap)

@@ -33,9 +33,15 @@ struct OpticsRay {
 //   x = -(pu - W/2) * sx + ox,  y = (pv - H/2) * sy + oy,  z = sensor plane.
 Vec3 sensor_point(const Model& model, double pu, double pv);
 
-// Inverse of sensor_point in the centre convention used by the metadata: pixel (i, j)'s centre is
-// at (u, v) = (i, j). Returns whether the point lies inside the image.
-bool sensor_to_pixel(const Model& model, double x_mm, double y_mm, double* u, double* v);
+// A point of the picture in the centre convention used by the metadata (pixel (i, j)'s centre is
+// at (u, v) = (i, j)), and whether it lies inside the image.
+struct PixelPoint {
+    double u, v;
+    bool inside;
+};
+
+// Inverse of sensor_point, in the centre convention.
+PixelPoint sensor_to_pixel(const Model& model, double x_mm, double y_mm);
 
 // Where the optical axis meets the sensor, centre convention.
 Vec2 principal_point_px(const Model& model);
@@ -45,8 +51,12 @@ Vec3 lens_centre_mm(const Model& model, LensIndex lens);
 
 // The lens a sensor point belongs to: the lens whose cell contains the intersection of the line
 // (main-lens centre -> point) with the array plane; with no main lens, the lens straight above
-// the point. False when that line misses the array plane (only for extreme tilts).
-bool own_lens(const Model& model, Vec3 sensor_point_mm, LensIndex* lens);
+// the point. Not found when that line misses the array plane (only for extreme tilts).
+struct OwnLens {
+    LensIndex lens;
+    bool found;
+};
+OwnLens own_lens(const Model& model, Vec3 sensor_point_mm);
 
 // The ray of one sample of pixel (i, j). `lens` forces the microlens the light passes through
 // (overlap modelling); nullptr uses the own lens of the sample's sensor point. Not passed when

@@ -40,8 +40,9 @@ TEST(Optics, SensorPointConvention)
     EXPECT_DOUBLE_EQ(c.x, -((10 + 0.5) - 320) * 0.01 + 0.3);
     EXPECT_DOUBLE_EQ(c.y, ((20 + 0.5) - 240) * 0.02 - 0.1);
     EXPECT_DOUBLE_EQ(c.z, -52);
-    double u, v;
-    EXPECT_TRUE(sensor_to_pixel(with_film(m, W, H), c.x, c.y, &u, &v));
+    const PixelPoint px = sensor_to_pixel(with_film(m, W, H), c.x, c.y);
+    EXPECT_TRUE(px.inside);
+    const double u = px.u, v = px.v;
     EXPECT_NEAR(u, 10, 1e-9);
     EXPECT_NEAR(v, 20, 1e-9);
     const Vec2 principal = principal_point_px(with_film(m, W, H));
@@ -202,8 +203,9 @@ void check_posed_lookup(GridType grid, bool with_main_lens)
             q = p + Vec3{0, 0, dot(n, centre - p) / n.z};  // straight up
         const Vec3 local = test::reference_unrotate(deg, q - centre);
         const LensIndex expected = test::brute_force_nearest(grid, 0.13, local.x, local.y);
-        LensIndex found;
-        ASSERT_TRUE(own_lens(m, p, &found));
+        const OwnLens found_lookup = own_lens(m, p);
+        ASSERT_TRUE(found_lookup.found);
+        const LensIndex found = found_lookup.lens;
         if (found != expected) {
             const Vec2 a = lens_centre(grid, 0.13, found), b = lens_centre(grid, 0.13, expected);
             const double da = std::hypot(local.x - a.x, local.y - a.y), db = std::hypot(local.x - b.x, local.y - b.y);
@@ -424,8 +426,9 @@ TEST(Optics, OverlapLensesListsTheOwnLensFirst)
     const Model apart = make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 10, 50));
     LensIndex lenses[kMaxOverlapLenses];
     EXPECT_EQ(overlap_lenses(with_film(apart, W, H), 10, 20, lenses, kMaxOverlapLenses), 1);
-    LensIndex own;
-    ASSERT_TRUE(own_lens(apart, sensor_point(with_film(apart, W, H), 10.5, 20.5), &own));
+    const OwnLens own_lookup = own_lens(apart, sensor_point(with_film(apart, W, H), 10.5, 20.5));
+    ASSERT_TRUE(own_lookup.found);
+    const LensIndex own = own_lookup.lens;
     EXPECT_EQ(lenses[0], own);
 
     const Model overlapping = make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 2.5, 50));

@@ -28,7 +28,8 @@ bool local_to_px(const Model& m, Vec2 local, Vec2* px)
         x = e.x + (c.x - e.x) * s;
         y = e.y + (c.y - e.y) * s;
     }
-    sensor_to_pixel(m, x, y, &px->x, &px->y);
+    const PixelPoint p = sensor_to_pixel(m, x, y);
+    *px = Vec2{p.u, p.v};
     return is_finite(*px);
 }
 
@@ -91,9 +92,10 @@ void fit_lftoolbox(const Model& m, MicroimageLattice* lattice)
     // The lenslet at (row 1, col 1).
     const double first_shift = shift_row == 1 ? h_spacing / 2 : 0.0;
     const double first_u = offset.x + first_shift * e.x - 1, first_v = offset.y + first_shift * e.y - 1;
-    LensIndex first;
-    if (!own_lens(m, sensor_point(m, first_u + 0.5, first_v + 0.5), &first))
+    const OwnLens first_lookup = own_lens(m, sensor_point(m, first_u + 0.5, first_v + 0.5));
+    if (!first_lookup.found)
         return;
+    const LensIndex first = first_lookup.lens;
     // As LFBuildLensletGridModel: UMax = floor((W - HOffset) / HSpacing) + 1, likewise VMax;
     // counts beyond 1e15 (absurdly fine grids) are not expressible.
     const double u_max = std::floor((W - offset.x) / h_spacing) + 1;

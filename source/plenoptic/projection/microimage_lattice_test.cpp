@@ -67,8 +67,9 @@ void check_lftoolbox(GridType grid, double rotate_z, double offset_x, double tx)
             const double x = c * uu - s * vv + lattice.h_offset;  // 1-based
             const double y = s * uu + c * vv + lattice.v_offset;
             const double u = x - 1, v = y - 1;
-            LensIndex lens;
-            ASSERT_TRUE(own_lens(m, sensor_point(with_film(m, W, H), u + 0.5, v + 0.5), &lens));
+            const OwnLens lens_lookup = own_lens(m, sensor_point(with_film(m, W, H), u + 0.5, v + 0.5));
+            ASSERT_TRUE(lens_lookup.found);
+            const LensIndex lens = lens_lookup.lens;
             double cu, cv;
             ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), lens, &cu, &cv));
             EXPECT_NEAR(cu, u, 1e-6) << "grid (" << row << "," << col << ") rotate " << rotate_z;

@@ -79,20 +79,18 @@ std::vector<Vec2> microimage_cell(const Model& m, LensIndex lens)
 
 bool delivered_point(const Model& m, LensIndex lens, Vec2 s)
 {
-    double u, v;
-    if (!sensor_to_pixel(m, s.x, s.y, &u, &v))
+    if (!sensor_to_pixel(m, s.x, s.y).inside)
         return false;
-    LensIndex owner;
-    return own_lens(m, Vec3{s.x, s.y, m.sensor_z_mm}, &owner) && within_rings(m, owner, lens, receiving_rings(m));
+    const OwnLens owner = own_lens(m, Vec3{s.x, s.y, m.sensor_z_mm});
+    return owner.found && within_rings(m, owner.lens, lens, receiving_rings(m));
 }
 
 void add_point_hit(const Model& m, LensIndex lens, Vec3 s, double fraction, std::vector<PixelHit>* hits)
 {
     if (!delivered_point(m, lens, Vec2{s.x, s.y}))
         return;
-    double u, v;
-    sensor_to_pixel(m, s.x, s.y, &u, &v);
-    hits->push_back(PixelHit{lens, u, v, fraction});
+    const PixelPoint px = sensor_to_pixel(m, s.x, s.y);
+    hits->push_back(PixelHit{lens, px.u, px.v, fraction});
 }
 
 } // namespace detail
@@ -450,10 +448,10 @@ void add_spot_hit(const Model& m, LensIndex lens, const std::vector<Vec2>& light
     const double kept = delivered_area(m, lens, light, &centroid);
     if (!(kept > 0))
         return;
-    double u, v;
-    if (!sensor_to_pixel(m, centroid.x, centroid.y, &u, &v))
+    const PixelPoint px = sensor_to_pixel(m, centroid.x, centroid.y);
+    if (!px.inside)
         return;  // only by rounding, for light along the picture's edge
-    hits->push_back(PixelHit{lens, u, v, fraction * std::min(1.0, kept / area)});
+    hits->push_back(PixelHit{lens, px.u, px.v, fraction * std::min(1.0, kept / area)});
 }
 
 // The picture on the sensor plane (x, y, mm), as a box.
@@ -671,9 +669,9 @@ std::vector<PixelHit> forward_project(const Model& m, const double point_mm[3])
             return hits;
         // Pinhole, or the chief ray of a thin lens (the centre of its blur disc).
         const double s = m.sensor_z_mm / point.z;
-        double u, v;
-        if (sensor_to_pixel(m, point.x * s, point.y * s, &u, &v))
-            hits.push_back(PixelHit{LensIndex{0, 0}, u, v, 1.0});
+        const PixelPoint px = sensor_to_pixel(m, point.x * s, point.y * s);
+        if (px.inside)
+            hits.push_back(PixelHit{LensIndex{0, 0}, px.u, px.v, 1.0});
         return hits;
     }
     if (!m.lens) {

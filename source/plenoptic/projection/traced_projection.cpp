@@ -329,9 +329,11 @@ std::vector<PixelHit> forward_project_traced(const Model& m, Vec3 point,
 
     if (m.grid == GridType::None) {
         const LensLight& spot = light.lenses[RowKey(0, 0)];
-        double u, v;
-        if (spot.weight > 0 && sensor_to_pixel(m, spot.sx / spot.weight, spot.sy / spot.weight, &u, &v))
-            hits.push_back(PixelHit{LensIndex{0, 0}, u, v, 1.0});
+        if (!(spot.weight > 0))
+            return hits;
+        const PixelPoint px = sensor_to_pixel(m, spot.sx / spot.weight, spot.sy / spot.weight);
+        if (px.inside)
+            hits.push_back(PixelHit{LensIndex{0, 0}, px.u, px.v, 1.0});
         return hits;
     }
     for (const auto& entry : light.lenses) {
@@ -349,9 +351,9 @@ std::vector<PixelHit> forward_project_traced(const Model& m, Vec3 point,
         }
         if (!(acc.weight > 0))
             continue;
-        double u, v;
-        if (sensor_to_pixel(m, acc.sx / acc.weight, acc.sy / acc.weight, &u, &v))
-            hits.push_back(PixelHit{lens, u, v, std::min(1.0, acc.weight / total)});
+        const PixelPoint px = sensor_to_pixel(m, acc.sx / acc.weight, acc.sy / acc.weight);
+        if (px.inside)
+            hits.push_back(PixelHit{lens, px.u, px.v, std::min(1.0, acc.weight / total)});
     }
     return hits;
 }

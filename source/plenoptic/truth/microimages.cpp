@@ -52,8 +52,8 @@ public:
         if (m_.model_overlap)
             return true;
         // Without overlap modelling the renderer gives a sensor point the light of its own lens only.
-        LensIndex own;
-        return own_lens(m_, sensor_point(m_, u, v), &own) && own == lens_;
+        const OwnLens own = own_lens(m_, sensor_point(m_, u, v));
+        return own.found && own.lens == lens_;
     }
 
 private:
@@ -148,7 +148,8 @@ bool project_to_sensor_px(const Model& m, Vec3 q, Vec2* px)
     if (!(q.z < e.z))
         return false;
     const double t = (m.sensor_z_mm - e.z) / (q.z - e.z);
-    sensor_to_pixel(m, e.x + t * (q.x - e.x), e.y + t * (q.y - e.y), &px->x, &px->y);
+    const PixelPoint p = sensor_to_pixel(m, e.x + t * (q.x - e.x), e.y + t * (q.y - e.y));
+    *px = Vec2{p.u, p.v};
     return is_finite(*px);
 }
 
@@ -210,7 +211,9 @@ Guess guess_region(const Model& m, LensIndex lens, double lens_u, double lens_v,
         wy += shift.y;
     }
     Guess guess{true, 0, 0, disc.radius * drop / along / pixel};
-    sensor_to_pixel(m, h.x - drop * wx, h.y - drop * wy, &guess.u, &guess.v);
+    const PixelPoint centre = sensor_to_pixel(m, h.x - drop * wx, h.y - drop * wy);
+    guess.u = centre.u;
+    guess.v = centre.v;
     guess.u += 0.5;
     guess.v += 0.5;
     if (!(std::isfinite(guess.u) && std::isfinite(guess.v) && std::isfinite(guess.radius_px)))
