@@ -462,7 +462,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
             }
         }
     }
-    const Model m = make_model(p);
+    const Model m = with_film(make_model(p), in.W, in.H);
     model_is_sane(m);
     if (check_diffraction_size(m, p.diffraction).empty()) {
         // The picture keeps its light through the convolution and stays finite.
@@ -488,30 +488,30 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
         const int count = std::max(in.samples, std::min(m.samples_max, 8));
         for (int n = 0; n < in.samples; ++n) {
             OpticsRay r;
-            if ((r = generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, count), nullptr)).passed) {
+            if ((r = generate_ray(m, i, j, make_sample(i, j, n, count), nullptr)).passed) {
                 check_ray(m, r, "generate_ray", i, j);
                 check_origin(m, r, i, j);
             }
         }
-        check_ray(m, chief_ray(with_film(m, W, H), i, j), "chief_ray", i, j);
+        check_ray(m, chief_ray(m, i, j), "chief_ray", i, j);
         LensIndex lenses[kMaxOverlapLenses];
-        const int lens_count = overlap_lenses(with_film(m, W, H), i, j, lenses, kMaxOverlapLenses);
+        const int lens_count = overlap_lenses(m, i, j, lenses, kMaxOverlapLenses);
         FUZZ_ASSERT(lens_count >= 0 && lens_count <= kMaxOverlapLenses, "overlap_lenses gave %d", lens_count);
         for (int l = 0; l < lens_count && l < 4; ++l) {
             OpticsRay r;
-            if ((r = generate_ray(with_film(m, W, H), i, j, make_sample(i, j, l, 4), &lenses[l])).passed) {
+            if ((r = generate_ray(m, i, j, make_sample(i, j, l, 4), &lenses[l])).passed) {
                 check_ray(m, r, "generate_ray through an overlap lens", i, j);
                 check_origin(m, r, i, j);
             }
         }
         if (m.samples_max <= 16) {
-            const Rgbt v = shade_pixel(with_film(m, W, H), i, j, [](const OpticsRay& r) {
+            const Rgbt v = shade_pixel(m, i, j, [](const OpticsRay& r) {
                 return Rgbt{r.dir.x, r.dir.y, r.dir.z, 0.5};
             });
             FUZZ_ASSERT(std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b) && std::isfinite(v.t),
                         "shade_pixel (%d, %d) = (%g, %g, %g, %g)", i, j, v.r, v.g, v.b, v.t);
             // A white world: no pixel is negative or NaN, under either radiometry.
-            const Rgbt white = shade_pixel(with_film(m, W, H), i, j, [](const OpticsRay&) { return Rgbt{1, 1, 1, 1}; });
+            const Rgbt white = shade_pixel(m, i, j, [](const OpticsRay&) { return Rgbt{1, 1, 1, 1}; });
             FUZZ_ASSERT(std::isfinite(white.r) && white.r >= 0, "white pixel (%d, %d) = %g", i, j, white.r);
         }
     }
@@ -519,17 +519,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     // skip sizes where that is millions of lenses, to keep the fuzzer fast.
     const double span_mm = std::max(W * m.pixel_size_mm[0], H * m.pixel_size_mm[1]);
     if (m.grid == GridType::None || span_mm <= 64 * m.pitch_mm) {
-        for (const PixelHit& hit : forward_project(with_film(m, W, H), in.point)) {
+        for (const PixelHit& hit : forward_project(m, in.point)) {
             FUZZ_ASSERT(std::isfinite(hit.u) && std::isfinite(hit.v), "forward_project hit (%g, %g)", hit.u, hit.v);
             FUZZ_ASSERT(hit.u >= -0.5 && hit.u < W - 0.5 && hit.v >= -0.5 && hit.v < H - 0.5,
                         "forward_project hit (%.17g, %.17g) outside the %dx%d image", hit.u, hit.v, W, H);
         }
-        const MicroimageLattice lattice = microimage_lattice(with_film(m, W, H));
+        const MicroimageLattice lattice = microimage_lattice(m);
         if (lattice.valid)
             FUZZ_ASSERT(std::isfinite(lattice.origin_px[0]) && std::isfinite(lattice.origin_px[1]),
                         "lattice origin (%g, %g)", lattice.origin_px[0], lattice.origin_px[1]);
         const CameraFrame frame = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-        const std::string json = metadata_json(with_film(m, W, H), p, frame, "");
+        const std::string json = metadata_json(m, p, frame, "");
         FUZZ_ASSERT(!json_has_non_finite(json), "metadata JSON has a non-finite number:\n%s", json.c_str());
     }
     g_input = nullptr;
