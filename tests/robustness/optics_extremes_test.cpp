@@ -91,12 +91,12 @@ TEST(OpticsExtremes, ThinMainLensRaysMeetAtTheConjugateFromFocalLength1e6To1e_6)
             CameraParams params = thin_main(F, 2.8, D);
             params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = F * 1e-3;  // ~0.01 rad per pixel
             ASSERT_EQ(check_camera(params), "") << describe(params);
-            const Model m = make_model(params);
-            const Vec3 p = sensor_point(with_film(m, W, H), i + 0.5, j + 0.5);
+            const Model m = with_film(make_model(params), W, H);
+            const Vec3 p = sensor_point(m, i + 0.5, j + 0.5);
             // Independently, with divisions (the code under test has none): the image of p.
             const double u = 1 / (1 / F - 1 / m.distance_mm);
             const Vec3 conjugate{-p.x * u / m.distance_mm, -p.y * u / m.distance_mm, u};
-            const std::vector<OpticsRay> rays = rays_of_point(with_film(m, W, H), i, j, 64);
+            const std::vector<OpticsRay> rays = rays_of_point(m, i, j, 64);
             ASSERT_EQ(rays.size(), 64u) << describe(params) << ": a bare thin lens blocks nothing";
             for (const OpticsRay& r : rays) {
                 if (D_over_F > 1 + 1e-9) {
@@ -121,9 +121,9 @@ TEST(OpticsExtremes, SensorAtTheFocalPlaneGivesParallelRaysAtEveryScale)
     for (double F : {1e-6, 1.0, 1e6}) {
         CameraParams params = thin_main(F, 1.4, F);  // D = F exactly
         params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = F * 1e-3;
-        const Model m = make_model(params);
-        const Vec3 expected = normalized(-sensor_point(with_film(m, W, H), i + 0.5, j + 0.5));
-        for (const OpticsRay& r : rays_of_point(with_film(m, W, H), i, j, 64))
+        const Model m = with_film(make_model(params), W, H);
+        const Vec3 expected = normalized(-sensor_point(m, i + 0.5, j + 0.5));
+        for (const OpticsRay& r : rays_of_point(m, i, j, 64))
             EXPECT_LT(length(dir_of(r) - expected), 1e-14) << describe(params) << " " << str(dir_of(r));
     }
 }
@@ -184,16 +184,16 @@ TEST(OpticsExtremes, PlenopticRaysOfASensorPointMeetAtTheSystemConjugate)
             CameraParams params = test::plenoptic_camera(grid, sc.pitch, sc.f, sc.d, sc.F, sc.N, sc.D);
             params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = sc.pitch / 7;
             ASSERT_EQ(check_camera(params), "") << describe(params);
-            const Model m = make_model(params);
+            const Model m = with_film(make_model(params), W, H);
             int met = 0;
             for (const auto& px : pixels) {
-                const Vec3 p = sensor_point(with_film(m, W, H), px[0] + 0.5, px[1] + 0.5);
+                const Vec3 p = sensor_point(m, px[0] + 0.5, px[1] + 0.5);
                 const OwnLens lens_lookup = own_lens(m, p);
                 ASSERT_TRUE(lens_lookup.found);
                 const LensIndex lens = lens_lookup.lens;
                 const Vec3 c = lens_centre_mm(m, lens);
                 const Homog X = system_conjugate(p, c, sc.f, sc.d, sc.D, sc.F);
-                for (const OpticsRay& r : rays_of_point(with_film(m, W, H), px[0], px[1], 128)) {
+                for (const OpticsRay& r : rays_of_point(m, px[0], px[1], 128)) {
                     double scale;
                     const double err = homog_miss(X, r, &scale);
                     EXPECT_LT(err, 1e-9 * std::max(scale, sc.F))
@@ -221,11 +221,11 @@ TEST(OpticsExtremes, BareArrayRaysMeetAtTheMicrolensConjugateEvenTiltedNearlyEdg
                 test::set_pose(&params, tilt, 0, 30, 0.01, -0.02, 0);
                 params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.01;
                 ASSERT_EQ(check_camera(params), "") << describe(params);
-                const Model m = make_model(params);
+                const Model m = with_film(make_model(params), W, H);
                 const double* deg = params.array.rotate_deg;
                 for (int i : {5, 20, 37}) {
                     const int j = (i * 7) % H;
-                    const Vec3 p = sensor_point(with_film(m, W, H), i + 0.5, j + 0.5);
+                    const Vec3 p = sensor_point(m, i + 0.5, j + 0.5);
                     const OwnLens lens_lookup = own_lens(m, p);
                     if (!lens_lookup.found)
                         continue;
@@ -236,13 +236,13 @@ TEST(OpticsExtremes, BareArrayRaysMeetAtTheMicrolensConjugateEvenTiltedNearlyEdg
                     const Vec3 p_local = test::reference_unrotate(deg, p - m.pose.centre_mm);
                     const double s = -p_local.z;
                     if (!(s > 0)) {  // the point is in front of the (steeply tilted) array: no light
-                        EXPECT_TRUE(rays_of_point(with_film(m, W, H), i, j, 16).empty()) << describe(params);
+                        EXPECT_TRUE(rays_of_point(m, i, j, 16).empty()) << describe(params);
                         continue;
                     }
                     // Homogeneous image of p by the microlens: (c (s - f) + (c - p) f, f s, w = s - f).
                     const double w = s - f;
                     const Vec3 xyz = w * c_local + f * (c_local - p_local);  // z: f s
-                    const std::vector<OpticsRay> rays = rays_of_point(with_film(m, W, H), i, j, 64);
+                    const std::vector<OpticsRay> rays = rays_of_point(m, i, j, 64);
                     for (const OpticsRay& r : rays) {
                         const Vec3 o = origin_of(r);
                         // Origin on the array plane (the last element).
@@ -280,14 +280,14 @@ TEST(OpticsExtremes, PinholeMainLensRaysAllLeaveThroughThePinhole)
                 const std::string refusal = check_camera(params);
                 if (!refusal.empty())
                     continue;  // the degenerate combination, refused as it must be
-                const Model m = make_model(params);
+                const Model m = with_film(make_model(params), W, H);
                 int unblocked = 0, off_pinhole = 0, backwards = 0, not_unit = 0;
                 OpticsRay example{};
                 for (int j = 0; j < H; j += 5) {
                     for (int i = 0; i < W; i += 3) {
                         for (int n = 0; n < 8; ++n) {
                             OpticsRay r;
-                            if (!(r = generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, 8), nullptr)).passed)
+                            if (!(r = generate_ray(m, i, j, make_sample(i, j, n, 8), nullptr)).passed)
                                 continue;
                             ++unblocked;
                             if (!(r.origin_mm.x == 0 && r.origin_mm.y == 0 && r.origin_mm.z == 0))

@@ -78,13 +78,13 @@ TEST(Pixel, AdaptiveSamplingStopsEarlyOnFlatScenesAndGoesOnOnNoisyOnes)
     params.sampling.adaptive = true;
     params.sampling.samples_min = 8;
     params.sampling.samples_max = 64;
-    const Model m = make_model(params);
+    const Model m = with_film(make_model(params), 64, 64);
     int calls = 0;
     auto flat = [&](const OpticsRay&) {
         ++calls;
         return Rgbt{0.3, 0.3, 0.3, 0};
     };
-    const Rgbt value = shade_pixel(with_film(m, 64, 64), 10, 10, flat);
+    const Rgbt value = shade_pixel(m, 10, 10, flat);
     EXPECT_EQ(calls, 8) << "zero variance after the minimum";
     EXPECT_NEAR(value.r, 0.3, 1e-15);
 
@@ -93,7 +93,7 @@ TEST(Pixel, AdaptiveSamplingStopsEarlyOnFlatScenesAndGoesOnOnNoisyOnes)
         ++calls;
         return Rgbt{ray.origin_mm.x > 0 ? 1.0 : 0.0, 0, 0, 0};
     };
-    shade_pixel(with_film(m, 64, 64), 10, 10, noisy);
+    shade_pixel(m, 10, 10, noisy);
     EXPECT_GT(calls, 8);
     EXPECT_LE(calls, 64);
     EXPECT_EQ((calls - 8) % 4 == 0 || calls == 64, true) << calls << " samples: batches of 4 after the minimum";
@@ -110,7 +110,7 @@ TEST(Pixel, AdaptiveSamplingDoesNotTakeAnUnluckyBlockedStartForADarkPixel)
     adaptive.sampling.adaptive = true;
     adaptive.sampling.samples_min = minimum;
     adaptive.sampling.samples_max = maximum;
-    const Model m_fixed = make_model(fixed), m_adaptive = make_model(adaptive);
+    const Model m_fixed = with_film(make_model(fixed), W, H), m_adaptive = with_film(make_model(adaptive), W, H);
     auto white = [](const OpticsRay&) { return Rgbt{1, 1, 1, 0}; };
     int unlucky = 0;
     for (int j = 0; j < H; ++j)
@@ -118,12 +118,12 @@ TEST(Pixel, AdaptiveSamplingDoesNotTakeAnUnluckyBlockedStartForADarkPixel)
             bool first_lit = false;
             for (int n = 0; n < minimum && !first_lit; ++n) {
                 OpticsRay ray;
-                first_lit = (ray = generate_ray(with_film(m_adaptive, W, H), i, j, make_sample(i, j, n, maximum), nullptr)).passed;
+                first_lit = (ray = generate_ray(m_adaptive, i, j, make_sample(i, j, n, maximum), nullptr)).passed;
             }
-            const bool lit = shade_pixel(with_film(m_fixed, W, H), i, j, white).r > 0;
-            const Rgbt value = shade_pixel(with_film(m_adaptive, W, H), i, j, white);
+            const bool lit = shade_pixel(m_fixed, i, j, white).r > 0;
+            const Rgbt value = shade_pixel(m_adaptive, i, j, white);
             EXPECT_EQ(value.r > 0, lit) << "pixel " << i << "," << j << ": dark exactly when no sample passes";
-            EXPECT_EQ(pixel_receives_light(with_film(m_adaptive, W, H), i, j), lit) << "pixel " << i << "," << j;
+            EXPECT_EQ(pixel_receives_light(m_adaptive, i, j), lit) << "pixel " << i << "," << j;
             if (lit && !first_lit)
                 ++unlucky;
         }
@@ -137,20 +137,20 @@ TEST(Pixel, VignettingProbesBringRimPixelsCloserToTheirTrueLitFraction)
     const int W = 160, H = 120, samples = 16, reference = 4096;
     CameraParams params = matched_plenoptic1();
     params.sampling.samples = samples;
-    const Model m = make_model(params);
+    const Model m = with_film(make_model(params), W, H);
     auto white = [](const OpticsRay&) { return Rgbt{1, 1, 1, 0}; };
     double error_plain = 0, error_probed = 0;
     int rim = 0;
     for (int j = 0; j < H; j += 2)
         for (int i = 0; i < W; i += 2) {
             int first;
-            const double truth = double(detail::passing_samples(with_film(m, W, H), i, j, 0, reference, &first)) / reference;
+            const double truth = double(detail::passing_samples(m, i, j, 0, reference, &first)) / reference;
             if (truth == 0 || truth == 1)
                 continue;
             ++rim;
-            const double plain = double(detail::passing_samples(with_film(m, W, H), i, j, 0, samples, &first)) / samples;
+            const double plain = double(detail::passing_samples(m, i, j, 0, samples, &first)) / samples;
             error_plain += (plain - truth) * (plain - truth);
-            const double probed = shade_pixel(with_film(m, W, H), i, j, white).r;
+            const double probed = shade_pixel(m, i, j, white).r;
             error_probed += (probed - truth) * (probed - truth);
         }
     ASSERT_GT(rim, 500) << "f-number-matched microimages: many pixels at their rims";

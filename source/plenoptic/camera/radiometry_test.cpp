@@ -280,10 +280,10 @@ TEST(Radiometry, AngularResponseMultipliesTheCos4LawAndKeepsTheAxisAtOne)
     CameraParams p = irradiance_pinhole();
     p.sensor.angular_exponent = 6;
     ASSERT_EQ(check_camera(p), "");
-    const Model pinhole = make_model(p);
+    const Model pinhole = with_film(make_model(p), 201, 1);
     const double x = centre_x(170, 201, 0.5);
     const double cos2 = 2500 / (2500 + x * x);
-    EXPECT_NEAR(shade_pixel(with_film(pinhole, 201, 1), 170, 0, white).r, std::pow(cos2, 5), 1e-12);
+    EXPECT_NEAR(shade_pixel(pinhole, 170, 0, white).r, std::pow(cos2, 5), 1e-12);
 
     // A 50 mm f/2 thin lens: the pixel is the integral of cos^(4 + e) over the pupil, 1 on the axis.
     CameraParams t = test::thin_lens_camera(50, 2, 52);

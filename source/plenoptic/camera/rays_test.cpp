@@ -314,7 +314,7 @@ TEST(Optics, PixelToRayToSensorRoundTrip)
     for (RoundTripCase& c : cases) {
         c.params.sensor.pixel_size_mm[0] = c.params.sensor.pixel_size_mm[1] = 0.02;
         ASSERT_EQ(check_camera(c.params), "") << c.name;
-        const Model m = make_model(c.params);
+        const Model m = with_film(make_model(c.params), W, H);
         int traced = 0;
         double worst = 0;
         for (int j = 0; j < H; j += 7) {
@@ -322,11 +322,11 @@ TEST(Optics, PixelToRayToSensorRoundTrip)
                 for (int n = 0; n < 8; ++n) {
                     const CameraSample s = make_sample(i, j, n, 8);
                     OpticsRay ray;
-                    if (!(ray = generate_ray(with_film(m, W, H), i, j, s, nullptr)).passed)
+                    if (!(ray = generate_ray(m, i, j, s, nullptr)).passed)
                         continue;
                     std::string failure;
                     const Vec3 back = trace_back(m, c.params, ray, &failure);
-                    const Vec3 start = sensor_point(with_film(m, W, H), i + s.pixel_u, j + s.pixel_v);
+                    const Vec3 start = sensor_point(m, i + s.pixel_u, j + s.pixel_v);
                     EXPECT_TRUE(failure.empty()) << c.name << ": " << failure;
                     worst = std::max(worst, length(back - start));
                     EXPECT_LT(length(back - start), 1e-9) << c.name << " pixel " << i << "," << j << " sample " << n
@@ -423,19 +423,19 @@ TEST(Optics, OverlapPruningNeverDropsALensThatDeliversLight)
 TEST(Optics, OverlapLensesListsTheOwnLensFirst)
 {
     const int W = 200, H = 200;
-    const Model apart = make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 10, 50));
+    const Model apart = with_film(make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 10, 50)), W, H);
     LensIndex lenses[kMaxOverlapLenses];
-    EXPECT_EQ(overlap_lenses(with_film(apart, W, H), 10, 20, lenses, kMaxOverlapLenses), 1);
-    const OwnLens own_lookup = own_lens(apart, sensor_point(with_film(apart, W, H), 10.5, 20.5));
+    EXPECT_EQ(overlap_lenses(apart, 10, 20, lenses, kMaxOverlapLenses), 1);
+    const OwnLens own_lookup = own_lens(apart, sensor_point(apart, 10.5, 20.5));
     ASSERT_TRUE(own_lookup.found);
     const LensIndex own = own_lookup.lens;
     EXPECT_EQ(lenses[0], own);
 
-    const Model overlapping = make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 2.5, 50));
+    const Model overlapping = with_film(make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 2.5, 50)), W, H);
     int most = 0;
     for (int j = 0; j < H; j += 3)
         for (int i = 0; i < W; i += 3)
-            most = std::max(most, overlap_lenses(with_film(overlapping, W, H), i, j, lenses, kMaxOverlapLenses));
+            most = std::max(most, overlap_lenses(overlapping, i, j, lenses, kMaxOverlapLenses));
     EXPECT_GE(most, 3) << "a main lens at half the matched f-number lights pixels through several lenses";
     EXPECT_LE(most, kMaxOverlapLenses);
 }

@@ -90,19 +90,19 @@ TEST(Stress, ExtremeParametersGiveFiniteUnitDirections)
     for (StressCase& c : stress_cases()) {
         c.params.sampling.samples = 4;
         ASSERT_EQ(check_camera(c.params), "") << c.name;
-        const Model m = make_model(c.params);
+        const Model m = with_film(make_model(c.params), W, H);
         int unblocked = 0;
         for (int j = 0; j < H; ++j) {
             for (int i = 0; i < W; ++i) {
                 for (int n = 0; n < 4; ++n) {
                     OpticsRay ray;
-                    if ((ray = generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, 4), nullptr)).passed) {
+                    if ((ray = generate_ray(m, i, j, make_sample(i, j, n, 4), nullptr)).passed) {
                         ++unblocked;
                         expect_unit_and_finite(ray, c.name + " generate_ray");
                     }
                 }
-                expect_unit_and_finite(chief_ray(with_film(m, W, H), i, j), c.name + " chief_ray");
-                const Rgbt value = shade_pixel(with_film(m, W, H), i, j, [](const OpticsRay& r) {
+                expect_unit_and_finite(chief_ray(m, i, j), c.name + " chief_ray");
+                const Rgbt value = shade_pixel(m, i, j, [](const OpticsRay& r) {
                     return Rgbt{r.dir.x, r.dir.y, r.dir.z, 0};
                 });
                 ASSERT_TRUE(std::isfinite(value.r) && std::isfinite(value.g) && std::isfinite(value.b) &&
@@ -113,11 +113,11 @@ TEST(Stress, ExtremeParametersGiveFiniteUnitDirections)
         RecordProperty(c.name, unblocked);
         for (double z : {1.0, 60.0, 1e4, 1e9}) {
             const double point[3] = {0.01 * z, -0.02 * z, z};
-            for (const PixelHit& hit : forward_project(with_film(m, W, H), point))
+            for (const PixelHit& hit : forward_project(m, point))
                 ASSERT_TRUE(std::isfinite(hit.u) && std::isfinite(hit.v)) << c.name << " z " << z;
         }
         CameraFrame frame = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-        const std::string json = metadata_json(with_film(m, W, H), c.params, frame, "");
+        const std::string json = metadata_json(m, c.params, frame, "");
         EXPECT_EQ(json.find("nan"), std::string::npos) << c.name;
         EXPECT_EQ(json.find("inf"), std::string::npos) << c.name;
     }
@@ -130,15 +130,15 @@ TEST(Stress, HugeCoordinatesDoNotOverflowTheLattice)
     ASSERT_EQ(check_camera(p), "");
     EXPECT_NE(check_camera(plenoptic_camera(GridType::Hexagonal, 1e-200, 1e-200, 1e-200, 50, 4, 52)), "")
         << "lengths below 1 nm leave double precision in products: refused";
-    const Model m = make_model(p);
+    const Model m = with_film(make_model(p), 8, 8);
     for (int n = 0; n < 16; ++n) {
         OpticsRay ray;
-        if ((ray = generate_ray(with_film(m, 8, 8), 0, 0, make_sample(0, 0, n, 16), nullptr)).passed)
+        if ((ray = generate_ray(m, 0, 0, make_sample(0, 0, n, 16), nullptr)).passed)
             expect_unit_and_finite(ray, "tiny pitch");
     }
     const double point[3] = {1, 2, 1000};
-    EXPECT_TRUE(forward_project(with_film(m, 8, 8), point).size() <= 1u);
-    const MicroimageLattice lattice = microimage_lattice(with_film(m, 8, 8));
+    EXPECT_TRUE(forward_project(m, point).size() <= 1u);
+    const MicroimageLattice lattice = microimage_lattice(m);
     if (lattice.lftoolbox_valid) {
         for (double x : {lattice.h_spacing, lattice.v_spacing, lattice.h_offset, lattice.v_offset, lattice.rot})
             EXPECT_TRUE(std::isfinite(x)) << "LFToolbox fields of a 1 nm pitch array";

@@ -117,14 +117,14 @@ TEST(Optics, TiltedArrayLatticeIsMarkedApproximate)
 {
     CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.137, 0.7, 0.7, 50, 5, 52);
     test::set_pose(&params, 1, 0, 0, 0, 0, 0);
-    const Model m = make_model(params);
-    const MicroimageLattice lattice = microimage_lattice(with_film(m, 320, 240));
+    const Model m = with_film(make_model(params), 320, 240);
+    const MicroimageLattice lattice = microimage_lattice(m);
     ASSERT_TRUE(lattice.valid);
     EXPECT_FALSE(lattice.exact);
     // Still a tenth of a pixel near the centre.
     double u0, v0, u1, v1;
-    ASSERT_TRUE(microimage_centre_px(with_film(m, 320, 240), LensIndex{0, 0}, &u0, &v0));
-    ASSERT_TRUE(microimage_centre_px(with_film(m, 320, 240), LensIndex{1, 0}, &u1, &v1));
+    ASSERT_TRUE(microimage_centre_px(m, LensIndex{0, 0}, &u0, &v0));
+    ASSERT_TRUE(microimage_centre_px(m, LensIndex{1, 0}, &u1, &v1));
     EXPECT_NEAR(u1 - u0, lattice.basis_a_px[0], 0.1);
     EXPECT_NEAR(v1 - v0, lattice.basis_a_px[1], 0.1);
 }

@@ -160,13 +160,13 @@ TEST(TracedProjection, AWeakSingletImagesWhereTheThinLensDoes)
     for (CameraParams* c : {&real, &thin}) {
         c->sensor.pixel_size_mm[0] = c->sensor.pixel_size_mm[1] = 0.01;
     }
-    const Model mr = make_model(real), mt = make_model(thin);
+    const Model mr = with_film(make_model(real), 301, 201), mt = with_film(make_model(thin), 301, 201);
     ASSERT_EQ(test::lens_kind(mr), "prescription");
     const double points[][3] = {{0, 0, 30000}, {5, -3, 25000}, {-20, 12, 50000}, {1, 0.5, 4000}};
     for (const auto& q : points) {
-        const std::vector<PixelHit> a = forward_project(with_film(mt, 301, 201), q);
+        const std::vector<PixelHit> a = forward_project(mt, q);
         const double in_real[3] = {q[0], q[1], q[2] + front_h};
-        const std::vector<PixelHit> b = forward_project(with_film(mr, 301, 201), in_real);
+        const std::vector<PixelHit> b = forward_project(mr, in_real);
         ASSERT_FALSE(a.empty());
         const Difference d = compare(a, b, 0.05);
         EXPECT_EQ(d.unmatched, 0) << "point z " << q[2];
@@ -177,11 +177,11 @@ TEST(TracedProjection, AWeakSingletImagesWhereTheThinLensDoes)
 
 TEST(TracedProjection, RefusesPointsBehindTheFrontWindow)
 {
-    const Model m = make_model(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52));
+    const Model m = with_film(make_model(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52)), 301, 201);
     const TracedProjectionOptions options = default_traced_projection_options();
-    EXPECT_TRUE(forward_project_traced(with_film(m, 301, 201), Vec3{0, 0, -10}, options).empty());
-    EXPECT_TRUE(forward_project_traced(with_film(m, 301, 201), Vec3{0, 0, 0}, options).empty());
-    EXPECT_TRUE(forward_project_traced(with_film(m, 301, 201), Vec3{NAN, 0, 100}, options).empty());
+    EXPECT_TRUE(forward_project_traced(m, Vec3{0, 0, -10}, options).empty());
+    EXPECT_TRUE(forward_project_traced(m, Vec3{0, 0, 0}, options).empty());
+    EXPECT_TRUE(forward_project_traced(m, Vec3{NAN, 0, 100}, options).empty());
 }
 
 } // namespace

@@ -25,8 +25,8 @@ TEST(DistortionProfile, IdealThinLensHasNone)
 {
     CameraParams p = thin_lens_camera(50, 4, 60);
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.02;
-    const Model m = make_model(p);
-    const DistortionProfile profile = distortion_profile(with_film(m, 1200, 800), 17);
+    const Model m = with_film(make_model(p), 1200, 800);
+    const DistortionProfile profile = distortion_profile(m, 17);
     ASSERT_TRUE(profile.valid);
     ASSERT_EQ(profile.samples.size(), 17u);
     EXPECT_FALSE(profile.object_at_infinity);
@@ -47,8 +47,8 @@ TEST(DistortionProfile, ThinLensRadialDistortionFollowsThePolynomial)
     p.main.has_distortion = true;
     p.main.distortion = DistortionParams{{-0.12, 0.03, -0.004}, {0, 0}};
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.02;
-    const Model m = make_model(p);
-    const DistortionProfile profile = distortion_profile(with_film(m, 1200, 800), 9);
+    const Model m = with_film(make_model(p), 1200, 800);
+    const DistortionProfile profile = distortion_profile(m, 9);
     ASSERT_TRUE(profile.valid);
     ASSERT_EQ(profile.samples.size(), 9u);
     for (const DistortionSample& s : profile.samples) {
@@ -92,13 +92,13 @@ TEST(DistortionProfile, StopPositionGivesTheSignOfASinglesDistortion)
 {
     // Stop in front of a positive lens: barrel; behind it: pincushion. The thick-lens model of
     // the same prescription (paraxial) has none.
-    const Model front = singlet_camera(20, MainLensType::Prescription);
-    const Model behind = singlet_camera(-20, MainLensType::Prescription);
-    const Model thick = singlet_camera(20, MainLensType::ThickLens);
+    const Model front = with_film(singlet_camera(20, MainLensType::Prescription), 1500, 1000);
+    const Model behind = with_film(singlet_camera(-20, MainLensType::Prescription), 1500, 1000);
+    const Model thick = with_film(singlet_camera(20, MainLensType::ThickLens), 1500, 1000);
     ASSERT_EQ(test::lens_kind(front), "prescription");
-    const DistortionProfile a = distortion_profile(with_film(front, 1500, 1000), 9);
-    const DistortionProfile b = distortion_profile(with_film(behind, 1500, 1000), 9);
-    const DistortionProfile c = distortion_profile(with_film(thick, 1500, 1000), 9);
+    const DistortionProfile a = distortion_profile(front, 9);
+    const DistortionProfile b = distortion_profile(behind, 9);
+    const DistortionProfile c = distortion_profile(thick, 9);
     ASSERT_TRUE(a.valid && b.valid && c.valid);
     ASSERT_EQ(a.samples.size(), 9u);
     ASSERT_EQ(b.samples.size(), 9u);

@@ -117,8 +117,8 @@ TEST(Metadata, PlenopticCameraWritesEveryField)
 {
     const CameraParams p = documented_camera();
     ASSERT_EQ(check_camera(p), "");
-    const Model m = make_model(p);
-    const std::string json = metadata_json(with_film(m, 640, 480), p, kFrame, "scene.depth.exr");
+    const Model m = with_film(make_model(p), 640, 480);
+    const std::string json = metadata_json(m, p, kFrame, "scene.depth.exr");
     parsed(json);
     const char* keys[] = {"\"format\": \"povray-plenoptic-metadata\"", "\"version\": 1", "\"image\"", "\"width\": 640",
                           "\"height\": 480", "\"mm_per_unit\": 1000", "\"camera_frame\"", "\"location\": [0, 0.5, -3]",
@@ -189,8 +189,8 @@ TEST(Metadata, NumbersAreWrittenInTheirShortestRoundTripForm)
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.01;
     test::set_pose(&p, 0, 0, 0.3, 0.01, 0, 0);
     ASSERT_EQ(check_camera(p), "");
-    const Model m = make_model(p);
-    const std::string json = metadata_json(with_film(m, 640, 480), p, kFrame, "");
+    const Model m = with_film(make_model(p), 640, 480);
+    const std::string json = metadata_json(m, p, kFrame, "");
     parsed(json);
     EXPECT_TRUE(has(json, "\"pitch_mm\": 0.15,")) << json;
     EXPECT_TRUE(has(json, "\"focal_lengths_mm\": [0.6, 2.1, 2.2]")) << json;
@@ -229,8 +229,8 @@ TEST(Metadata, ExtremeNumbersReadBackExactly)
 TEST(Metadata, SensorReadOut)
 {
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.1, 0.4, 0.4, 50, 4, 52);
-    const Model m = make_model(p);
-    EXPECT_TRUE(parsed(metadata_json(with_film(m, 64, 48), p, kFrame, ""))["sensor"]["read_out"].is_null());
+    const Model m = with_film(make_model(p), 64, 48);
+    EXPECT_TRUE(parsed(metadata_json(m, p, kFrame, ""))["sensor"]["read_out"].is_null());
     SensorChainParams& c = p.sensor.chain;
     c.given = true;
     c.bayer = BayerPattern::GRBG;
@@ -239,7 +239,7 @@ TEST(Metadata, SensorReadOut)
     c.read_noise_e = 3;
     c.black_level_dn = 64;
     c.seed = 7;
-    Json out = parsed(metadata_json(with_film(m, 64, 48), p, kFrame, with_raw("scene.raw.png")))["sensor"]["read_out"];
+    Json out = parsed(metadata_json(m, p, kFrame, with_raw("scene.raw.png")))["sensor"]["read_out"];
     EXPECT_EQ(out["raw_file"], "scene.raw.png");
     EXPECT_EQ(out["bayer"], "grbg");
     EXPECT_EQ(out["bit_depth"], 10);
@@ -250,7 +250,7 @@ TEST(Metadata, SensorReadOut)
     EXPECT_EQ(out["gain_dn_per_e"].get<double>(), (1023.0 - 64) / 4500);
     // Asked for but not written (the file could not be written): the parameters, and no file.
     c.bayer = BayerPattern::None;
-    out = parsed(metadata_json(with_film(m, 64, 48), p, kFrame, ""))["sensor"]["read_out"];
+    out = parsed(metadata_json(m, p, kFrame, ""))["sensor"]["read_out"];
     EXPECT_TRUE(out["raw_file"].is_null());
     EXPECT_TRUE(out["bayer"].is_null());
 }
@@ -258,13 +258,13 @@ TEST(Metadata, SensorReadOut)
 TEST(Metadata, StringsAreEscapedAndValidUtf8)
 {
     CameraParams p = plenoptic_camera(GridType::Rectangular, 0.1, 2.0, 2.0, 50, 4, 52);
-    const Model m = make_model(p);
-    std::string json = metadata_json(with_film(m, 64, 48), p, kFrame, "dir\\name \"quoted\"\t\xc3\xa9.exr");
+    const Model m = with_film(make_model(p), 64, 48);
+    std::string json = metadata_json(m, p, kFrame, "dir\\name \"quoted\"\t\xc3\xa9.exr");
     EXPECT_EQ(parsed(json)["depth_map"].get<std::string>(), "dir\\name \"quoted\"\t\xc3\xa9.exr");
     EXPECT_TRUE(has(json, "\"depth_map\": \"dir\\\\name \\\"quoted\\\"\\t\xc3\xa9.exr\"")) << json;
     // A file name that is not UTF-8 (Latin-1 bytes) cannot be JSON text: each bad byte is written
     // as U+FFFD and the file stays valid.
-    json = metadata_json(with_film(m, 64, 48), p, kFrame, "caf\xe9\xff.exr");
+    json = metadata_json(m, p, kFrame, "caf\xe9\xff.exr");
     EXPECT_EQ(parsed(json)["depth_map"].get<std::string>(), "caf\xef\xbf\xbd\xef\xbf\xbd.exr") << json;
     // A rectangular grid has no LFToolbox row shift.
     EXPECT_TRUE(has(json, "\"FirstPosShiftRow\": null")) << json;
@@ -334,9 +334,9 @@ TEST(Metadata, LatticeFieldsMatchTheMicroimageLattice)
 {
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2.0, 2.0, 50, 4, 52);
     test::set_pose(&p, 0, 0, 2, 0, 0, 0);
-    const Model m = make_model(p);
-    const MicroimageLattice lattice = microimage_lattice(with_film(m, 640, 480));
-    const Json doc = parsed(metadata_json(with_film(m, 640, 480), p, kFrame, ""));
+    const Model m = with_film(make_model(p), 640, 480);
+    const MicroimageLattice lattice = microimage_lattice(m);
+    const Json doc = parsed(metadata_json(m, p, kFrame, ""));
     const Json& grid = doc["lftoolbox_lenslet_grid_model"];
     EXPECT_EQ(grid["HSpacing"].get<double>(), lattice.h_spacing);
     EXPECT_EQ(grid["Rot"].get<double>(), lattice.rot);
@@ -351,7 +351,7 @@ TEST(Metadata, LatticeFieldsMatchTheMicroimageLattice)
 TEST(Metadata, MicroimagesSummaryIsWrittenAsGiven)
 {
     const CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2.0, 2.0, 50, 4, 52);
-    const Model m = make_model(p);
+    const Model m = with_film(make_model(p), 640, 480);
     MicroimageSummary summary = MicroimageSummary();
     summary.file = "scene.microimages.csv";
     summary.lenses = 12;
@@ -368,7 +368,7 @@ TEST(Metadata, MicroimagesSummaryIsWrittenAsGiven)
     summary.fit.worst = LensIndex{-3, 2};
     summary.from_lattice_rms_px = 0.25;
     summary.from_lattice_max_px = 1.5;
-    const Json doc = parsed(metadata_json(with_film(m, 640, 480), p, kFrame, with_microimages(&summary)));
+    const Json doc = parsed(metadata_json(m, p, kFrame, with_microimages(&summary)));
     const Json& mi = doc["microimages"];
     std::vector<std::string> names;
     for (auto it = mi.begin(); it != mi.end(); ++it)
@@ -384,7 +384,7 @@ TEST(Metadata, MicroimagesSummaryIsWrittenAsGiven)
     EXPECT_EQ(mi["lattice_fit"]["max_residual_lens"], Json::parse("[-3, 2]"));
     EXPECT_EQ(mi["from_microimage_lattice"]["max_px"].get<double>(), 1.5);
     summary.fit.valid = false;
-    EXPECT_TRUE(parsed(metadata_json(with_film(m, 640, 480), p, kFrame, with_microimages(&summary)))["microimages"]["lattice_fit"].is_null());
+    EXPECT_TRUE(parsed(metadata_json(m, p, kFrame, with_microimages(&summary)))["microimages"]["lattice_fit"].is_null());
 }
 
 TEST(Metadata, DistortionProfileOfAThinLensWithDistortion)

@@ -221,13 +221,13 @@ TEST(MicroimageTruth, CancellingStopsAtTheNextLensAndReturnsNothing)
 {
     CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 8, 52);
     params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.01;
-    const Model m = make_model(params);
+    const Model m = with_film(make_model(params), 401, 301);
     MicroimageOptions options = default_microimage_options();
     options.threads = 2;
-    ASSERT_GT(microimage_truth(with_film(m, 401, 301), options).size(), 50u);
+    ASSERT_GT(microimage_truth(m, options).size(), 50u);
     int polls = 0;
     std::size_t reports = 0;
-    const std::vector<MicroimageTruth> none = microimage_truth(with_film(m, 401, 301), options, [&](std::size_t done, std::size_t) { reports = done; }, [&]() { return ++polls > 5; });
+    const std::vector<MicroimageTruth> none = microimage_truth(m, options, [&](std::size_t done, std::size_t) { reports = done; }, [&]() { return ++polls > 5; });
     EXPECT_TRUE(none.empty());
     EXPECT_EQ(polls, 6);  // polled before each lens of the calling thread, stopped at the first true
     EXPECT_LT(reports, 50u);
@@ -235,13 +235,13 @@ TEST(MicroimageTruth, CancellingStopsAtTheNextLensAndReturnsNothing)
 
 TEST(MicroimageTruth, NothingWithoutAnArrayOrAMainLens)
 {
-    const Model no_array = make_model(test::thin_lens_camera(50, 4, 52));
-    EXPECT_TRUE(microimage_truth(with_film(no_array, 100, 100), default_microimage_options()).empty());
+    const Model no_array = with_film(make_model(test::thin_lens_camera(50, 4, 52)), 100, 100);
+    EXPECT_TRUE(microimage_truth(no_array, default_microimage_options()).empty());
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52);
     p.main.given = false;
     p.main.type = MainLensType::None;
-    const Model no_main = make_model(p);
-    EXPECT_TRUE(microimage_truth(with_film(no_main, 100, 100), default_microimage_options()).empty());
+    const Model no_main = with_film(make_model(p), 100, 100);
+    EXPECT_TRUE(microimage_truth(no_main, default_microimage_options()).empty());
 }
 
 } // namespace
