@@ -13,29 +13,27 @@ camera is recognised only inside `camera { plenoptic ... }`. Three checks:
 3. Declared identifiers of every other kind, named like the block words (`sensor` an object,
    `main_lens` a vector...), do not stop those words from working as keywords.
 
-The words come from the parser's own table (kContextWords in
-source/povray_glue/parse_plenoptic.cpp), so a keyword added later is covered without
-editing this test; the words known when the test was written must all be in that table.
+The words come from the parser's own keyword table (source/povray_glue/plenoptic_keywords.cpp,
+listed by plenoptic-keyword-table from --build-dir): its words that are not POV-Ray reserved
+words, so a keyword added later is covered without editing this test; the words known when the
+test was written must all be in that table.
 """
 import os
-import re
 
 import numpy as np
 import pytest
 
 import plenoptic_testing as pt
+from plenoptic_testing.keywords import keyword_table
 
 KNOWN_WORDS = {"main_lens", "microlens_array", "sensor", "thin_lens", "pinhole", "focal_length",
                "focal_lengths", "f_number", "focus_distance", "hexagonal", "rectangular", "pitch",
                "pixel_size", "depth_map", "microimage_centres"}
 
 
-def camera_words(parser_source):
-    with open(parser_source) as f:
-        text = f.read()
-    table = re.search(r"kContextWords\[\]\s*=\s*\{(.*?)\};", text, re.S)
-    assert table, "no kContextWords table in %s" % parser_source
-    return sorted(set(re.findall(r'\{\s*"([a-z_0-9]+)"\s*,\s*Word::', table.group(1))))
+def camera_words(build_dir):
+    """The table's words that are the camera's own (not POV-Ray reserved words), each once."""
+    return sorted({k.word for k in keyword_table(build_dir) if not k.reserved})
 
 
 def render(povray, scene_text, name, work, width=96, height=72, extra=()):
@@ -168,7 +166,7 @@ def metadata(work, name):
 
 @pytest.fixture(scope="module")
 def words(args):
-    words = camera_words(os.path.join(args.source_dir, "source", "povray_glue", "parse_plenoptic.cpp"))
+    words = camera_words(args.build_dir)
     print("camera words read in context (%d): %s" % (len(words), " ".join(words)))
     return words
 
