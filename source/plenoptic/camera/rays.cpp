@@ -124,8 +124,6 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
     if (m.grid == GridType::None) {
         // The sensor point towards a point of the exit pupil, through the lens.
         const Vec3 on_pupil = m.lens->exit_pupil_point(lens_u, lens_v);
-        if (!m.lens->forms_image())
-            return weigh(m, finish(on_pupil, on_pupil - p, out), p, on_pupil, Vec3{0, 0, 1}, out);
         return weigh(m, emit(m.lens->to_scene(p, on_pupil - p, false), out), p, on_pupil, Vec3{0, 0, 1}, out);
     }
 
