@@ -174,14 +174,11 @@ Model make_model(const CameraParams& params)
 
     m.irradiance_k_mm2 = irradiance_constant_mm2(m);
 
-    if (m.lens && m.lens->traced()) {
-        // The round stop holds the iris: bounds from the lens without blades hold the lens with them.
-        Prescription round = m.prescription;
-        round.blades = 0;
-        const std::shared_ptr<const MainLens> traced = make_prescription_lens(round, 0, true, m.distance_mm);
-        m.pupil_bounds = std::make_shared<PupilBounds>(round, *traced, m.grid == GridType::None ? m.sensor_z_mm : m.pose.centre_mm.z);
-        if (m.grid == GridType::None && m.prescription.blades == 0)
-            m.lit_area = std::make_shared<LitAreaTable>(*traced, *m.pupil_bounds, m.irradiance_k_mm2, m.angular_exponent);
+    if (m.lens) {
+        // The lens says where light from the array's plane (or the sensor's) passes it.
+        m.pupil_bounds = m.lens->pupil_bounds(m.grid == GridType::None ? m.sensor_z_mm : m.pose.centre_mm.z);
+        if (m.pupil_bounds && m.grid == GridType::None)
+            m.lit_area = m.lens->lit_area(*m.pupil_bounds, m.irradiance_k_mm2, m.angular_exponent);
     }
 
     for (int a = 0; a < 2; ++a) {

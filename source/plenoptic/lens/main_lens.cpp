@@ -7,6 +7,8 @@
 #include <cmath>
 
 #include "plenoptic/core/format.h"
+#include "plenoptic/lens/lit_area.h"
+#include "plenoptic/lens/pupil_bounds.h"
 #include "plenoptic/core/sampling.h"
 
 namespace plenoptic {
@@ -250,9 +252,25 @@ private:
 // a lens of revolution does not notice; the iris is turned with it).
 class ExactMainLens : public MainLens {
 public:
-    ExactMainLens(const Prescription& lens, double length, const ThickMainLens& paraxial)
-        : lens_(lens), unbounded_(unbounded(lens)), length_(length), paraxial_(paraxial)
+    ExactMainLens(const Prescription& lens, double length, const ThickMainLens& paraxial, double image_distance_mm)
+        : lens_(lens), unbounded_(unbounded(lens)), length_(length), paraxial_(paraxial),
+          image_distance_mm_(image_distance_mm)
     {
+    }
+    std::shared_ptr<const PupilBounds> pupil_bounds(double plane_z) const override
+    {
+        // The round stop holds the iris: bounds from the lens without blades hold the lens with them.
+        Prescription round = *prescription();
+        round.blades = 0;
+        const std::shared_ptr<const MainLens> traced = make_prescription_lens(round, 0, true, image_distance_mm_);
+        return std::make_shared<PupilBounds>(round, *traced, plane_z);
+    }
+    std::shared_ptr<const LitAreaTable> lit_area(const PupilBounds& bounds, double irradiance_k_mm2,
+                                                 double angular_exponent) const override
+    {
+        if (prescription()->blades != 0)
+            return nullptr;  // a blade iris: the per-pixel probes measure it
+        return std::make_shared<LitAreaTable>(*this, bounds, irradiance_k_mm2, angular_exponent);
     }
     const char* kind_name() const override { return "prescription"; }
     const char* chief_ray_description() const override { return "through the centre of the aperture stop (traced)"; }
@@ -311,6 +329,7 @@ private:
     TracingLens unbounded_;  // the same without clear apertures or iris
     double length_;
     ThickMainLens paraxial_;
+    double image_distance_mm_;  // where the axial beam the pupils belong to converges (NaN: the stop's)
 };
 
 } // namespace
@@ -330,7 +349,7 @@ std::shared_ptr<const MainLens> make_prescription_lens(const Prescription& lens,
     const ThickMainLens thick(sized, p);
     if (!exact)
         return std::make_shared<ThickMainLens>(thick);
-    return std::make_shared<ExactMainLens>(sized, length, thick);
+    return std::make_shared<ExactMainLens>(sized, length, thick, image_distance_mm);
 }
 
 std::shared_ptr<const MainLens> make_pinhole_lens() { return std::make_shared<PinholeMainLens>(); }

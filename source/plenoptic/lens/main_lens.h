@@ -45,6 +45,9 @@ struct FrontWindow {
     double z, radius, sag;
 };
 
+class PupilBounds;
+class LitAreaTable;
+
 class MainLens {
 public:
     virtual ~MainLens() {}
@@ -73,6 +76,25 @@ public:
     virtual bool front_window(FrontWindow* window) const { (void)window; return false; }
     // The paraxial entrance pupil: optics-frame z and radius.
     virtual FrontWindow entrance_pupil() const { return FrontWindow{0, 0, 0}; }
+    // Where light from points of the plane z = plane_z (the array, or the sensor) passes the lens:
+    // made for a lens traced surface by surface (lens/pupil_bounds.h); nullptr for the others,
+    // whose exit pupil says it.
+    virtual std::shared_ptr<const PupilBounds> pupil_bounds(double plane_z) const
+    {
+        (void)plane_z;
+        return nullptr;
+    }
+    // Without an array: the lit area of the exit pupil's plane per sensor radius, from these
+    // bounds, its samples weighted as the camera weighs them (irradiance_weight with K; K = 0:
+    // flat); nullptr where the lens has no such table (an ideal lens, a blade iris).
+    virtual std::shared_ptr<const LitAreaTable> lit_area(const PupilBounds& bounds, double irradiance_k_mm2,
+                                                         double angular_exponent) const
+    {
+        (void)bounds;
+        (void)irradiance_k_mm2;
+        (void)angular_exponent;
+        return nullptr;
+    }
     // Advice when a render would be almost dark, or when microimages overlap by `free_mm` too
     // little on the array (magnification k = d / D): "" when the lens has none to give.
     virtual std::string dark_image_advice(double distance_mm) const { (void)distance_mm; return ""; }
