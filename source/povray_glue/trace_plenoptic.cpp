@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // The renderer's side of the plenoptic camera: one pixel, shaded by the pure optics in
-// source/plenoptic/ with POV-Ray's tracer behind each ray.
+// source/plenoptic/ with POV-Ray's tracer behind each ray; the render's outputs that follow the
+// pixels (the depth map) see the scene through the same tracer first.
 
 #include <cmath>
 #include <limits>
@@ -36,6 +37,18 @@ void To_Scene(const plenoptic::Render& render, const plenoptic::OpticsRay& in, R
 		VNormalizeEq(out.Direction);
 }
 
+// The scene as the outputs see it from this thread: the first surface along a camera ray.
+template <class FirstHit>
+class Probe : public plenoptic::SceneProbe
+{
+	public:
+		explicit Probe(FirstHit& first_hit) : first_hit_(first_hit) {}
+		double first_hit(const plenoptic::OpticsRay& ray) { return first_hit_(ray); }
+		void cooperate() { Task::CurrentTaskCooperate(); }
+	private:
+		FirstHit& first_hit_;
+};
+
 }
 
 void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DBL height)
@@ -51,32 +64,19 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 	// Antialiasing may ask for sub-pixel positions: the camera samples the whole pixel itself.
 	const int i = (int)std::floor(x + 0.5), j = (int)std::floor(y + 0.5);
 
-	plenoptic::DepthMap *depth = render.depth();
-	if (depth != NULL && !pretrace)
+	if (render.traces_pixels() && !pretrace)
 	{
-		// Distance along a pixel's chief ray, from the lens it leaves to the first surface;
-		// +inf where it hits nothing, -1 where no sample of the pixel passes the apertures.
-		auto depth_of = [&](int column, int row) -> float
+		// Distance along an optics ray to the first surface; +inf where it hits nothing.
+		auto first_hit = [&](const plenoptic::OpticsRay& optics_ray) -> double
 		{
-			if (!plenoptic::pixel_receives_light(model, column, row))
-				return -1.0f;
 			Ray ray;
 			ray.SetFlags(Ray::PrimaryRay, false, false, false, false, pretrace);
-			To_Scene(render, plenoptic::chief_ray(model, column, row), ray);
+			To_Scene(render, optics_ray, ray);
 			Intersection isect;
-			return FindIntersection(isect, ray) ? (float)isect.Depth : std::numeric_limits<float>::infinity();
+			return FindIntersection(isect, ray) ? isect.Depth : std::numeric_limits<double>::infinity();
 		};
-		depth->set(i, j, depth_of(i, j));
-		// A continued render (+C) owes the depth of the blocks it does not trace: a share of it
-		// with each traced pixel, a row of a block at a time, stopping promptly when asked to.
-		plenoptic::DepthBackfill *backfill = render.backfill();
-		backfill->pixel_traced();
-		for (plenoptic::PixelRun run = backfill->next_due(); !run.none(); run = backfill->next_due())
-		{
-			for (int column = run.left; column <= run.right; column++)
-				depth->set(column, run.row, depth_of(column, run.row));
-			Task::CurrentTaskCooperate();
-		}
+		Probe<decltype(first_hit)> scene(first_hit);
+		render.pixel_traced(i, j, scene);
 	}
 
 	POV_ULONG traced = 0;  // camera rays into the scene, for the render statistics' "Samples"

@@ -2,8 +2,8 @@
 // The sensor's raw as a 16-bit PNG: grey for a Bayer mosaic, RGB otherwise, the values
 // the DN themselves (no scaling), with an sBIT chunk giving the sensor's bit depth.
 
-#ifndef POVRAY_GLUE_PLENOPTIC_RAW_PNG_H
-#define POVRAY_GLUE_PLENOPTIC_RAW_PNG_H
+#ifndef POVRAY_GLUE_OUTPUTS_RAW_PNG_H
+#define POVRAY_GLUE_OUTPUTS_RAW_PNG_H
 
 #include <cstdint>
 #include <string>

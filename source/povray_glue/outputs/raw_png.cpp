@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // The sensor's raw as a 16-bit PNG (see the header), encoded in memory with libpng.
 
-#include "povray_glue/plenoptic_raw_png.h"
+#include "povray_glue/outputs/raw_png.h"
 
 #include <csetjmp>
 

@@ -1,0 +1,31 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Writing the files beside an image: each to a temporary name in the same directory, renamed
+// onto its own name once complete, so no file is ever left half-written. Failures are reported
+// on stderr as "plenoptic camera: cannot write <what> <path>: <reason>".
+
+#ifndef POVRAY_GLUE_OUTPUTS_FILES_H
+#define POVRAY_GLUE_OUTPUTS_FILES_H
+
+#include <functional>
+#include <string>
+
+namespace plenoptic {
+
+// `path` with its extension (if any) replaced by `suffix`: dir/name.ext -> dir/name<suffix>.
+std::string replace_extension(const std::string& path, const std::string& suffix);
+
+// The file's name without its directory (as the metadata names the files beside the image).
+std::string base_name(const std::string& path);
+
+// Writes `bytes` to `path`; `what` names the file in messages.
+bool write_file_atomically(const char* what, const std::string& path, const std::string& bytes);
+
+// Writes a W x H one-channel float EXR (channel `channel`) row by row (memory: one row):
+// fill(j, row) fills row j and returns false to stop (cancelled: nothing is written, no
+// message). `what` names the file in messages.
+bool write_float_exr(const std::string& path, const char* what, const char* channel, int W, int H,
+                     const std::function<bool(int j, float* row)>& fill);
+
+} // namespace plenoptic
+
+#endif

@@ -1,0 +1,60 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The microimage centres output: <image>.microimages.csv, the microimages of a white scene through
+// this camera (truth/microimages.h), and their summary in the metadata. Needs a main lens and an
+// array; `microimage_centres` on or off, and by default written only where the centres leave the
+// lattice the metadata gives (a traced lens, a thin lens with distortion).
+
+#include <cstdio>
+
+#include "plenoptic/truth/microimages.h"
+#include "povray_glue/outputs/files.h"
+#include "povray_glue/outputs/render.h"
+
+namespace plenoptic {
+
+namespace {
+
+class MicroimagesOutput : public Output {
+public:
+    bool write(const WrittenImage& image, SidecarFiles& files) override
+    {
+        const Model& model = image.camera;
+        const MicroimageOptions options = default_microimage_options();
+        // Seconds for large arrays (about 0.5 ms a lens and thread behind a real lens): say how far.
+        const MicroimageProgress progress = [](std::size_t done, std::size_t total) {
+            if (total >= 20000)
+                std::fprintf(stderr, "plenoptic camera: microimage centres: %zu of %zu lenses\n", done, total);
+        };
+        const std::vector<MicroimageTruth> truth = microimage_truth(model, options, progress, image.cancelled);
+        const std::string path = image.beside(".microimages.csv");
+        if (image.cancelled()) {
+            std::fprintf(stderr, "plenoptic camera: cancelled: no microimage centres written (%s); the metadata says "
+                                 "\"microimages\": null.\n", path.c_str());
+            return true;
+        }
+        MicroimageSummary summary = summarise_microimages(model, truth, options, base_name(path));
+        if (!write_file_atomically("microimage centres", path, microimages_csv(model, truth, summary.fit)))
+            return false;
+        summary_.reset(new MicroimageSummary(summary));
+        files.microimages = summary_.get();
+        return true;
+    }
+
+private:
+    std::unique_ptr<MicroimageSummary> summary_;  // what the metadata names, once written
+};
+
+} // namespace
+
+std::unique_ptr<Output> start_microimages(const Render& render, const RenderArea&)
+{
+    const Model& model = render.model();
+    const CameraSetup::MicroimageCentres asked = render.setup().microimage_centres;
+    const bool off_lattice = (model.lens && model.lens->traced()) || model.has_distortion;
+    if (model.grid == GridType::None || !model.lens ||
+        !(asked == CameraSetup::kWrite || (asked == CameraSetup::kDefault && off_lattice)))
+        return nullptr;
+    return std::unique_ptr<Output>(new MicroimagesOutput());
+}
+
+} // namespace plenoptic
