@@ -24,6 +24,16 @@ bool inside_disc(double x, double y, double radius)
     return std::hypot(x, y) <= radius;
 }
 
+// Whether the line from `origin` along `direction` passes through the origin, heading towards it
+// (to rounding).
+bool through_origin(Vec3 origin, Vec3 direction)
+{
+    const Vec3 to_pinhole = -origin;
+    const Vec3 c = cross(to_pinhole, direction);
+    return !(dot(c, c) > 1e-24 * dot(to_pinhole, to_pinhole) * dot(direction, direction)) &&
+           dot(to_pinhole, direction) > 0;
+}
+
 // Every ray through it passes through the origin.
 class PinholeMainLens : public MainLens {
 public:
@@ -33,20 +43,16 @@ public:
     Vec3 exit_pupil_centre() const override { return Vec3{0, 0, 0}; }
     double exit_pupil_radius() const override { return 0; }
     Vec3 exit_pupil_point(double, double) const override { return Vec3{0, 0, 0}; }
+    // Only the line through the pinhole passes: the caller aims at it (exit_pupil_point).
     SceneRay to_scene(Vec3 origin, Vec3 direction, bool) const override
     {
-        // Only the line through the pinhole passes: the caller aims at it (exit_pupil_point).
-        const Vec3 to_pinhole = -origin;
-        const Vec3 c = cross(to_pinhole, direction);
-        if (dot(c, c) > 1e-24 * dot(to_pinhole, to_pinhole) * dot(direction, direction) || !(dot(to_pinhole, direction) > 0))
+        if (!through_origin(origin, direction))
             return SceneRay{origin, direction, false};
         return scene_ray(Vec3{0, 0, 0}, direction);
     }
     ImageRay to_image(Vec3 origin, Vec3 direction, bool) const override
     {
-        const Vec3 to_pinhole = -origin;
-        const Vec3 c = cross(to_pinhole, direction);
-        if (dot(c, c) > 1e-24 * dot(to_pinhole, to_pinhole) * dot(direction, direction) || !(dot(to_pinhole, direction) > 0))
+        if (!through_origin(origin, direction))
             return ImageRay{origin, direction, false};
         return image_ray(Vec3{0, 0, 0}, direction);
     }
