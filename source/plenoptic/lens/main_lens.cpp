@@ -304,25 +304,29 @@ public:
     Vec3 exit_pupil_point(double u, double v) const override { return paraxial_.exit_pupil_point(u, v); }
     SceneRay to_scene(Vec3 origin, Vec3 direction, bool check_apertures) const override
     {
-        const LensRay in{Vec3{origin.x, origin.y, length_ - origin.z}, normalized(Vec3{direction.x, direction.y, -direction.z})};
-        const Traced out = (check_apertures ? lens_ : unbounded_).trace_from_image(in);
+        const Traced out = (check_apertures ? lens_ : unbounded_).trace_from_image(to_lens(origin, direction));
         if (out.result != TraceResult::Passed)
             return SceneRay{origin, direction, false};
-        return scene_ray(Vec3{out.ray.origin.x, out.ray.origin.y, length_ - out.ray.origin.z},
-                         Vec3{out.ray.dir.x, out.ray.dir.y, -out.ray.dir.z});
+        return scene_ray(point_to_optics(out.ray.origin), direction_to_optics(out.ray.dir));
     }
     ImageRay to_image(Vec3 origin, Vec3 direction, bool check_apertures) const override
     {
-        const LensRay in{Vec3{origin.x, origin.y, length_ - origin.z}, normalized(Vec3{direction.x, direction.y, -direction.z})};
-        const Traced out = (check_apertures ? lens_ : unbounded_).trace_from_object(in);
+        const Traced out = (check_apertures ? lens_ : unbounded_).trace_from_object(to_lens(origin, direction));
         if (out.result != TraceResult::Passed)
             return ImageRay{origin, direction, false};
-        return image_ray(Vec3{out.ray.origin.x, out.ray.origin.y, length_ - out.ray.origin.z},
-                         Vec3{out.ray.dir.x, out.ray.dir.y, -out.ray.dir.z});
+        return image_ray(point_to_optics(out.ray.origin), direction_to_optics(out.ray.dir));
     }
     HomogeneousPoint paraxial_image(Vec3 point) const override { return paraxial_.paraxial_image(point); }
 
 private:
+    // Optics frame <-> lens frame: z_lens = length - z_optics, x and y unchanged (directions flip z).
+    LensRay to_lens(Vec3 origin, Vec3 direction) const
+    {
+        return LensRay{Vec3{origin.x, origin.y, length_ - origin.z}, normalized(Vec3{direction.x, direction.y, -direction.z})};
+    }
+    Vec3 point_to_optics(Vec3 p) const { return Vec3{p.x, p.y, length_ - p.z}; }
+    static Vec3 direction_to_optics(Vec3 d) { return Vec3{d.x, d.y, -d.z}; }
+
     TracingLens lens_;
     // Chief rays and depth maps want a ray for every pixel: no clear aperture blocks.
     static Prescription unbounded(Prescription lens)
