@@ -103,8 +103,10 @@ AiryKernel airy_kernel(double rx, double ry)
     k.ky = std::max(1, int(std::ceil(kAiryKernelRadii * ry)));
     const int w = 2 * k.kx + 1, h = 2 * k.ky + 1;
     k.weights.assign(size_t(w) * h, 0.0);
-    // Midpoint points per pixel side: enough to resolve the core of a pattern narrower than a pixel.
-    const int n = std::max(4, std::min(24, int(std::ceil(12 / std::min(rx, ry)))));
+    // Midpoint points per pixel side: enough to resolve the core of a pattern narrower than a pixel
+    // (compared as a double first: a pattern far narrower than a pixel asks for more than an int holds).
+    const double wanted = std::ceil(12 / std::min(rx, ry));
+    const int n = wanted < 24 ? std::max(4, int(wanted)) : 24;
     double total = 0;
     for (int dy = -k.ky; dy <= k.ky; ++dy)
         for (int dx = -k.kx; dx <= k.kx; ++dx) {
@@ -120,6 +122,12 @@ AiryKernel airy_kernel(double rx, double ry)
             k.weights[size_t((dy + k.ky) * w + (dx + k.kx))] = sum;
             total += sum;
         }
+    if (!(total > 0)) {
+        // The whole pattern lies between the midpoints of the centre pixel (an Airy radius below about
+        // 0.007 pixel, where its 4 radii fall short of the nearest midpoint at 1/48 pixel on each axis):
+        // all its light falls on that pixel.
+        k.weights[size_t(k.ky * w + k.kx)] = total = 1;
+    }
     for (double& weight : k.weights)
         weight /= total;
     return k;

@@ -20,6 +20,27 @@ double encircled_energy(double x)
     return 1 - j0 * j0 - j1 * j1;
 }
 
+TEST(Diffraction, PatternFarNarrowerThanAPixelStaysInItsPixel)
+{
+    // The centre pixel holds at least the light within the circle inscribed in it (half a pixel),
+    // over the window's share; down to radii where no sample point reaches the pattern (a fuzzer
+    // found 1e-16 px: the sample count overflowed an int and the weights divided by zero).
+    const double x1 = 3.8317059702075125;
+    for (double radius : {0.2, 0.05, 0.01, 0.004, 1e-6, 1e-16}) {
+        const AiryKernel k = airy_kernel(radius, radius);
+        EXPECT_EQ(k.kx, 1);
+        double total = 0;
+        for (double w : k.weights) {
+            ASSERT_TRUE(std::isfinite(w)) << radius;
+            total += w;
+        }
+        EXPECT_NEAR(total, 1, 1e-12) << radius;
+        const double inscribed = std::min(1.0, encircled_energy(0.5 / radius * x1) /
+                                                   encircled_energy(kAiryKernelRadii * x1));
+        EXPECT_GE(k.at(0, 0), inscribed - 0.01) << radius;
+    }
+}
+
 TEST(Diffraction, AiryPatternIsDarkAtItsRadiusAndOneAtTheCentre)
 {
     EXPECT_EQ(airy_intensity(0, 2.5), 1);
