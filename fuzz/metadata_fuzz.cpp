@@ -30,7 +30,7 @@ namespace {
 using namespace plenoptic;
 
 // The kind of a model's main lens, as the metadata names it ("none" without one).
-inline std::string lens_kind(const Model& m) { return m.lens ? m.lens->kind_name() : "none"; }
+inline std::string lens_kind(const PlenopticCamera& m) { return m.lens ? m.lens->kind_name() : "none"; }
 
 const std::string* g_text = nullptr;
 
@@ -65,31 +65,31 @@ void expect_same_camera(const RenderMetadata& a, const RenderMetadata& b)
 {
     FUZZ_ASSERT(a.width == b.width && a.height == b.height, "image %dx%d read back as %dx%d", a.width, a.height,
                 b.width, b.height);
-    const Model& m = a.model;
-    const Model& n = b.model;
-    FUZZ_ASSERT(lens_kind(m) == lens_kind(n) && m.grid == n.grid && m.microlens == n.microlens &&
-                    m.lens_type_count == n.lens_type_count,
+    const PlenopticCamera& m = a.model;
+    const PlenopticCamera& n = b.model;
+    FUZZ_ASSERT(lens_kind(m) == lens_kind(n) && m.array.grid == n.array.grid && m.array.microlens == n.array.microlens &&
+                    m.array.lens_type_count == n.array.lens_type_count,
                 "kinds differ after a round trip");
     FUZZ_ASSERT(same_double(m.mm_per_unit, n.mm_per_unit), "mm_per_unit %.17g -> %.17g", m.mm_per_unit, n.mm_per_unit);
     FUZZ_ASSERT(same_double(m.distance_mm, n.distance_mm), "D %.17g -> %.17g", m.distance_mm, n.distance_mm);
-    FUZZ_ASSERT(same_double(m.sensor_z_mm, n.sensor_z_mm), "sensor z %.17g -> %.17g", m.sensor_z_mm, n.sensor_z_mm);
+    FUZZ_ASSERT(same_double(m.sensor.z_mm, n.sensor.z_mm), "sensor z %.17g -> %.17g", m.sensor.z_mm, n.sensor.z_mm);
     if (lens_kind(m) == "thin_lens") {
-        FUZZ_ASSERT(same_double(m.focal_length_mm, n.focal_length_mm) && same_double(m.aperture_mm, n.aperture_mm),
-                    "main lens F %.17g A %.17g -> F %.17g A %.17g", m.focal_length_mm, m.aperture_mm,
-                    n.focal_length_mm, n.aperture_mm);
+        FUZZ_ASSERT(same_double(m.focal_length_mm(), n.focal_length_mm()) && same_double(m.aperture_mm(), n.aperture_mm()),
+                    "main lens F %.17g A %.17g -> F %.17g A %.17g", m.focal_length_mm(), m.aperture_mm(),
+                    n.focal_length_mm(), n.aperture_mm());
     }
-    if (m.grid != GridType::None) {
-        FUZZ_ASSERT(same_double(m.pitch_mm, n.pitch_mm) && same_double(m.array_distance_mm, n.array_distance_mm),
-                    "pitch %.17g d %.17g -> pitch %.17g d %.17g", m.pitch_mm, m.array_distance_mm, n.pitch_mm,
-                    n.array_distance_mm);
+    if (m.array.grid != GridType::None) {
+        FUZZ_ASSERT(same_double(m.array.pitch_mm, n.array.pitch_mm) && same_double(m.array.distance_mm, n.array.distance_mm),
+                    "pitch %.17g d %.17g -> pitch %.17g d %.17g", m.array.pitch_mm, m.array.distance_mm, n.array.pitch_mm,
+                    n.array.distance_mm);
         for (int i = 0; i < 3; ++i)
             FUZZ_ASSERT(same_double(a.params.array.rotate_deg[i], b.params.array.rotate_deg[i]) &&
                             same_double(a.params.array.translate_mm[i], b.params.array.translate_mm[i]),
                         "array pose [%d] differs after a round trip", i);
     }
     for (int i = 0; i < 2; ++i)
-        FUZZ_ASSERT(same_double(m.pixel_size_mm[i], n.pixel_size_mm[i]) &&
-                        same_double(m.sensor_offset_mm[i], n.sensor_offset_mm[i]),
+        FUZZ_ASSERT(same_double(m.sensor.pixel_size_mm[i], n.sensor.pixel_size_mm[i]) &&
+                        same_double(m.sensor.offset_mm[i], n.sensor.offset_mm[i]),
                     "sensor [%d] differs after a round trip", i);
     for (int i = 0; i < 3; ++i)
         FUZZ_ASSERT(same_double(a.frame.location[i], b.frame.location[i]) &&
@@ -115,8 +115,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     FUZZ_ASSERT(metadata.width >= 1 && metadata.height >= 1, "image %dx%d accepted", metadata.width, metadata.height);
     const std::string problem = check_camera(metadata.params);
     FUZZ_ASSERT(problem.empty(), "accepted a camera check_camera refuses: %s", problem.c_str());
-    const Model& m = metadata.model;
-    FUZZ_ASSERT(std::isfinite(m.sensor_z_mm) && m.sensor_z_mm < 0, "sensor plane z = %.17g", m.sensor_z_mm);
+    const PlenopticCamera& m = metadata.model;
+    FUZZ_ASSERT(std::isfinite(m.sensor.z_mm) && m.sensor.z_mm < 0, "sensor plane z = %.17g", m.sensor.z_mm);
 
     // Write what was read, read it again: the same camera, and the same text when written again.
     const std::string written =
@@ -133,8 +133,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 
     // Forward projection visits every lens that can image into the picture: only where that is a
     // few thousand lenses, to keep the fuzzer fast.
-    const double span_mm = std::max(metadata.width * m.pixel_size_mm[0], metadata.height * m.pixel_size_mm[1]);
-    if (m.grid == GridType::None || span_mm <= 64 * m.pitch_mm) {
+    const double span_mm = std::max(metadata.width * m.sensor.pixel_size_mm[0], metadata.height * m.sensor.pixel_size_mm[1]);
+    if (m.array.grid == GridType::None || span_mm <= 64 * m.array.pitch_mm) {
         const double points[3][3] = {{0, 0, 1}, {0.1, -0.05, 2}, {-3, 2, 50}};
         for (const auto& point : points) {
             for (const PixelHit& hit : project_world_point(metadata, point)) {

@@ -46,7 +46,7 @@ namespace {
 using namespace plenoptic;
 
 // The kind of a model's main lens, as the metadata names it ("none" without one).
-inline std::string lens_kind(const Model& m) { return m.lens ? m.lens->kind_name() : "none"; }
+inline std::string lens_kind(const PlenopticCamera& m) { return m.lens ? m.lens->kind_name() : "none"; }
 
 const double kInf = std::numeric_limits<double>::infinity();
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -338,25 +338,25 @@ void accepted_values_are_sane(const CameraParams& p)
     }
 }
 
-void model_is_sane(const Model& m)
+void model_is_sane(const PlenopticCamera& m)
 {
-    FUZZ_ASSERT(std::isfinite(m.sensor_z_mm) && m.sensor_z_mm < 0, "sensor plane z = %.17g", m.sensor_z_mm);
+    FUZZ_ASSERT(std::isfinite(m.sensor.z_mm) && m.sensor.z_mm < 0, "sensor plane z = %.17g", m.sensor.z_mm);
     FUZZ_ASSERT(std::isfinite(m.distance_mm), "D = %.17g", m.distance_mm);
-    FUZZ_ASSERT(m.samples_min >= 1 && m.samples_min <= m.samples_max && m.samples_max <= kMaxSamples,
-                "model samples %d..%d", m.samples_min, m.samples_max);
+    FUZZ_ASSERT(m.sampling.samples_min >= 1 && m.sampling.samples_min <= m.sampling.samples_max && m.sampling.samples_max <= kMaxSamples,
+                "model samples %d..%d", m.sampling.samples_min, m.sampling.samples_max);
     if (lens_kind(m) == "thin_lens")
-        FUZZ_ASSERT(std::isfinite(m.aperture_mm) && m.aperture_mm > 0 && std::isfinite(m.focal_length_mm),
-                    "aperture %.17g F %.17g", m.aperture_mm, m.focal_length_mm);
-    const Vec3 c = m.pose.centre_mm;
-    FUZZ_ASSERT(is_finite(c) && is_finite(m.pose.normal), "array pose not finite");
-    if (m.grid != GridType::None) {
-        FUZZ_ASSERT(c.z > m.sensor_z_mm, "array at z %.17g not above the sensor %.17g", c.z, m.sensor_z_mm);
+        FUZZ_ASSERT(std::isfinite(m.aperture_mm()) && m.aperture_mm() > 0 && std::isfinite(m.focal_length_mm()),
+                    "aperture %.17g F %.17g", m.aperture_mm(), m.focal_length_mm());
+    const Vec3 c = m.array.pose.centre_mm;
+    FUZZ_ASSERT(is_finite(c) && is_finite(m.array.pose.normal), "array pose not finite");
+    if (m.array.grid != GridType::None) {
+        FUZZ_ASSERT(c.z > m.sensor.z_mm, "array at z %.17g not above the sensor %.17g", c.z, m.sensor.z_mm);
         if (lens_kind(m) != "none")
             FUZZ_ASSERT(c.z < 0, "array at z %.17g not behind the main lens", c.z);
     }
 }
 
-void check_ray(const Model& m, const OpticsRay& r, const char* what, int i, int j)
+void check_ray(const PlenopticCamera& m, const OpticsRay& r, const char* what, int i, int j)
 {
     const Vec3 o{r.origin_mm.x, r.origin_mm.y, r.origin_mm.z};
     const Vec3 d{r.dir.x, r.dir.y, r.dir.z};
@@ -369,7 +369,7 @@ void check_ray(const Model& m, const OpticsRay& r, const char* what, int i, int 
                 what, i, j, d.x, d.y, d.z);
 }
 
-void check_origin(const Model& m, const OpticsRay& r, int i, int j)
+void check_origin(const PlenopticCamera& m, const OpticsRay& r, int i, int j)
 {
     const Vec3 o{r.origin_mm.x, r.origin_mm.y, r.origin_mm.z};
     if (lens_kind(m) == "pinhole") {
@@ -377,12 +377,12 @@ void check_origin(const Model& m, const OpticsRay& r, int i, int j)
                     o.x, o.y, o.z);
     } else if (lens_kind(m) == "thin_lens") {
         FUZZ_ASSERT(o.z == 0, "pixel (%d, %d): origin z %.17g off the main-lens plane", i, j, o.z);
-        FUZZ_ASSERT(std::hypot(o.x, o.y) <= 0.5 * m.aperture_mm * (1 + 1e-12),
-                    "pixel (%d, %d): origin (%g, %g) outside the aperture %.17g", i, j, o.x, o.y, m.aperture_mm);
+        FUZZ_ASSERT(std::hypot(o.x, o.y) <= 0.5 * m.aperture_mm() * (1 + 1e-12),
+                    "pixel (%d, %d): origin (%g, %g) outside the aperture %.17g", i, j, o.x, o.y, m.aperture_mm());
     } else {
-        const Vec3 local = mul_transposed(m.pose.rotation, o - m.pose.centre_mm);
+        const Vec3 local = mul_transposed(m.array.pose.rotation, o - m.array.pose.centre_mm);
         // Relative to the magnitudes involved: o = centre + R local rounds at |centre| and |o|.
-        FUZZ_ASSERT(std::fabs(local.z) <= 1e-9 * (1 + length(o) + length(m.pose.centre_mm)),
+        FUZZ_ASSERT(std::fabs(local.z) <= 1e-9 * (1 + length(o) + length(m.array.pose.centre_mm)),
                     "pixel (%d, %d): origin (%g, %g, %g) is %.3g mm off the array plane", i, j, o.x, o.y, o.z, local.z);
     }
 }
@@ -462,7 +462,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
             }
         }
     }
-    const Model m = with_film(make_model(p), in.W, in.H);
+    const PlenopticCamera m = with_film(make_camera(p), in.W, in.H);
     model_is_sane(m);
     if (check_diffraction_size(m, p.diffraction).empty()) {
         // The picture keeps its light through the convolution and stays finite.
@@ -485,15 +485,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     const int W = in.W, H = in.H;
     for (int k = 0; k < in.pixel_count; ++k) {
         const int i = in.pixels[k][0], j = in.pixels[k][1];
-        const int count = std::max(in.samples, std::min(m.samples_max, 8));
+        const int count = std::max(in.samples, std::min(m.sampling.samples_max, 8));
         for (int n = 0; n < in.samples; ++n) {
             OpticsRay r;
-            if ((r = generate_ray(m, i, j, make_sample(i, j, n, count), nullptr)).passed) {
+            if ((r = m.generate_ray(i, j, make_sample(i, j, n, count))).passed) {
                 check_ray(m, r, "generate_ray", i, j);
                 check_origin(m, r, i, j);
             }
         }
-        check_ray(m, chief_ray(m, i, j), "chief_ray", i, j);
+        check_ray(m, m.chief_ray(i, j), "chief_ray", i, j);
         LensIndex lenses[kMaxOverlapLenses];
         const int lens_count = overlap_lenses(m, i, j, lenses, kMaxOverlapLenses);
         FUZZ_ASSERT(lens_count >= 0 && lens_count <= kMaxOverlapLenses, "overlap_lenses gave %d", lens_count);
@@ -504,7 +504,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
                 check_origin(m, r, i, j);
             }
         }
-        if (m.samples_max <= 16) {
+        if (m.sampling.samples_max <= 16) {
             const Rgbt v = shade_pixel(m, i, j, [](const OpticsRay& r) {
                 return Rgbt{r.dir.x, r.dir.y, r.dir.z, 0.5};
             });
@@ -517,9 +517,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     }
     // forward_project visits every lens that can image into the picture (bounded at 2^22 lenses);
     // skip sizes where that is millions of lenses, to keep the fuzzer fast.
-    const double span_mm = std::max(W * m.pixel_size_mm[0], H * m.pixel_size_mm[1]);
-    if (m.grid == GridType::None || span_mm <= 64 * m.pitch_mm) {
-        for (const PixelHit& hit : forward_project(m, in.point)) {
+    const double span_mm = std::max(W * m.sensor.pixel_size_mm[0], H * m.sensor.pixel_size_mm[1]);
+    if (m.array.grid == GridType::None || span_mm <= 64 * m.array.pitch_mm) {
+        for (const PixelHit& hit : m.project(Vec3{in.point[0], in.point[1], in.point[2]})) {
             FUZZ_ASSERT(std::isfinite(hit.u) && std::isfinite(hit.v), "forward_project hit (%g, %g)", hit.u, hit.v);
             FUZZ_ASSERT(hit.u >= -0.5 && hit.u < W - 0.5 && hit.v >= -0.5 && hit.v < H - 0.5,
                         "forward_project hit (%.17g, %.17g) outside the %dx%d image", hit.u, hit.v, W, H);

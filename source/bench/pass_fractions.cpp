@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // plenoptic_pass_fractions: how many of the camera rays generated behind a real main lens pass it
-// (a benchmark figure). A count, not a timing: it builds the camera's Model from
-// parameters as the scene parser would (check_camera, make_model), asks generate_ray for the
+// (a benchmark figure). A count, not a timing: it builds the camera's PlenopticCamera from
+// parameters as the scene parser would (check_camera, make_camera), asks generate_ray for the
 // camera's own samples (make_sample, as shade_pixel does) of the central, an edge and a corner
 // pixel and of a patch of pixels around each, and counts the rays that pass the lens. Without an
 // array it also counts what sampling the whole rear element's clear aperture uniformly (pbrt's
@@ -33,7 +33,7 @@
 #include <string>
 
 #include "plenoptic/lens/main_lens.h"
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 #include "plenoptic/optics.h"
 #include "plenoptic/camera/params.h"
 #include "plenoptic/lens/prescription.h"
@@ -135,10 +135,10 @@ CameraParams camera(const Options& o, const Prescription& lens, double array_foc
 
 // Image-side f-number: exit pupil to the plane D behind the rear vertex, over the pupil's diameter
 // (the metadata's paraxial.working_f_number).
-double working_f_number(const Model& m)
+double working_f_number(const PlenopticCamera& m)
 {
-    const double exit_pupil_z = m.lens_length_mm - m.paraxial.exit_pupil_z;  // optics frame
-    return (exit_pupil_z + m.distance_mm) / m.paraxial.exit_pupil_mm;
+    const double exit_pupil_z = m.lens_length_mm() - m.paraxial().exit_pupil_z;  // optics frame
+    return (exit_pupil_z + m.distance_mm) / m.paraxial().exit_pupil_mm;
 }
 
 struct Count {
@@ -152,15 +152,15 @@ struct Count {
 // `samples` from make_sample, then generate_ray. Without an array also the pbrt-style sample: the
 // same aperture sample mapped onto the rear element's clear aperture (a disc in the plane of the
 // rear vertex), traced with the lens's own exact trace.
-void count_pixel(const Model& m, int i, int j, int samples, double rear_radius_mm, Count* c)
+void count_pixel(const PlenopticCamera& m, int i, int j, int samples, double rear_radius_mm, Count* c)
 {
     for (int n = 0; n < samples; ++n) {
         const CameraSample s = make_sample(i, j, n, samples);
         ++c->generated;
-        const OpticsRay ray = generate_ray(m, i, j, s);
+        const OpticsRay ray = m.generate_ray(i, j, s);
         if (ray.passed)
             ++c->passed;
-        if (m.grid == GridType::None && rear_radius_mm > 0) {
+        if (m.array.grid == GridType::None && rear_radius_mm > 0) {
             const Vec3 p = sensor_point(m, i + s.pixel_u, j + s.pixel_v);
             const Vec2 d = concentric_disc(s.lens_u, s.lens_v);
             const Vec3 on_rear{rear_radius_mm * d.x, rear_radius_mm * d.y, 0};
@@ -224,7 +224,7 @@ int main(int argc, char** argv)
             std::fprintf(stderr, "plenoptic_pass_fractions: %s\n", error.c_str());
             return 1;
         }
-        const Model m = make_model(first);
+        const PlenopticCamera m = make_camera(first);
         working_n = working_f_number(m);
         if (o.array_pitch_mm > 0)
             array_focal_mm = o.array_focal_mm > 0 ? o.array_focal_mm : o.array_pitch_mm * working_n;
@@ -236,14 +236,14 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "plenoptic_pass_fractions: %s\n", error.c_str());
         return 1;
     }
-    const Model m = with_film(make_model(params), o.width, o.height);
+    const PlenopticCamera m = with_film(make_camera(params), o.width, o.height);
     const int W = o.width, H = o.height;
     int patch = o.patch;
     if (patch == 0)
         patch = o.array_pitch_mm > 0 ? int(std::ceil(2 * o.array_pitch_mm / o.pixel_mm)) : 16;
     patch = std::min(patch, std::min(W, H));
-    const double rear_radius = 0.5 * m.prescription.surfaces.back().aperture_mm;
-    const bool unbounded = m.grid == GridType::None && m.lens && m.lens->traced();
+    const double rear_radius = 0.5 * m.prescription().surfaces.back().aperture_mm;
+    const bool unbounded = m.array.grid == GridType::None && m.lens && m.lens->traced();
 
     struct Place {
         const char* name;
@@ -257,14 +257,14 @@ int main(int argc, char** argv)
     };
 
     std::printf("{\n \"lens_file\": \"%s\", \"thick_lens\": %s, \"f_number\": %.9g, \"focus_distance\": %.9g,\n",
-                o.lens_file.c_str(), o.thick ? "true" : "false", m.f_number, o.focus_distance);
+                o.lens_file.c_str(), o.thick ? "true" : "false", m.f_number(), o.focus_distance);
     std::printf(" \"effective_focal_length_mm\": %.9g, \"distance_mm\": %.9g, \"working_f_number\": %.9g,\n",
-                m.focal_length_mm, m.distance_mm, working_n);
+                m.focal_length_mm(), m.distance_mm, working_n);
     std::printf(" \"exit_pupil_radius_mm\": %.9g, \"rear_aperture_radius_mm\": %.9g, \"light_field_radius_mm\": %.9g,\n",
                 m.lens->exit_pupil_radius(), rear_radius, m.pupil_bounds ? m.pupil_bounds->field_radius_mm() : -1.0);
-    if (m.grid != GridType::None)
+    if (m.array.grid != GridType::None)
         std::printf(" \"array\": {\"grid\": \"hexagonal\", \"pitch_mm\": %.9g, \"focal_length_mm\": %.9g, "
-                    "\"distance_mm\": %.9g},\n", m.pitch_mm, m.microlens_focal_mm[0], m.array_distance_mm);
+                    "\"distance_mm\": %.9g},\n", m.array.pitch_mm, m.array.focal_mm[0], m.array.distance_mm);
     else
         std::printf(" \"array\": null,\n");
     std::printf(" \"sensor\": {\"width\": %d, \"height\": %d, \"pixel_size_mm\": %.9g}, \"samples\": %d, "

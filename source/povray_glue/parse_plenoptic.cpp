@@ -644,11 +644,11 @@ void PlenopticParser::Close_Camera()
 		last_step = step;
 		std::fprintf(stderr, "plenoptic camera: setting up a lens of %zu surfaces: %s %d %%\n", surfaces, step, 10 * tenth);
 	});
-	setup->model = plenoptic::make_model(params);
+	setup->model = plenoptic::make_camera(params);
 	Check(plenoptic::check_diffraction_size(setup->model, params.diffraction));
 	for (size_t k = 0; k < setup->white_image.f_numbers.size() && params.diffraction.given; k++)
 		Check(plenoptic::check_diffraction_size(
-			plenoptic::make_model(plenoptic::at_f_number(params, setup->white_image.f_numbers[k])), params.diffraction));
+			plenoptic::make_camera(plenoptic::at_f_number(params, setup->white_image.f_numbers[k])), params.diffraction));
 }
 
 void PlenopticParser::Parse_Camera(Camera& New)

@@ -26,7 +26,7 @@ std::shared_ptr<plenoptic::Render> Plenoptic_Start_Render(
     direction.normalize();
     // The optics frame's origin: the scene's location is a real lens's front vertex, the frame's
     // origin its rear vertex, the lens's length behind it.
-    const double behind_units = camera.Plenoptic->model.lens_length_mm / camera.Plenoptic->model.mm_per_unit;
+    const double behind_units = camera.Plenoptic->model.lens_length_mm() / camera.Plenoptic->model.mm_per_unit;
     for (int i = 0; i < 3; i++) {
         frame.location[i] = camera.Location[i] - behind_units * direction[i];
         frame.right[i] = right[i];

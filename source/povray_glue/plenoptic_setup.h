@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 #include "plenoptic/camera/params.h"
 #include "plenoptic/sensor/white_image.h"
 
@@ -15,7 +15,7 @@ namespace plenoptic {
 
 struct CameraSetup {
     CameraParams params;
-    Model model;
+    PlenopticCamera model;
     bool depth_map = false;  // write <output>.depth.exr beside the image
     // <output>.microimages.csv: `microimage_centres` on or off; by default written only where the
     // centres leave the metadata's lattice (a traced prescription, a thin lens with distortion).

@@ -57,9 +57,9 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 	if (!camera.PlenopticRender)
 		throw POV_EXCEPTION_STRING("plenoptic camera: the render has no plenoptic state (internal error).");
 	plenoptic::Render& render = *camera.PlenopticRender;
-	const plenoptic::Model& model = render.model();
+	const plenoptic::PlenopticCamera& model = render.model();
 	const int W = (int)width, H = (int)height;
-	if (W != model.film.width || H != model.film.height)
+	if (W != model.sensor.film.width || H != model.sensor.film.height)
 		throw POV_EXCEPTION_STRING("plenoptic camera: a pixel of an image of another size than the render's (internal error).");
 	// Antialiasing may ask for sub-pixel positions: the camera samples the whole pixel itself.
 	const int i = (int)std::floor(x + 0.5), j = (int)std::floor(y + 0.5);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Metadata JSON (parsed by nlohmann-json) -> CameraParams -> Model, with a message naming the
+// Metadata JSON (parsed by nlohmann-json) -> CameraParams -> PlenopticCamera, with a message naming the
 // field for every refusal.
 
 #include "plenoptic_metadata_reader.h"
@@ -430,11 +430,11 @@ void read_all(const Json& root, RenderMetadata* out)
     const std::string problem = check_camera(p);
     if (!problem.empty())
         throw FieldError("the camera described is invalid: " + problem);
-    out->model = with_film(make_model(p), out->width, out->height);
-    const Model& m = out->model;
+    out->model = with_film(make_camera(p), out->width, out->height);
+    const PlenopticCamera& m = out->model;
 
     // Derived values must agree with what the parameters give.
-    check_close("sensor.plane_z_mm", plane_z, m.sensor_z_mm, std::fabs(m.sensor_z_mm) + 1,
+    check_close("sensor.plane_z_mm", plane_z, m.sensor.z_mm, std::fabs(m.sensor.z_mm) + 1,
                 "the distances (main_lens.distance_mm, microlens_array.distance_mm, translate_mm)");
     double principal[2];
     numbers(root, "", "principal_point_px", 2, false, principal);
@@ -442,7 +442,7 @@ void read_all(const Json& root, RenderMetadata* out)
     check_close("principal_point_px[0]", principal[0], pp.x, out->width + 1.0, "image.width and sensor.offset_mm");
     check_close("principal_point_px[1]", principal[1], pp.y, out->height + 1.0, "image.height and sensor.offset_mm");
     const Json& lattice = member(root, "", "microimage_lattice");
-    if (m.grid == GridType::None) {
+    if (m.array.grid == GridType::None) {
         if (!lattice.is_null())
             refuse("microimage_lattice", "null when microlens_array is null", lattice);
     } else {
@@ -531,7 +531,7 @@ std::vector<PixelHit> project_world_point(const RenderMetadata& md, const double
     double optics[3];
     if (!world_to_optics_mm(md, world, optics))
         return std::vector<PixelHit>();
-    return forward_project(md.model, optics);
+    return md.model.project(Vec3{optics[0], optics[1], optics[2]});
 }
 
 } // namespace plenoptic

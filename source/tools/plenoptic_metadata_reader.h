@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "plenoptic/truth/metadata.h"
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 #include "plenoptic/optics.h"
 #include "plenoptic/camera/params.h"
 
@@ -19,7 +19,7 @@ struct RenderMetadata {
     int width = 0;
     int height = 0;
     CameraParams params;  // rebuilt from the resolved values (D as distance_mm)
-    Model model;
+    PlenopticCamera model;
     CameraFrame frame;    // world frame of the optics frame, scene units
     std::string depth_map;// file name of the depth EXR, empty when none
 };

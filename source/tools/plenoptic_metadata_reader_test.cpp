@@ -49,7 +49,7 @@ CameraParams hexagonal_camera()
 std::string good_text(const std::string& depth_map = "scene.depth.exr")
 {
     const CameraParams p = hexagonal_camera();
-    return metadata_json(with_film(make_model(p), 320, 240), p, kFrame, depth_map);
+    return metadata_json(with_film(make_camera(p), 320, 240), p, kFrame, depth_map);
 }
 
 // The text with its first `from` replaced by `to`.
@@ -86,16 +86,16 @@ TEST(MetadataReader, ReadsWhatTheWriterWrites)
     std::string error;
     ASSERT_TRUE(parse_metadata(good_text(), &metadata, &error)) << error;
     const CameraParams p = hexagonal_camera();
-    const Model m = make_model(p);
+    const PlenopticCamera m = make_camera(p);
     EXPECT_EQ(metadata.width, 320);
     EXPECT_EQ(metadata.height, 240);
     EXPECT_EQ(metadata.depth_map, "scene.depth.exr");
     EXPECT_EQ(metadata.frame.location[2], -0.3);
     // Shortest round-trip numbers: every value reads back bit for bit.
     EXPECT_EQ(metadata.model.distance_mm, m.distance_mm);
-    EXPECT_EQ(metadata.model.pitch_mm, 0.15);
-    EXPECT_EQ(metadata.model.microlens_focal_mm[0], 0.6);
-    EXPECT_EQ(metadata.model.sensor_z_mm, m.sensor_z_mm);
+    EXPECT_EQ(metadata.model.array.pitch_mm, 0.15);
+    EXPECT_EQ(metadata.model.array.focal_mm[0], 0.6);
+    EXPECT_EQ(metadata.model.sensor.z_mm, m.sensor.z_mm);
     EXPECT_EQ(metadata.params.array.rotate_deg[2], 0.3);
 }
 
@@ -184,7 +184,7 @@ TEST(MetadataReader, ExtremeShiftsKeepALatticeTheReaderTakesBack)
     p.array.translate_mm[0] = 1e12;
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 1e-12;
     ASSERT_EQ(check_camera(p), "");
-    const std::string text = metadata_json(with_film(make_model(p), 320, 240), p, kFrame, "");
+    const std::string text = metadata_json(with_film(make_camera(p), 320, 240), p, kFrame, "");
     ASSERT_FALSE(contains(text, "\"microimage_lattice\": null")) << text;
     RenderMetadata metadata;
     std::string error;

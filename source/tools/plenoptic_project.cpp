@@ -122,7 +122,7 @@ int main(int argc, char** argv)
             if (with_fraction)
                 std::printf(" %.6g", hit.fraction);
             if (with_blur)
-                std::printf(" %.6f", plenoptic::blur_radius_px(metadata.model, optics, hit.lens));
+                std::printf(" %.6f", plenoptic::blur_radius_px(metadata.model, plenoptic::Vec3{optics[0], optics[1], optics[2]}, hit.lens));
             std::printf("\n");
         }
     }

@@ -65,15 +65,15 @@ CameraParams pinhole_main(double D)
 }
 
 // Rays of one sensor point: pixel (i, j)'s centre, `count` aperture samples. Unblocked ones only.
-std::vector<OpticsRay> rays_of_point(const Model& m, int i, int j, int count)
+std::vector<OpticsRay> rays_of_point(const PlenopticCamera& m, int i, int j, int count)
 {
-    const int W = m.film.width, H = m.film.height;
+    const int W = m.sensor.film.width, H = m.sensor.film.height;
     std::vector<OpticsRay> rays;
     for (int n = 0; n < count; ++n) {
         CameraSample s = make_sample(i, j, n, count);
         s.pixel_u = s.pixel_v = 0.5;
         OpticsRay ray;
-        if ((ray = generate_ray(with_film(m, W, H), i, j, s, nullptr)).passed)
+        if ((ray = with_film(m, W, H).generate_ray(i, j, s)).passed)
             rays.push_back(ray);
     }
     return rays;
@@ -91,7 +91,7 @@ TEST(OpticsExtremes, ThinMainLensRaysMeetAtTheConjugateFromFocalLength1e6To1e_6)
             CameraParams params = thin_main(F, 2.8, D);
             params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = F * 1e-3;  // ~0.01 rad per pixel
             ASSERT_EQ(check_camera(params), "") << describe(params);
-            const Model m = with_film(make_model(params), W, H);
+            const PlenopticCamera m = with_film(make_camera(params), W, H);
             const Vec3 p = sensor_point(m, i + 0.5, j + 0.5);
             // Independently, with divisions (the code under test has none): the image of p.
             const double u = 1 / (1 / F - 1 / m.distance_mm);
@@ -121,7 +121,7 @@ TEST(OpticsExtremes, SensorAtTheFocalPlaneGivesParallelRaysAtEveryScale)
     for (double F : {1e-6, 1.0, 1e6}) {
         CameraParams params = thin_main(F, 1.4, F);  // D = F exactly
         params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = F * 1e-3;
-        const Model m = with_film(make_model(params), W, H);
+        const PlenopticCamera m = with_film(make_camera(params), W, H);
         const Vec3 expected = normalized(-sensor_point(m, i + 0.5, j + 0.5));
         for (const OpticsRay& r : rays_of_point(m, i, j, 64))
             EXPECT_LT(length(dir_of(r) - expected), 1e-14) << describe(params) << " " << str(dir_of(r));
@@ -184,7 +184,7 @@ TEST(OpticsExtremes, PlenopticRaysOfASensorPointMeetAtTheSystemConjugate)
             CameraParams params = test::plenoptic_camera(grid, sc.pitch, sc.f, sc.d, sc.F, sc.N, sc.D);
             params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = sc.pitch / 7;
             ASSERT_EQ(check_camera(params), "") << describe(params);
-            const Model m = with_film(make_model(params), W, H);
+            const PlenopticCamera m = with_film(make_camera(params), W, H);
             int met = 0;
             for (const auto& px : pixels) {
                 const Vec3 p = sensor_point(m, px[0] + 0.5, px[1] + 0.5);
@@ -221,7 +221,7 @@ TEST(OpticsExtremes, BareArrayRaysMeetAtTheMicrolensConjugateEvenTiltedNearlyEdg
                 test::set_pose(&params, tilt, 0, 30, 0.01, -0.02, 0);
                 params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.01;
                 ASSERT_EQ(check_camera(params), "") << describe(params);
-                const Model m = with_film(make_model(params), W, H);
+                const PlenopticCamera m = with_film(make_camera(params), W, H);
                 const double* deg = params.array.rotate_deg;
                 for (int i : {5, 20, 37}) {
                     const int j = (i * 7) % H;
@@ -233,7 +233,7 @@ TEST(OpticsExtremes, BareArrayRaysMeetAtTheMicrolensConjugateEvenTiltedNearlyEdg
                     // In the array's own frame (reference rotation): p at height -s below lens c.
                     const Vec2 c2 = lens_centre(GridType::Hexagonal, 0.1, lens);
                     const Vec3 c_local{c2.x, c2.y, 0};
-                    const Vec3 p_local = test::reference_unrotate(deg, p - m.pose.centre_mm);
+                    const Vec3 p_local = test::reference_unrotate(deg, p - m.array.pose.centre_mm);
                     const double s = -p_local.z;
                     if (!(s > 0)) {  // the point is in front of the (steeply tilted) array: no light
                         EXPECT_TRUE(rays_of_point(m, i, j, 16).empty()) << describe(params);
@@ -246,14 +246,14 @@ TEST(OpticsExtremes, BareArrayRaysMeetAtTheMicrolensConjugateEvenTiltedNearlyEdg
                     for (const OpticsRay& r : rays) {
                         const Vec3 o = origin_of(r);
                         // Origin on the array plane (the last element).
-                        const Vec3 o_local = test::reference_unrotate(deg, o - m.pose.centre_mm);
-                        EXPECT_LT(std::fabs(o_local.z), 1e-12 * (1 + length(o - m.pose.centre_mm)))
+                        const Vec3 o_local = test::reference_unrotate(deg, o - m.array.pose.centre_mm);
+                        EXPECT_LT(std::fabs(o_local.z), 1e-12 * (1 + length(o - m.array.pose.centre_mm)))
                             << describe(params) << ": origin " << str(o) << " is off the array plane";
                         if (std::fabs(w) <= 1e-9 * s) {
                             const Vec3 dir = normalized(test::reference_rotate(deg, xyz));
                             EXPECT_LT(length(dir_of(r) - dir), 1e-9) << describe(params) << " " << str(dir_of(r));
                         } else {
-                            const Vec3 x = m.pose.centre_mm + test::reference_rotate(deg, (1 / w) * xyz);
+                            const Vec3 x = m.array.pose.centre_mm + test::reference_rotate(deg, (1 / w) * xyz);
                             EXPECT_LT(miss(x, r), 1e-9 * (length(x - o) + s))
                                 << describe(params) << " pixel " << i << ": ray " << str(o) << " + t " << str(dir_of(r))
                                 << " misses the microlens conjugate " << str(x);
@@ -280,14 +280,14 @@ TEST(OpticsExtremes, PinholeMainLensRaysAllLeaveThroughThePinhole)
                 const std::string refusal = check_camera(params);
                 if (!refusal.empty())
                     continue;  // the degenerate combination, refused as it must be
-                const Model m = with_film(make_model(params), W, H);
+                const PlenopticCamera m = with_film(make_camera(params), W, H);
                 int unblocked = 0, off_pinhole = 0, backwards = 0, not_unit = 0;
                 OpticsRay example{};
                 for (int j = 0; j < H; j += 5) {
                     for (int i = 0; i < W; i += 3) {
                         for (int n = 0; n < 8; ++n) {
                             OpticsRay r;
-                            if (!(r = generate_ray(m, i, j, make_sample(i, j, n, 8), nullptr)).passed)
+                            if (!(r = m.generate_ray(i, j, make_sample(i, j, n, 8))).passed)
                                 continue;
                             ++unblocked;
                             if (!(r.origin_mm.x == 0 && r.origin_mm.y == 0 && r.origin_mm.z == 0))
@@ -322,7 +322,7 @@ void check_invariants(const CameraParams& params, int W, int H, int* models, lon
 {
     if (!check_camera(params).empty())
         return;
-    const Model m = make_model(params);
+    const PlenopticCamera m = make_camera(params);
     ++*models;
     const std::string what = describe(params);
     const int pixel_list[5][2] = {{0, 0}, {W - 1, H - 1}, {W / 2, H / 2}, {W - 1, 0}, {W / 3, (2 * H) / 3}};
@@ -330,7 +330,7 @@ void check_invariants(const CameraParams& params, int W, int H, int* models, lon
         const int i = px[0], j = px[1];
         for (int n = 0; n < 6; ++n) {
             OpticsRay r;
-            if (!(r = generate_ray(with_film(m, W, H), i, j, make_sample(i, j, n, 6), nullptr)).passed)
+            if (!(r = with_film(m, W, H).generate_ray(i, j, make_sample(i, j, n, 6))).passed)
                 continue;
             ++*rays;
             const Vec3 o = origin_of(r), d = dir_of(r);
@@ -341,26 +341,26 @@ void check_invariants(const CameraParams& params, int W, int H, int* models, lon
                 ASSERT_TRUE(o.x == 0 && o.y == 0 && o.z == 0) << what << " origin " << str(o);
             } else if (test::lens_kind(m) == "thin_lens") {
                 ASSERT_EQ(o.z, 0.0) << what << " origin " << str(o) << " off the main-lens plane";
-                ASSERT_LE(std::hypot(o.x, o.y), 0.5 * m.aperture_mm * (1 + 1e-12))
-                    << what << " origin " << str(o) << " outside the aperture " << m.aperture_mm;
+                ASSERT_LE(std::hypot(o.x, o.y), 0.5 * m.aperture_mm() * (1 + 1e-12))
+                    << what << " origin " << str(o) << " outside the aperture " << m.aperture_mm();
             } else {
-                const Vec3 local = mul_transposed(m.pose.rotation, o - m.pose.centre_mm);
-                ASSERT_LE(std::fabs(local.z), 1e-12 * (1 + length(o - m.pose.centre_mm)))
+                const Vec3 local = mul_transposed(m.array.pose.rotation, o - m.array.pose.centre_mm);
+                ASSERT_LE(std::fabs(local.z), 1e-12 * (1 + length(o - m.array.pose.centre_mm)))
                     << what << " origin " << str(o) << " off the array plane";
             }
         }
-        const OpticsRay chief = chief_ray(with_film(m, W, H), i, j);
+        const OpticsRay chief = with_film(m, W, H).chief_ray(i, j);
         ASSERT_TRUE(is_finite(origin_of(chief)) && is_finite(dir_of(chief))) << what << " chief ray";
         ASSERT_NEAR(length(dir_of(chief)), 1.0, 1e-12) << what << " chief ray";
     }
     // forward_project visits every lens that may image into the picture (bounded at 2^24): with
     // microimages far smaller than a pixel that is up to ~1e6 hits and a second per point, so the
     // sweep asks it only where the picture spans at most ~100 pitches across.
-    if (m.grid != GridType::None && !(std::max(W, H) * m.pixel_size_mm[0] <= 100 * m.pitch_mm))
+    if (m.array.grid != GridType::None && !(std::max(W, H) * m.sensor.pixel_size_mm[0] <= 100 * m.array.pitch_mm))
         return;
     for (double z : {1e-3, 1.0, 1e3, 1e9}) {
-        const double point[3] = {0.05 * z, -0.03 * z, z};
-        for (const PixelHit& hit : forward_project(with_film(m, W, H), point)) {
+        const Vec3 point{0.05 * z, -0.03 * z, z};
+        for (const PixelHit& hit : with_film(m, W, H).project(point)) {
             ASSERT_TRUE(std::isfinite(hit.u) && std::isfinite(hit.v)) << what << " z " << z;
             ASSERT_TRUE(hit.u >= -0.5 && hit.u < W - 0.5 && hit.v >= -0.5 && hit.v < H - 0.5)
                 << what << " forward_project hit (" << hit.u << ", " << hit.v << ") outside the image";

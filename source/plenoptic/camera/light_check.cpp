@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plenoptic/camera/pixel.h"
 #include "plenoptic/camera/rays.h"
 #include "plenoptic/camera/params.h"
 #include "plenoptic/core/sampling.h"
@@ -17,18 +18,18 @@ const int kMaxPatchPixels = 64;
 
 } // namespace
 
-double lit_fraction_near_axis(const Model& camera)
+double lit_fraction_near_axis(const PlenopticCamera& camera)
 {
     // A patch about three microimages (or, without an array, a few pixels) across, centred on
     // the pixel where the optical axis meets the sensor.
     int patch = 8;
-    if (camera.grid != GridType::None) {
-        const double pixel_mm = std::min(camera.pixel_size_mm[0], camera.pixel_size_mm[1]);
-        const double across = 3 * camera.pitch_mm / pixel_mm;
+    if (camera.array.grid != GridType::None) {
+        const double pixel_mm = std::min(camera.sensor.pixel_size_mm[0], camera.sensor.pixel_size_mm[1]);
+        const double across = 3 * camera.array.pitch_mm / pixel_mm;
         patch = int(std::min<double>(kMaxPatchPixels, std::max(8.0, std::ceil(across))));
     }
     // The camera taking a picture of just the patch.
-    const Model model = with_film(camera, patch, patch);
+    const PlenopticCamera model = with_film(camera, patch, patch);
     const Vec2 axis = principal_point_px(model);
     if (!std::isfinite(axis.x) || !std::isfinite(axis.y))
         return 0;
@@ -44,7 +45,7 @@ double lit_fraction_near_axis(const Model& camera)
     return total > 0 ? double(passing) / total : 0;
 }
 
-std::string dark_image_warning(const Model& model)
+std::string dark_image_warning(const PlenopticCamera& model)
 {
     const double fraction = lit_fraction_near_axis(model);
     if (fraction >= kDarkImageFraction)
@@ -55,6 +56,11 @@ std::string dark_image_warning(const Model& model)
     if (model.lens)
         message += model.lens->dark_image_advice(model.distance_mm);
     return message;
+}
+
+bool PlenopticCamera::receives_light(int i, int j) const
+{
+    return pixel_receives_light(*this, i, j);
 }
 
 } // namespace plenoptic

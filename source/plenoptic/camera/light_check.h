@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 
 namespace plenoptic {
 
@@ -16,12 +16,12 @@ const double kDarkImageFraction = 1e-3;
 
 // The fraction of the sample points of the pixels around the optical axis (a patch of about
 // three microimages across, at most 64 x 64 pixels, 16 points each) that pass every aperture.
-double lit_fraction_near_axis(const Model& model);
+double lit_fraction_near_axis(const PlenopticCamera& model);
 
 // A warning when lit_fraction_near_axis is below kDarkImageFraction: what passes, and the
 // usual causes (a tiny main-lens aperture; a focus distance at the focal length, which puts
 // the array far behind the lens). Empty otherwise.
-std::string dark_image_warning(const Model& model);
+std::string dark_image_warning(const PlenopticCamera& model);
 
 } // namespace plenoptic
 

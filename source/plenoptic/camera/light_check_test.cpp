@@ -24,7 +24,7 @@ CameraParams plenoptic_1_0(double f_number)
 TEST(LightCheck, LitFractionIsTheMicroimageDiscOverItsCell)
 {
     for (double f_number : {6.0, 8.0, 16.0}) {
-        const Model m = make_model(plenoptic_1_0(f_number));
+        const PlenopticCamera m = make_camera(plenoptic_1_0(f_number));
         const double radius = 0.5 * (16 / f_number) * 0.6 / m.distance_mm;
         const double expected = kPi * radius * radius / (0.15 * 0.15);
         const double measured = lit_fraction_near_axis(m);
@@ -37,7 +37,7 @@ TEST(LightCheck, LitFractionIsTheMicroimageDiscOverItsCell)
 
 TEST(LightCheck, TinyApertureWarns)
 {
-    const Model m = make_model(plenoptic_1_0(1e6));
+    const PlenopticCamera m = make_camera(plenoptic_1_0(1e6));
     EXPECT_LT(lit_fraction_near_axis(m), kDarkImageFraction);
     const std::string message = dark_image_warning(m);
     EXPECT_NE(message.find("black"), std::string::npos) << message;
@@ -51,7 +51,7 @@ TEST(LightCheck, FocusAtTheFocalLengthWarns)
     p.main.has_focus_distance = true;
     p.main.focus_distance_units = 0.016 + 1e-9;  // 1e-6 mm beyond F = 16 mm
     ASSERT_EQ(check_camera(p), "");
-    const Model m = make_model(p);
+    const PlenopticCamera m = make_camera(p);
     EXPECT_GT(m.distance_mm, 1e7);
     EXPECT_LT(lit_fraction_near_axis(m), kDarkImageFraction);
     EXPECT_NE(dark_image_warning(m).find("black"), std::string::npos) << dark_image_warning(m);
@@ -59,10 +59,10 @@ TEST(LightCheck, FocusAtTheFocalLengthWarns)
 
 TEST(LightCheck, CamerasWithoutDarknessStayQuiet)
 {
-    EXPECT_EQ(dark_image_warning(make_model(test::thin_lens_camera(50, 1e6, 52))), "");  // samples aim at the disc
+    EXPECT_EQ(dark_image_warning(make_camera(test::thin_lens_camera(50, 1e6, 52))), "");  // samples aim at the disc
     CameraParams array_only;
     test::add_array(&array_only, GridType::Hexagonal, 0.1, 0, 0.4);
-    EXPECT_GT(lit_fraction_near_axis(make_model(array_only)), 0.9);
+    EXPECT_GT(lit_fraction_near_axis(make_camera(array_only)), 0.9);
 }
 
 } // namespace

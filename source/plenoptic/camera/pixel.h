@@ -95,12 +95,12 @@ inline CameraSample lens_sample(int i, int j, int n, int count, int lenses, int*
 
 // How many of samples from .. to-1 of pixel (i, j) pass the apertures through the pixel's own
 // lenses (geometry only); *first is the first of them (-1 if none).
-inline int passing_samples(const Model& model, int i, int j, int from, int to, int* first)
+inline int passing_samples(const PlenopticCamera& model, int i, int j, int from, int to, int* first)
 {
     int passing = 0;
     *first = -1;
     for (int n = from; n < to; ++n) {
-        const OpticsRay ray = generate_ray(model, i, j, make_sample(i, j, n, to));
+        const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, n, to));
         if (ray.passed) {
             ++passing;
             if (*first < 0)
@@ -116,14 +116,14 @@ inline int passing_samples(const Model& model, int i, int j, int from, int to, i
 // `sum` holds the sums of the `passed` traced colours of samples 0 .. n-1. With none passed but
 // some probe passing, that probe's sample is traced so the pixel is not black where light lands.
 template <class TraceFn>
-Rgbt vignetted_value(const Model& model, int i, int j, int n, int passed, double sum[4], TraceFn& trace)
+Rgbt vignetted_value(const PlenopticCamera& model, int i, int j, int n, int passed, double sum[4], TraceFn& trace)
 {
     const int probes = n * kVignettingProbesPerSample;
     int first_untraced;
     // Samples 0 .. n-1 were generated already: only the points after them are new.
     const int passing = passed + passing_samples(model, i, j, n, probes, &first_untraced);
     if (passed == 0 && first_untraced >= 0) {
-        const OpticsRay ray = generate_ray(model, i, j, make_sample(i, j, first_untraced, probes));
+        const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, first_untraced, probes));
         const Rgbt c = detail::traced(trace, ray);
         sum[0] = c.r;
         sum[1] = c.g;
@@ -143,7 +143,7 @@ const int kLitAreaGrid = 4;
 // The mean lit area (LitAreaTable) of pixel (i, j): the midpoint rule on a kLitAreaGrid square
 // grid over the pixel. The lit area is smooth across a pixel (a kink where vignetting sets in at
 // most), so the rule's error is second order in the pixel's size; a table look-up each, no trace.
-inline double mean_lit_area(const Model& model, int i, int j)
+inline double mean_lit_area(const PlenopticCamera& model, int i, int j)
 {
     double total = 0;
     for (int b = 0; b < kLitAreaGrid; ++b)
@@ -152,7 +152,7 @@ inline double mean_lit_area(const Model& model, int i, int j)
     return total / (kLitAreaGrid * kLitAreaGrid);
 }
 
-// The pixel's value behind a real lens with a lit-area table (Model::lit_area: no array, round
+// The pixel's value behind a real lens with a lit-area table (PlenopticCamera::lit_area: no array, round
 // stop), from its n > 1 samples: the mean colour of those that passed (`plain`: their colours
 // without the ray weight) times the pixel's mean lit area (mean_lit_area). The samples that pass
 // are spread uniformly over the pixel's lit (sensor point, pupil point) pairs, so their plain
@@ -160,7 +160,7 @@ inline double mean_lit_area(const Model& model, int i, int j)
 // vignetting costs look-ups, not traces. With none passed, the first passing point of
 // kVignettingProbesPerSample n points of its sample sequence is traced for the colour.
 template <class TraceFn>
-Rgbt lit_area_value(const Model& model, int i, int j, int n, int passed, const double plain[4], TraceFn& trace)
+Rgbt lit_area_value(const PlenopticCamera& model, int i, int j, int n, int passed, const double plain[4], TraceFn& trace)
 {
     const double lit = mean_lit_area(model, i, j);
     if (!(lit > 0))
@@ -171,7 +171,7 @@ Rgbt lit_area_value(const Model& model, int i, int j, int n, int passed, const d
     }
     const int points = n * kVignettingProbesPerSample;
     for (int k = n; k < points; ++k) {
-        const OpticsRay ray = generate_ray(model, i, j, make_sample(i, j, k, points));
+        const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, k, points));
         if (ray.passed) {
             const Rgbt c = trace(ray);
             return Rgbt{c.r * lit, c.g * lit, c.b * lit, c.t * lit};
@@ -184,7 +184,7 @@ Rgbt lit_area_value(const Model& model, int i, int j, int n, int passed, const d
 
 // Shades pixel (i, j) of a W x H image. For each sample it builds the sample, generates the ray
 // and calls trace(const OpticsRay&) -> Rgbt for unblocked rays only; a blocked sample counts as
-// black and opaque (0, 0, 0, t = 0). Fixed count: model.samples_max samples. Adaptive (as
+// black and opaque (0, 0, 0, t = 0). Fixed count: model.sampling.samples_max samples. Adaptive (as
 // focal_blur): samples_min samples, then batches of 4, stopping once at least one sample has
 // passed the apertures and the variance of the estimate is below thresholds[n-1] in every
 // channel (r, g, b, t), or samples_max is reached. When some of the n samples were blocked, the
@@ -198,17 +198,17 @@ Rgbt lit_area_value(const Model& model, int i, int j, int n, int passed, const d
 // the value is the sum over lenses of each lens's mean; t is clamped to [0, 1]. A pixel that no
 // lens reaches is black and opaque, never background.
 template <class TraceFn>
-Rgbt shade_pixel(const Model& model, int i, int j, TraceFn trace)
+Rgbt shade_pixel(const PlenopticCamera& model, int i, int j, TraceFn trace)
 {
-    const int count = std::max(1, model.samples_max);
-    if (!model.adaptive && !model.model_overlap) {
+    const int count = std::max(1, model.sampling.samples_max);
+    if (!model.sampling.adaptive && !model.overlap.modelled) {
         // Fixed count through the own lens: the plain mean, without the variance bookkeeping
         // (the common case, and the one whose cost is compared with the stock cameras).
         const bool lit_area = model.lit_area && count > 1;
         double sum[4] = {0, 0, 0, 0};
         int passed = 0;
         for (int n = 0; n < count; ++n) {
-            const OpticsRay ray = generate_ray(model, i, j, make_sample(i, j, n, count));
+            const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, n, count));
             if (ray.passed) {
                 // With a lit-area table the colours are summed without the ray weight: the
                 // pixel's lit area scales their mean (detail::lit_area_value).
@@ -229,7 +229,7 @@ Rgbt shade_pixel(const Model& model, int i, int j, TraceFn trace)
 
     LensIndex lenses[kMaxOverlapLenses];
     int lens_count = 1;
-    if (model.model_overlap) {
+    if (model.overlap.modelled) {
         lens_count = overlap_lenses(model, i, j, lenses, kMaxOverlapLenses);
         if (lens_count == 0)
             return Rgbt{0, 0, 0, 0};
@@ -238,7 +238,7 @@ Rgbt shade_pixel(const Model& model, int i, int j, TraceFn trace)
     for (int s = 0; s < lens_count; ++s)
         sums[s] = detail::SampleSums{{0, 0, 0, 0}, {0, 0, 0, 0}, 0};
 
-    int batch = model.adaptive ? std::max(1, model.samples_min) : count;
+    int batch = model.sampling.adaptive ? std::max(1, model.sampling.samples_min) : count;
     double value[4], variance[4];
     int n = 0;
     int passed = 0;  // samples that passed the apertures so far
@@ -248,7 +248,7 @@ Rgbt shade_pixel(const Model& model, int i, int j, TraceFn trace)
         for (; n < stop; ++n) {
             int slot = 0;
             const CameraSample sample = detail::lens_sample(i, j, n, count, lens_count, &slot);
-            const OpticsRay ray = generate_ray(model, i, j, sample, model.model_overlap ? &lenses[slot] : nullptr);
+            const OpticsRay ray = generate_ray(model, i, j, sample, model.overlap.modelled ? &lenses[slot] : nullptr);
             Rgbt colour{0, 0, 0, 0};
             if (ray.passed) {
                 const Rgbt raw = trace(ray);
@@ -261,7 +261,7 @@ Rgbt shade_pixel(const Model& model, int i, int j, TraceFn trace)
             }
             detail::add_sample(&sums[slot], colour);
         }
-        if (!model.adaptive || n >= count)
+        if (!model.sampling.adaptive || n >= count)
             break;
         batch = 4;
         // While every sample so far was blocked, the zero variance says nothing: a pixel at the
@@ -273,7 +273,7 @@ Rgbt shade_pixel(const Model& model, int i, int j, TraceFn trace)
         // rim pixels sampling (tried: leaving it out to the vignetting probes stopped them too early;
         // on the benchmark's plenoptic 1.0 scene that took 1.6-2x the time for the same error).
         detail::estimate(sums, lens_count, value, variance);
-        const double threshold = model.thresholds[n - 1];
+        const double threshold = model.sampling.thresholds[n - 1];
         if (std::fabs(variance[0]) < threshold && std::fabs(variance[1]) < threshold &&
             std::fabs(variance[2]) < threshold && std::fabs(variance[3]) < threshold)
             break;
@@ -290,7 +290,7 @@ Rgbt shade_pixel(const Model& model, int i, int j, TraceFn trace)
 // Whether any of the sample points shade_pixel looks at for pixel (i, j) passes the apertures
 // (the traced samples and the vignetting probes): the pixels for which it is false are those
 // no light reaches (no scene needed).
-inline bool pixel_receives_light(const Model& model, int i, int j)
+inline bool pixel_receives_light(const PlenopticCamera& model, int i, int j)
 {
     bool lit = false;
     shade_pixel(model, i, j, [&lit](const OpticsRay&) {

@@ -35,7 +35,7 @@ TEST(Pixel, BlockedSamplesAreBlackAndOpaqueNeverBackground)
     // Pinhole array behind a small main aperture: small microimage discs, dark cells between.
     CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.5, 0, 2, 50, 50, 52);
     params.sampling.samples = 16;
-    const Model m = make_model(params);
+    const PlenopticCamera m = make_camera(params);
     const int W = 101, H = 101;
     int calls = 0;
     // The scene returns fully transparent background for every ray it is asked about.
@@ -78,7 +78,7 @@ TEST(Pixel, AdaptiveSamplingStopsEarlyOnFlatScenesAndGoesOnOnNoisyOnes)
     params.sampling.adaptive = true;
     params.sampling.samples_min = 8;
     params.sampling.samples_max = 64;
-    const Model m = with_film(make_model(params), 64, 64);
+    const PlenopticCamera m = with_film(make_camera(params), 64, 64);
     int calls = 0;
     auto flat = [&](const OpticsRay&) {
         ++calls;
@@ -110,7 +110,7 @@ TEST(Pixel, AdaptiveSamplingDoesNotTakeAnUnluckyBlockedStartForADarkPixel)
     adaptive.sampling.adaptive = true;
     adaptive.sampling.samples_min = minimum;
     adaptive.sampling.samples_max = maximum;
-    const Model m_fixed = with_film(make_model(fixed), W, H), m_adaptive = with_film(make_model(adaptive), W, H);
+    const PlenopticCamera m_fixed = with_film(make_camera(fixed), W, H), m_adaptive = with_film(make_camera(adaptive), W, H);
     auto white = [](const OpticsRay&) { return Rgbt{1, 1, 1, 0}; };
     int unlucky = 0;
     for (int j = 0; j < H; ++j)
@@ -118,12 +118,12 @@ TEST(Pixel, AdaptiveSamplingDoesNotTakeAnUnluckyBlockedStartForADarkPixel)
             bool first_lit = false;
             for (int n = 0; n < minimum && !first_lit; ++n) {
                 OpticsRay ray;
-                first_lit = (ray = generate_ray(m_adaptive, i, j, make_sample(i, j, n, maximum), nullptr)).passed;
+                first_lit = (ray = m_adaptive.generate_ray(i, j, make_sample(i, j, n, maximum))).passed;
             }
             const bool lit = shade_pixel(m_fixed, i, j, white).r > 0;
             const Rgbt value = shade_pixel(m_adaptive, i, j, white);
             EXPECT_EQ(value.r > 0, lit) << "pixel " << i << "," << j << ": dark exactly when no sample passes";
-            EXPECT_EQ(pixel_receives_light(m_adaptive, i, j), lit) << "pixel " << i << "," << j;
+            EXPECT_EQ(m_adaptive.receives_light(i, j), lit) << "pixel " << i << "," << j;
             if (lit && !first_lit)
                 ++unlucky;
         }
@@ -137,7 +137,7 @@ TEST(Pixel, VignettingProbesBringRimPixelsCloserToTheirTrueLitFraction)
     const int W = 160, H = 120, samples = 16, reference = 4096;
     CameraParams params = matched_plenoptic1();
     params.sampling.samples = samples;
-    const Model m = with_film(make_model(params), W, H);
+    const PlenopticCamera m = with_film(make_camera(params), W, H);
     auto white = [](const OpticsRay&) { return Rgbt{1, 1, 1, 0}; };
     double error_plain = 0, error_probed = 0;
     int rim = 0;
@@ -162,7 +162,7 @@ TEST(Pixel, DeterministicWhateverThePixelOrder)
     CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.2, 1.5, 2, 50, 4, 55);
     params.sampling.samples = 8;
     params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.01;
-    const Model m = make_model(params);
+    const PlenopticCamera m = make_camera(params);
     const int W = 40, H = 30;
     std::vector<Rgbt> forward, backward(W * H);
     for (int j = 0; j < H; ++j)
@@ -185,11 +185,11 @@ TEST(Pixel, OverlapModellingLeavesSingleLensPixelsUnchanged)
     CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 10, 50);
     params.sampling.samples = 16;
     params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.005;
-    const Model plain = make_model(params);
-    ASSERT_FALSE(plain.model_overlap);
-    Model forced = plain;
-    forced.model_overlap = true;
-    forced.overlap_rings = 2;
+    const PlenopticCamera plain = make_camera(params);
+    ASSERT_FALSE(plain.overlap.modelled);
+    PlenopticCamera forced = plain;
+    forced.overlap.modelled = true;
+    forced.overlap.rings = 2;
     const int W = 100, H = 100;
     int single = 0;
     LensIndex lenses[kMaxOverlapLenses];
@@ -273,8 +273,8 @@ TEST(Pixel, OverlapPixelsAreUnbiasedEstimatesOfEachLensIntegral)
     CameraParams params = plenoptic_camera(GridType::Rectangular, p, d, d, F, 2.5, D);
     params.sampling.samples = 1024;
     params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = cell / 5;
-    const Model m = make_model(params);
-    ASSERT_TRUE(m.model_overlap);
+    const PlenopticCamera m = make_camera(params);
+    ASSERT_TRUE(m.overlap.modelled);
     const int W = 30, H = 30;
     const double A = F / 2.5;
     auto scene = [A](const OpticsRay& ray) {
@@ -319,9 +319,9 @@ TEST(Pixel, OverlapPixelsAreUnbiasedEstimatesOfEachLensIntegral)
     EXPECT_GT(compared, 10);
 }
 
-double mean_white_image(const Model& m)
+double mean_white_image(const PlenopticCamera& m)
 {
-    const int W = m.film.width, H = m.film.height;
+    const int W = m.sensor.film.width, H = m.sensor.film.height;
     double sum = 0;
     for (int j = 0; j < H; ++j)
         for (int i = 0; i < W; ++i)
@@ -340,17 +340,17 @@ TEST(Pixel, WhiteSceneMeanIsApertureImageAreaOverCellArea)
         CameraParams params = plenoptic_camera(GridType::Rectangular, p, d, d, F, f_number, D);
         params.sampling.samples = 16;
         params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = cell / 20;
-        const Model m = make_model(params);
+        const PlenopticCamera m = make_camera(params);
         const int W = 220, H = 220;
         const double A = F / f_number;
         const double expected = kPi * (A * d / (2 * D)) * (A * d / (2 * D)) / (cell * cell);
         const double mean = mean_white_image(with_film(m, W, H));
         EXPECT_NEAR(mean, expected, 0.003 * expected)
-            << "f/" << f_number << " overlap modelled: " << m.model_overlap << " rings " << m.overlap_rings;
+            << "f/" << f_number << " overlap modelled: " << m.overlap.modelled << " rings " << m.overlap.rings;
         if (f_number == 2.5) {
             // Without overlap modelling the neighbours' light would be lost.
-            Model without = m;
-            without.model_overlap = false;
+            PlenopticCamera without = m;
+            without.overlap.modelled = false;
             EXPECT_LT(mean_white_image(with_film(without, W, H)), 0.5 * expected);
         }
     }
@@ -361,7 +361,7 @@ TEST(Pixel, ReceivesLightExactlyWhenSomeSampleIsTraced)
     // f/8 behind f/4-matched microlenses: a ring of every microimage is dark.
     CameraParams p = test::plenoptic_camera(GridType::Hexagonal, 0.2, 0.8, 0.8, 50, 8, 52);
     p.sampling.samples = 8;
-    const Model m = make_model(p);
+    const PlenopticCamera m = make_camera(p);
     const int W = 60, H = 40;
     int dark = 0, lit = 0;
     for (int j = 0; j < H; ++j)

@@ -17,12 +17,12 @@ const int kCellGrid = 256;
 const int kDiscRings = 4096;
 
 // The mean of cos^m over a microlens cell, seen from the point at distance d under its centre.
-double mean_cos_power_over_cell(const Model& m, double d, double power)
+double mean_cos_power_over_cell(const PlenopticCamera& m, double d, double power)
 {
     double total = 0;
     for (int b = 0; b < kCellGrid; ++b)
         for (int a = 0; a < kCellGrid; ++a) {
-            const Vec2 q = sample_cell_uniform(m.grid, m.pitch_mm, (a + 0.5) / kCellGrid, (b + 0.5) / kCellGrid);
+            const Vec2 q = sample_cell_uniform(m.array.grid, m.array.pitch_mm, (a + 0.5) / kCellGrid, (b + 0.5) / kCellGrid);
             total += std::pow(d * d / (d * d + q.x * q.x + q.y * q.y), 0.5 * power);
         }
     return total / (kCellGrid * kCellGrid);
@@ -44,39 +44,39 @@ double mean_cos_power_over_disc(double a, double h, double power)
 
 } // namespace
 
-double irradiance_constant_mm2(const Model& m)
+double irradiance_constant_mm2(const PlenopticCamera& m)
 {
-    if (m.radiometry != Radiometry::Irradiance)
+    if (m.sensor.radiometry != Radiometry::Irradiance)
         return 0;
-    const double power = 4 + m.angular_exponent;
-    if (m.grid == GridType::None) {
+    const double power = 4 + m.sensor.angular_exponent;
+    if (m.array.grid == GridType::None) {
         // The sampled domain is the exit pupil's disc (a pinhole's point: the limit a -> 0), C is
         // its on-axis A mean(cos^4) / h^2 = pi a^2 / (h^2 + a^2) without an angular response,
         // so K = h^2 / mean(cos^m). A traced lens's samples cover the pupil-bounds disc instead;
         // their flat weight (its area over the paraxial pupil's) carries that difference.
-        const double h = m.lens->exit_pupil_centre().z - m.sensor_z_mm;
+        const double h = m.lens->exit_pupil_centre().z - m.sensor.z_mm;
         const double a = m.lens->exit_pupil_radius();
-        if (m.angular_exponent == 0)
+        if (m.sensor.angular_exponent == 0)
             return h * h + a * a;  // the closed form of the mean of cos^4
         return h * h / mean_cos_power_over_disc(a, h, power);
     }
     // The pixel under the centre of a lens, at d, lit through the lens's whole cell: K = A / C
     // with C = A * mean(cos^m) / d^2 (a pinhole microlens's point: mean 1).
     const double d = effective_array_distance_mm(m);
-    if (m.microlens == MicrolensType::Pinhole)
+    if (m.array.microlens == MicrolensType::Pinhole)
         return d * d;
     return d * d / mean_cos_power_over_cell(m, d, power);
 }
 
-double reference_projected_solid_angle_sr(const Model& m)
+double reference_projected_solid_angle_sr(const PlenopticCamera& m)
 {
-    if (m.radiometry != Radiometry::Irradiance)
+    if (m.sensor.radiometry != Radiometry::Irradiance)
         return 0;
-    if (m.grid == GridType::None)
-        return !m.lens->forms_image() ? 0 : kPi * std::pow(m.lens->exit_pupil_radius(), 2) / m.irradiance_k_mm2;
-    if (m.microlens == MicrolensType::Pinhole)
+    if (m.array.grid == GridType::None)
+        return !m.lens->forms_image() ? 0 : kPi * std::pow(m.lens->exit_pupil_radius(), 2) / m.sensor.irradiance_k_mm2;
+    if (m.array.microlens == MicrolensType::Pinhole)
         return 0;
-    return m.pitch_mm * row_spacing(m.grid, m.pitch_mm) / m.irradiance_k_mm2;  // A / K
+    return m.array.pitch_mm * row_spacing(m.array.grid, m.array.pitch_mm) / m.sensor.irradiance_k_mm2;  // A / K
 }
 
 const char* radiometry_name(Radiometry radiometry)

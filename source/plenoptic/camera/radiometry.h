@@ -31,19 +31,19 @@
 
 #include <cmath>
 
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 #include "plenoptic/core/irradiance.h"
 #include "plenoptic/core/vec.h"
 
 namespace plenoptic {
 
-// K = A / C of the model's sampled aperture domain (mm^2), for make_model; 0 under flat radiometry.
-double irradiance_constant_mm2(const Model& model);
+// K = A / C of the model's sampled aperture domain (mm^2), for make_camera; 0 under flat radiometry.
+double irradiance_constant_mm2(const PlenopticCamera& model);
 
 // C, the projected solid angle (sr) by which irradiance values are divided: E = value * C * L.
 // 0 under flat radiometry and where C is a pinhole's limit (a pinhole main lens without an
 // array, pinhole microlenses).
-double reference_projected_solid_angle_sr(const Model& model);
+double reference_projected_solid_angle_sr(const PlenopticCamera& model);
 
 // "flat" or "irradiance", as the scene writes it.
 const char* radiometry_name(Radiometry radiometry);

@@ -41,7 +41,7 @@ TEST(Radiometry, PinholeWithoutArrayFallsOffAsCos4AndIsOneOnAxis)
 {
     CameraParams p = irradiance_pinhole();
     ASSERT_EQ(check_camera(p), "");
-    const Model m = make_model(p);
+    const PlenopticCamera m = make_camera(p);
     const int W = 201, H = 151;
     double worst = 0;
     for (int j = 0; j < H; j += 15)
@@ -54,7 +54,7 @@ TEST(Radiometry, PinholeWithoutArrayFallsOffAsCos4AndIsOneOnAxis)
     EXPECT_NEAR(shade_pixel(with_film(m, W, H), 100, 75, white).r, 1, 1e-15);
     // Flat radiometry is the stock perspective camera: 1 everywhere.
     p.radiometry = Radiometry::Flat;
-    EXPECT_EQ(shade_pixel(with_film(make_model(p), W, H), 0, 0, white).r, 1);
+    EXPECT_EQ(shade_pixel(with_film(make_camera(p), W, H), 0, 0, white).r, 1);
 }
 
 // E / L of a point at distance r from the axis of a Lambertian disc of radius a, parallel to the
@@ -72,7 +72,7 @@ TEST(Radiometry, ThinLensWithoutArrayMatchesTheDiscViewFactorAcrossTheSensor)
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.25;
     p.sampling.samples = 4096;
     p.radiometry = Radiometry::Irradiance;
-    const Model m = make_model(p);
+    const PlenopticCamera m = make_camera(p);
     const int W = 241, H = 3;
     const double a = 12.5, h = 52;
     const double on_axis = disc_irradiance(a, h, 0);
@@ -117,7 +117,7 @@ TEST(Radiometry, BareArrayMicroimageFollowsTheCos4IntegralOverItsCell)
     p.sampling.samples = 1024;
     p.radiometry = Radiometry::Irradiance;
     ASSERT_EQ(check_camera(p), "");
-    const Model m = make_model(p);
+    const PlenopticCamera m = make_camera(p);
     const int W = 75, H = 75;  // 3 x 3 lenses of 25 pixels; pixel (37, 37) under the centre lens's centre
     const double reference = cell_cos4(0.1, 0, 0, 0.2, 0, 0);
     double worst = 0;
@@ -167,7 +167,7 @@ TEST(Radiometry, AnIdealArrayPassesTheEtendueOfItsCellThroughTheMainPupil)
     CameraParams p = test::plenoptic_camera(GridType::Hexagonal, 0.16, 0.64, 0.64, 16, 4, 16.1);
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.01;
     p.radiometry = Radiometry::Irradiance;
-    const Model m = make_model(p);
+    const PlenopticCamera m = make_camera(p);
     const int W = 61, H = 61;  // 0.61 mm: the microimage (0.16 mm) and its rim with room to spare
     const LensIndex centre{0, 0};
     const int count = 256;
@@ -233,7 +233,7 @@ TEST(Radiometry, MicroimageCentresFallOffAcrossTheSensorAsTheirCellIsSeen)
     p.sampling.samples = 1024;
     p.radiometry = Radiometry::Irradiance;
     ASSERT_EQ(check_camera(p), "");
-    const Model m = make_model(p);
+    const PlenopticCamera m = make_camera(p);
     const int W = 12801, H = 3;
     const double D = 20.2, d = 0.8;
     const double reference = cell_cos4(0.2, 0, 0, d, 0, 0);  // C
@@ -280,7 +280,7 @@ TEST(Radiometry, AngularResponseMultipliesTheCos4LawAndKeepsTheAxisAtOne)
     CameraParams p = irradiance_pinhole();
     p.sensor.angular_exponent = 6;
     ASSERT_EQ(check_camera(p), "");
-    const Model pinhole = with_film(make_model(p), 201, 1);
+    const PlenopticCamera pinhole = with_film(make_camera(p), 201, 1);
     const double x = centre_x(170, 201, 0.5);
     const double cos2 = 2500 / (2500 + x * x);
     EXPECT_NEAR(shade_pixel(pinhole, 170, 0, white).r, std::pow(cos2, 5), 1e-12);
@@ -291,7 +291,7 @@ TEST(Radiometry, AngularResponseMultipliesTheCos4LawAndKeepsTheAxisAtOne)
     t.sampling.samples = 4096;
     t.radiometry = Radiometry::Irradiance;
     t.sensor.angular_exponent = 8;
-    const Model thin = make_model(t);
+    const PlenopticCamera thin = make_camera(t);
     const int W = 241;
     const double on_axis = disc_cos_power(12.5, 52, 0, 12);
     double worst = 0;

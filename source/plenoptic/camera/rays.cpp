@@ -14,19 +14,19 @@ namespace detail {
 
 // Intersection of the line (main-lens centre -> p), or the vertical line through p when there is
 // no main lens, with the array plane; array-local coordinates.
-bool project_to_array(const Model& m, Vec3 p, Vec2* local)
+bool project_to_array(const PlenopticCamera& m, Vec3 p, Vec2* local)
 {
-    const Vec3 n = m.pose.normal;
+    const Vec3 n = m.array.pose.normal;
     Vec3 q;
     if (!m.lens) {
         if (!(n.z > 0))
             return false;
-        q = Vec3{p.x, p.y, p.z + dot(n, m.pose.centre_mm - p) / n.z};
+        q = Vec3{p.x, p.y, p.z + dot(n, m.array.pose.centre_mm - p) / n.z};
     } else {
         // The line from the exit pupil's centre e through p: q = e + s (p - e).
         const Vec3 e = m.lens->exit_pupil_centre();
         const double along = dot(n, p - e);
-        const double s = dot(n, m.pose.centre_mm - e) / along;
+        const double s = dot(n, m.array.pose.centre_mm - e) / along;
         if (!(s > 0) || !std::isfinite(s))
             return false;
         q = e + s * (p - e);
@@ -63,9 +63,9 @@ bool finish(Vec3 origin, Vec3 direction, OpticsRay* out) { return emit(scene_ray
 // The microlens images the pinhole O to the homogeneous point I = (o, 1 - o_z/f) (lens-relative
 // coordinates); every ray from p aimed at I leaves the lens through O. No division by
 // (1 + D/d - D/f), so near-degenerate set-ups only block rays.
-bool through_pinhole_main(const Model& m, Vec3 p, LensIndex lens, bool check_cell, OpticsRay* out)
+bool through_pinhole_main(const PlenopticCamera& m, Vec3 p, LensIndex lens, bool check_cell, OpticsRay* out)
 {
-    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
     const double f = microlens_focal(m, lens);
     const Vec3 o = to_local(m, Vec3{0, 0, 0});
     const Vec3 s = to_local(m, p);
@@ -82,26 +82,26 @@ bool through_pinhole_main(const Model& m, Vec3 p, LensIndex lens, bool check_cel
     const double t = -p_rel.z / along.z;
     const double hx = p_rel.x + t * along.x;
     const double hy = p_rel.y + t * along.y;
-    if (check_cell && nearest_lens(m.grid, m.pitch_mm, c.x + hx, c.y + hy) != lens)
+    if (check_cell && nearest_lens(m.array.grid, m.array.pitch_mm, c.x + hx, c.y + hy) != lens)
         return false;
     const Vec3 local_out{along.x / along.z - hx / f, along.y / along.z - hy / f, 1};
-    return finish(Vec3{0, 0, 0}, mul(m.pose.rotation, local_out), out);
+    return finish(Vec3{0, 0, 0}, mul(m.array.pose.rotation, local_out), out);
 }
 
 // Under irradiance radiometry, weights a passing ray from sensor point s towards aperture point q
 // (on a plane of normal n) by the cos^4 law (camera/radiometry.h); returns `passed`.
-bool weigh(const Model& m, bool passed, Vec3 s, Vec3 q, Vec3 n, OpticsRay* out)
+bool weigh(const PlenopticCamera& m, bool passed, Vec3 s, Vec3 q, Vec3 n, OpticsRay* out)
 {
-    if (passed && m.radiometry == Radiometry::Irradiance)
-        out->weight *= irradiance_weight(m.irradiance_k_mm2, m.angular_exponent, s, q, n);
+    if (passed && m.sensor.radiometry == Radiometry::Irradiance)
+        out->weight *= irradiance_weight(m.sensor.irradiance_k_mm2, m.sensor.angular_exponent, s, q, n);
     return passed;
 }
 
 // The whole camera for one sensor point and one aperture sample (lens_u, lens_v).
-bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double lens_u, double lens_v,
+bool trace_sensor_point(const PlenopticCamera& m, Vec3 p, const LensIndex* forced, double lens_u, double lens_v,
                         bool check_apertures, OpticsRay* out)
 {
-    if (m.grid == GridType::None && m.pupil_bounds && check_apertures) {
+    if (m.array.grid == GridType::None && m.pupil_bounds && check_apertures) {
         // A real lens: towards a point of the region of the exit pupil's plane where light from p
         // can pass, weighted by that region's area, or by the lit part's when the model has a
         // lit-area table (see OpticsRay::weight). Chief rays (no
@@ -121,7 +121,7 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
         out->weight = ratio * ratio;
         return weigh(m, true, p, on_pupil, Vec3{0, 0, 1}, out);
     }
-    if (m.grid == GridType::None) {
+    if (m.array.grid == GridType::None) {
         // The sensor point towards a point of the exit pupil, through the lens.
         const Vec3 on_pupil = m.lens->exit_pupil_point(lens_u, lens_v);
         return weigh(m, emit(m.lens->to_scene(p, on_pupil - p, false), out), p, on_pupil, Vec3{0, 0, 1}, out);
@@ -134,35 +134,35 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
         Vec2 q;
         if (!project_to_array(m, p, &q))
             return false;
-        lens = nearest_lens(m.grid, m.pitch_mm, q.x, q.y);
+        lens = nearest_lens(m.array.grid, m.array.pitch_mm, q.x, q.y);
     }
 
-    if (m.microlens == MicrolensType::ThinLens && m.lens && !m.lens->forms_image())
+    if (m.array.microlens == MicrolensType::ThinLens && m.lens && !m.lens->forms_image())
         return through_pinhole_main(m, p, lens, check_apertures, out);
 
-    const Vec2 c_local = lens_centre(m.grid, m.pitch_mm, lens);
+    const Vec2 c_local = lens_centre(m.array.grid, m.array.pitch_mm, lens);
     Vec3 leave;      // where the ray leaves the array
     Vec3 direction;  // after the microlens, optics frame, any length
-    if (m.microlens == MicrolensType::Pinhole) {
+    if (m.array.microlens == MicrolensType::Pinhole) {
         leave = to_optics(m, Vec3{c_local.x, c_local.y, 0});
         direction = leave - p;
-        if (!(dot(direction, m.pose.normal) > 0))
+        if (!(dot(direction, m.array.pose.normal) > 0))
             return false;  // the sensor point is not behind the array
     } else {
         // A point of the lens cell; refraction in the array's own frame, with the direction
         // normalised to unit local z: w' = w - (h - c) / f.
-        const Vec2 offset = sample_cell_uniform(m.grid, m.pitch_mm, lens_u, lens_v);
+        const Vec2 offset = sample_cell_uniform(m.array.grid, m.array.pitch_mm, lens_u, lens_v);
         leave = to_optics(m, Vec3{c_local.x + offset.x, c_local.y + offset.y, 0});
-        const Vec3 w = mul_transposed(m.pose.rotation, leave - p);
+        const Vec3 w = mul_transposed(m.array.pose.rotation, leave - p);
         if (!(w.z > 0))
             return false;
         const double f = microlens_focal(m, lens);
         const Vec3 refracted{w.x / w.z - offset.x / f, w.y / w.z - offset.y / f, 1};
-        direction = mul(m.pose.rotation, refracted);
+        direction = mul(m.array.pose.rotation, refracted);
     }
 
     if (!m.lens)
-        return weigh(m, finish(leave, direction, out), p, leave, m.pose.normal, out);
+        return weigh(m, finish(leave, direction, out), p, leave, m.array.pose.normal, out);
     if (!m.lens->forms_image())
         return false;  // pinhole + pinhole: refused at parse time, no ray passes both points
 
@@ -171,10 +171,10 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
     // (PupilBounds holds every point through which light from that point passes, and the bounds
     // were made for points of this plane), so it is blocked without the surface-by-surface trace:
     // most of the rays at the rims of microimages and their vignetting probes.
-    if (check_apertures && m.pupil_bounds && !m.pose.tilted && !m.pupil_bounds->may_pass(leave, direction))
+    if (check_apertures && m.pupil_bounds && !m.array.pose.tilted && !m.pupil_bounds->may_pass(leave, direction))
         return false;
     // On through the main lens (a ray that misses its apertures carries no light).
-    return weigh(m, emit(m.lens->to_scene(leave, direction, check_apertures), out), p, leave, m.pose.normal, out);
+    return weigh(m, emit(m.lens->to_scene(leave, direction, check_apertures), out), p, leave, m.array.pose.normal, out);
 }
 
 // Whether light through `lens` can reach some point of the pixel centred at p. With k = D/d
@@ -184,24 +184,24 @@ bool trace_sensor_point(const Model& m, Vec3 p, const LensIndex* forced, double 
 // lens reaches the pixel iff that region meets the aperture disc. Conservative: circumradius for
 // the cell, half the pixel diagonal for the pixel; for a slightly tilted array the spread terms get
 // a margin that grows with the tilt (validated against brute force in the unit tests).
-bool lens_reaches_pixel(const Model& m, LensIndex lens, Vec3 p)
+bool lens_reaches_pixel(const PlenopticCamera& m, LensIndex lens, Vec3 p)
 {
     if (!m.lens)
         return true;
     const Vec3 c = lens_centre_mm(m, lens);
     const Vec3 e = m.lens->exit_pupil_centre();
     const double main_distance = e.z - c.z;
-    const double array_distance = c.z - m.sensor_z_mm;
+    const double array_distance = c.z - m.sensor.z_mm;
     if (!(main_distance > 0) || !(array_distance > 0))
         return true;
     const double k = main_distance / array_distance;
     const double mx = (c.x - e.x) * (1 + k) - (p.x - e.x) * k;
     const double my = (c.y - e.y) * (1 + k) - (p.y - e.y) * k;
-    double spread = 0.5 * std::hypot(m.pixel_size_mm[0], m.pixel_size_mm[1]) * k;
-    if (m.microlens == MicrolensType::ThinLens)
-        spread += m.cell_circumradius_mm * std::fabs(1 + k - main_distance / microlens_focal(m, lens));
-    if (m.pose.tilted)
-        spread *= 1.25 + 4 * m.pose.tilt_sine;
+    double spread = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]) * k;
+    if (m.array.microlens == MicrolensType::ThinLens)
+        spread += m.array.cell_circumradius_mm * std::fabs(1 + k - main_distance / microlens_focal(m, lens));
+    if (m.array.pose.tilted)
+        spread *= 1.25 + 4 * m.array.pose.tilt_sine;
     if (m.pupil_bounds) {
         // A real lens: the region where light from the lens centre passes its apertures.
         const PupilDisc disc = m.pupil_bounds->disc_for(c);
@@ -212,42 +212,42 @@ bool lens_reaches_pixel(const Model& m, LensIndex lens, Vec3 p)
 
 } // namespace
 
-Vec3 sensor_point(const Model& m, double pu, double pv)
+Vec3 sensor_point(const PlenopticCamera& m, double pu, double pv)
 {
-    const int W = m.film.width, H = m.film.height;
-    return Vec3{-(pu - 0.5 * W) * m.pixel_size_mm[0] + m.sensor_offset_mm[0],
-                (pv - 0.5 * H) * m.pixel_size_mm[1] + m.sensor_offset_mm[1], m.sensor_z_mm};
+    const int W = m.sensor.film.width, H = m.sensor.film.height;
+    return Vec3{-(pu - 0.5 * W) * m.sensor.pixel_size_mm[0] + m.sensor.offset_mm[0],
+                (pv - 0.5 * H) * m.sensor.pixel_size_mm[1] + m.sensor.offset_mm[1], m.sensor.z_mm};
 }
 
-PixelPoint sensor_to_pixel(const Model& m, double x_mm, double y_mm)
+PixelPoint sensor_to_pixel(const PlenopticCamera& m, double x_mm, double y_mm)
 {
-    const int W = m.film.width, H = m.film.height;
-    const double u = 0.5 * W - 0.5 - (x_mm - m.sensor_offset_mm[0]) / m.pixel_size_mm[0];
-    const double v = 0.5 * H - 0.5 + (y_mm - m.sensor_offset_mm[1]) / m.pixel_size_mm[1];
+    const int W = m.sensor.film.width, H = m.sensor.film.height;
+    const double u = 0.5 * W - 0.5 - (x_mm - m.sensor.offset_mm[0]) / m.sensor.pixel_size_mm[0];
+    const double v = 0.5 * H - 0.5 + (y_mm - m.sensor.offset_mm[1]) / m.sensor.pixel_size_mm[1];
     return PixelPoint{u, v, u >= -0.5 && u < W - 0.5 && v >= -0.5 && v < H - 0.5};
 }
 
-Vec2 principal_point_px(const Model& m)
+Vec2 principal_point_px(const PlenopticCamera& m)
 {
     const PixelPoint p = sensor_to_pixel(m, 0, 0);
     return Vec2{p.u, p.v};
 }
 
-Vec3 lens_centre_mm(const Model& m, LensIndex lens)
+Vec3 lens_centre_mm(const PlenopticCamera& m, LensIndex lens)
 {
-    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
     return to_optics(m, Vec3{c.x, c.y, 0});
 }
 
-OwnLens own_lens(const Model& m, Vec3 p)
+OwnLens own_lens(const PlenopticCamera& m, Vec3 p)
 {
     Vec2 q;
     if (!project_to_array(m, p, &q))
         return OwnLens{LensIndex{0, 0}, false};
-    return OwnLens{nearest_lens(m.grid, m.pitch_mm, q.x, q.y), true};
+    return OwnLens{nearest_lens(m.array.grid, m.array.pitch_mm, q.x, q.y), true};
 }
 
-OpticsRay generate_ray(const Model& m, int i, int j, const CameraSample& sample, const LensIndex* lens)
+OpticsRay generate_ray(const PlenopticCamera& m, int i, int j, const CameraSample& sample, const LensIndex* lens)
 {
     const Vec3 p = sensor_point(m, i + sample.pixel_u, j + sample.pixel_v);
     OpticsRay ray;
@@ -255,9 +255,9 @@ OpticsRay generate_ray(const Model& m, int i, int j, const CameraSample& sample,
     return ray;
 }
 
-int overlap_lenses(const Model& m, int i, int j, LensIndex* out, int capacity)
+int overlap_lenses(const PlenopticCamera& m, int i, int j, LensIndex* out, int capacity)
 {
-    if (capacity < 1 || m.grid == GridType::None)
+    if (capacity < 1 || m.array.grid == GridType::None)
         return 0;
     const Vec3 p = sensor_point(m, i + 0.5, j + 0.5);
     const OwnLens lookup = own_lens(m, p);
@@ -266,19 +266,19 @@ int overlap_lenses(const Model& m, int i, int j, LensIndex* out, int capacity)
     const LensIndex own = lookup.lens;
     out[0] = own;
     int count = 1;
-    if (!m.model_overlap)
+    if (!m.overlap.modelled)
         return count;
-    const int rings = m.overlap_rings;
-    const std::int64_t own_skew = skew_k(m.grid, own);
-    const bool hexagonal = m.grid == GridType::Hexagonal;
+    const int rings = m.overlap.rings;
+    const std::int64_t own_skew = skew_k(m.array.grid, own);
+    const bool hexagonal = m.array.grid == GridType::Hexagonal;
     for (int dl = -rings; dl <= rings; ++dl) {
         for (int dk = -rings; dk <= rings; ++dk) {
             if (dk == 0 && dl == 0)
                 continue;
             if (hexagonal && std::abs(dk + dl) > rings)
                 continue;  // hexagonal ring distance in skew indices: max(|dk|, |dl|, |dk + dl|)
-            const LensIndex lens = from_skew(m.grid, own_skew + dk, own.l + dl);
-            if (m.pose.tilt_sine <= kMaxPrunedTiltSine && !lens_reaches_pixel(m, lens, p))
+            const LensIndex lens = from_skew(m.array.grid, own_skew + dk, own.l + dl);
+            if (m.array.pose.tilt_sine <= kMaxPrunedTiltSine && !lens_reaches_pixel(m, lens, p))
                 continue;
             if (count >= capacity)
                 return count;
@@ -288,14 +288,14 @@ int overlap_lenses(const Model& m, int i, int j, LensIndex* out, int capacity)
     return count;
 }
 
-OpticsRay chief_ray_through(const Model& m, double pu, double pv, const LensIndex* lens)
+OpticsRay chief_ray_through(const PlenopticCamera& m, double pu, double pv, const LensIndex* lens)
 {
     OpticsRay ray;
     ray.passed = trace_sensor_point(m, sensor_point(m, pu, pv), lens, 0.5, 0.5, false, &ray);
     return ray;
 }
 
-OpticsRay chief_ray(const Model& m, int i, int j)
+OpticsRay chief_ray(const PlenopticCamera& m, int i, int j)
 {
     OpticsRay ray = chief_ray_through(m, i + 0.5, j + 0.5);
     if (ray.passed)
@@ -304,6 +304,16 @@ OpticsRay chief_ray(const Model& m, int i, int j)
     const Vec3 e = m.lens ? m.lens->exit_pupil_centre() : Vec3{0, 0, 0};
     ray.passed = finish(e, e - p, &ray) || finish(e, Vec3{0, 0, 1}, &ray);
     return ray;
+}
+
+OpticsRay PlenopticCamera::generate_ray(int i, int j, const CameraSample& sample) const
+{
+    return plenoptic::generate_ray(*this, i, j, sample);
+}
+
+OpticsRay PlenopticCamera::chief_ray(int i, int j) const
+{
+    return plenoptic::chief_ray(*this, i, j);
 }
 
 } // namespace plenoptic

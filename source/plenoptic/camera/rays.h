@@ -6,7 +6,7 @@
 #define PLENOPTIC_RAYS_H
 
 #include "plenoptic/core/lattice.h"
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 #include "plenoptic/core/sampling.h"
 
 namespace plenoptic {
@@ -19,7 +19,7 @@ struct OpticsRay {
     // What the ray's colour counts for in its pixel: 1, except for a real lens without an array,
     // whose samples cover a region of its exit pupil's plane (PupilBounds) rather than the paraxial
     // pupil: the region's area over the paraxial pupil's, so that a pixel's value does not depend
-    // on the region sampled. With a lit-area table (Model::lit_area, a round stop): the area of
+    // on the region sampled. With a lit-area table (PlenopticCamera::lit_area, a round stop): the area of
     // the region's lit part over the paraxial pupil's, and the pixel averages its passing
     // samples only (shade_pixel).
     double weight;
@@ -31,7 +31,7 @@ struct OpticsRay {
 // Point on the sensor (optics frame, mm) at continuous pixel coordinates (pu, pv), where pixel
 // (i, j) spans [i, i+1) x [j, j+1); (i + 0.5, j + 0.5) is its centre:
 //   x = -(pu - W/2) * sx + ox,  y = (pv - H/2) * sy + oy,  z = sensor plane.
-Vec3 sensor_point(const Model& model, double pu, double pv);
+Vec3 sensor_point(const PlenopticCamera& model, double pu, double pv);
 
 // A point of the picture in the centre convention used by the metadata (pixel (i, j)'s centre is
 // at (u, v) = (i, j)), and whether it lies inside the image.
@@ -41,13 +41,13 @@ struct PixelPoint {
 };
 
 // Inverse of sensor_point, in the centre convention.
-PixelPoint sensor_to_pixel(const Model& model, double x_mm, double y_mm);
+PixelPoint sensor_to_pixel(const PlenopticCamera& model, double x_mm, double y_mm);
 
 // Where the optical axis meets the sensor, centre convention.
-Vec2 principal_point_px(const Model& model);
+Vec2 principal_point_px(const PlenopticCamera& model);
 
 // Centre of a lens in the optics frame (posed array), mm.
-Vec3 lens_centre_mm(const Model& model, LensIndex lens);
+Vec3 lens_centre_mm(const PlenopticCamera& model, LensIndex lens);
 
 // The lens a sensor point belongs to: the lens whose cell contains the intersection of the line
 // (main-lens centre -> point) with the array plane; with no main lens, the lens straight above
@@ -56,31 +56,31 @@ struct OwnLens {
     LensIndex lens;
     bool found;
 };
-OwnLens own_lens(const Model& model, Vec3 sensor_point_mm);
+OwnLens own_lens(const PlenopticCamera& model, Vec3 sensor_point_mm);
 
 // The ray of one sample of pixel (i, j). `lens` forces the microlens the light passes through
 // (overlap modelling); nullptr uses the own lens of the sample's sensor point. Not passed when
 // an aperture blocks the ray (it then carries no light: black, opaque). No allocation, no
 // search over lenses, no trigonometry except the concentric disc map of a bare main lens.
-OpticsRay generate_ray(const Model& model, int i, int j, const CameraSample& sample, const LensIndex* lens = nullptr);
+OpticsRay generate_ray(const PlenopticCamera& model, int i, int j, const CameraSample& sample, const LensIndex* lens = nullptr);
 
 // The lenses whose light can reach pixel (i, j) when the model models overlap: the pixel
-// centre's own lens first, then every neighbour within model.overlap_rings rings that passes a
+// centre's own lens first, then every neighbour within model.overlap.rings rings that passes a
 // conservative reach test (all of them for an array tilted by more than kMaxPrunedTiltSine).
 // Without overlap modelling: the own lens only. Returns the count (0 if the pixel sees no lens),
 // at most `capacity`.
-int overlap_lenses(const Model& model, int i, int j, LensIndex* out, int capacity);
+int overlap_lenses(const PlenopticCamera& model, int i, int j, LensIndex* out, int capacity);
 
 // The chief ray of pixel (i, j): pixel centre -> centre of its microlens (undeviated) -> refracted
 // by the main lens; with no array, pixel centre through the main-lens centre; with a pinhole main
 // lens, the pixel's only ray. Apertures are ignored (depth maps want a ray for every pixel).
 // Falls back to the line from the pixel centre through the main-lens centre when the geometry
 // has no such ray.
-OpticsRay chief_ray(const Model& model, int i, int j);
+OpticsRay chief_ray(const PlenopticCamera& model, int i, int j);
 
 // The same at continuous pixel coordinates (sensor_point's convention), optionally through a
 // given lens. Not passed when the geometry has no such ray.
-OpticsRay chief_ray_through(const Model& model, double pu, double pv, const LensIndex* lens = nullptr);
+OpticsRay chief_ray_through(const PlenopticCamera& model, double pu, double pv, const LensIndex* lens = nullptr);
 
 } // namespace plenoptic
 

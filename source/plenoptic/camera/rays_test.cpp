@@ -33,7 +33,7 @@ TEST(Optics, SensorPointConvention)
     p.sensor.pixel_size_mm[1] = 0.02;
     p.sensor.offset_mm[0] = 0.3;
     p.sensor.offset_mm[1] = -0.1;
-    const Model m = make_model(p);
+    const PlenopticCamera m = make_camera(p);
     const int W = 640, H = 480;
     // Pixel (i, j)'s centre: x = -((i + 0.5) - W/2) sx + ox, y = ((j + 0.5) - H/2) sy + oy.
     const Vec3 c = sensor_point(with_film(m, W, H), 10 + 0.5, 20 + 0.5);
@@ -64,13 +64,13 @@ TEST(Optics, CentreSampleGivesTheOpticalAxis)
 {
     const int W = 101, H = 101;  // pixel (50, 50) is centred on the axis
     OpticsRay ray;
-    ASSERT_TRUE((ray = generate_ray(with_film(make_model(thin_lens_camera(50, 4, 52)), W, H), 50, 50, kCentreSample, nullptr)).passed);
+    ASSERT_TRUE((ray = generate_ray(with_film(make_camera(thin_lens_camera(50, 4, 52)), W, H), 50, 50, kCentreSample, nullptr)).passed);
     expect_axis(ray, "thin lens, no array");
 
     for (GridType grid : {GridType::Hexagonal, GridType::Rectangular}) {
-        ASSERT_TRUE((ray = generate_ray(with_film(make_model(plenoptic_camera(grid, 0.5, 2, 2, 50, 4, 52)), W, H), 50, 50, kCentreSample, nullptr)).passed);
+        ASSERT_TRUE((ray = generate_ray(with_film(make_camera(plenoptic_camera(grid, 0.5, 2, 2, 50, 4, 52)), W, H), 50, 50, kCentreSample, nullptr)).passed);
         expect_axis(ray, "plenoptic 1.0");
-        ASSERT_TRUE((ray = generate_ray(with_film(make_model(plenoptic_camera(grid, 0.5, 0, 2, 50, 4, 52)), W, H), 50, 50, kCentreSample, nullptr)).passed);
+        ASSERT_TRUE((ray = generate_ray(with_film(make_camera(plenoptic_camera(grid, 0.5, 0, 2, 50, 4, 52)), W, H), 50, 50, kCentreSample, nullptr)).passed);
         expect_axis(ray, "pinhole array");
     }
     CameraParams pinhole_main;
@@ -80,7 +80,7 @@ TEST(Optics, CentreSampleGivesTheOpticalAxis)
     pinhole_main.main.distance_mm = 52;
     test::add_array(&pinhole_main, GridType::Hexagonal, 0.5, 1.5, 2);
     ASSERT_EQ(check_camera(pinhole_main), "");
-    ASSERT_TRUE((ray = generate_ray(with_film(make_model(pinhole_main), W, H), 50, 50, kCentreSample, nullptr)).passed);
+    ASSERT_TRUE((ray = with_film(make_camera(pinhole_main), W, H).generate_ray(50, 50, kCentreSample)).passed);
     expect_axis(ray, "pinhole main lens, thin array");
 }
 
@@ -89,7 +89,7 @@ TEST(Optics, CentreSampleGivesTheOpticalAxis)
 TEST(Optics, RaysFromASensorPointMeetAtTheThinLensConjugate)
 {
     const double F = 50, D = 60;
-    const Model m = make_model(thin_lens_camera(F, 2.8, D));
+    const PlenopticCamera m = make_camera(thin_lens_camera(F, 2.8, D));
     const int W = 101, H = 101, i = 10, j = 80;
     const Vec3 p = sensor_point(with_film(m, W, H), i + 0.5, j + 0.5);
     // Independently: 1/u = 1/F - 1/D, lateral magnification -u/D.
@@ -100,19 +100,19 @@ TEST(Optics, RaysFromASensorPointMeetAtTheThinLensConjugate)
         CameraSample s = make_sample(i, j, n, 200);
         s.pixel_u = s.pixel_v = 0.5;  // one sensor point, many lens points
         OpticsRay ray;
-        ASSERT_TRUE((ray = generate_ray(with_film(m, W, H), i, j, s, nullptr)).passed);
+        ASSERT_TRUE((ray = with_film(m, W, H).generate_ray(i, j, s)).passed);
         const double miss = test::distance_to_line(conjugate, origin_of(ray), dir_of(ray));
         EXPECT_LT(miss, 1e-9 * u) << "sample " << n << " origin " << str(origin_of(ray)) << " misses "
                                   << str(conjugate) << " by " << miss;
         spread = std::max(spread, length(origin_of(ray)));
     }
-    EXPECT_GT(spread, 0.4 * m.aperture_mm / 2);  // the rays really cover the aperture
+    EXPECT_GT(spread, 0.4 * m.aperture_mm() / 2);  // the rays really cover the aperture
 }
 
 TEST(Optics, SensorAtTheFocalPlaneGivesParallelRays)
 {
     const double F = 50;
-    const Model m = make_model(thin_lens_camera(F, 2.8, F));  // D = F exactly
+    const PlenopticCamera m = make_camera(thin_lens_camera(F, 2.8, F));  // D = F exactly
     const int W = 101, H = 101, i = 3, j = 77;
     const Vec3 p = sensor_point(with_film(m, W, H), i + 0.5, j + 0.5);
     const Vec3 expected = normalized(-p);
@@ -120,7 +120,7 @@ TEST(Optics, SensorAtTheFocalPlaneGivesParallelRays)
         CameraSample s = make_sample(i, j, n, 100);
         s.pixel_u = s.pixel_v = 0.5;
         OpticsRay ray;
-        ASSERT_TRUE((ray = generate_ray(with_film(m, W, H), i, j, s, nullptr)).passed);
+        ASSERT_TRUE((ray = with_film(m, W, H).generate_ray(i, j, s)).passed);
         EXPECT_LT(length(dir_of(ray) - expected), 1e-14) << "sample " << n << " " << str(dir_of(ray));
     }
 }
@@ -133,11 +133,11 @@ void check_microlens_conjugate(double f, double d, const double pose_deg[3])
     test::add_array(&params, GridType::Hexagonal, 0.5, f, d);
     test::set_pose(&params, pose_deg[0], pose_deg[1], pose_deg[2], 0.02, -0.03, 0);
     ASSERT_EQ(check_camera(params), "");
-    const Model m = make_model(params);
+    const PlenopticCamera m = make_camera(params);
     const int W = 200, H = 200, i = 120, j = 61;
     const Vec3 p = sensor_point(with_film(m, W, H), i + 0.5, j + 0.5);
     // Lens and distances in the array's frame, computed here with the reference rotation.
-    const Vec3 centre = m.pose.centre_mm;
+    const Vec3 centre = m.array.pose.centre_mm;
     const Vec3 n = test::reference_rotate(pose_deg, Vec3{0, 0, 1});
     const Vec3 foot = p + Vec3{0, 0, dot(n, centre - p) / n.z};
     const Vec3 foot_local = test::reference_unrotate(pose_deg, foot - centre);
@@ -158,7 +158,7 @@ void check_microlens_conjugate(double f, double d, const double pose_deg[3])
         CameraSample s = make_sample(i, j, k, 100);
         s.pixel_u = s.pixel_v = 0.5;
         OpticsRay ray;
-        ASSERT_TRUE((ray = generate_ray(with_film(m, W, H), i, j, s, nullptr)).passed);
+        ASSERT_TRUE((ray = with_film(m, W, H).generate_ray(i, j, s)).passed);
         if (parallel) {
             EXPECT_LT(length(dir_of(ray) - chief), 1e-13) << "sample " << k << " " << str(dir_of(ray))
                                                           << " vs " << str(chief);
@@ -188,14 +188,14 @@ void check_posed_lookup(GridType grid, bool with_main_lens)
         params.main = MainLensParams();
     test::set_pose(&params, deg[0], deg[1], deg[2], 0.05, -0.02, 0.1);
     ASSERT_EQ(check_camera(params), "");
-    const Model m = make_model(params);
-    const Vec3 centre = m.pose.centre_mm;
+    const PlenopticCamera m = make_camera(params);
+    const Vec3 centre = m.array.pose.centre_mm;
     const Vec3 n = test::reference_rotate(deg, Vec3{0, 0, 1});
     std::mt19937_64 rng(2024);
     std::uniform_real_distribution<double> coordinate(-5.0, 5.0);
     int failures = 0;
     for (int k = 0; k < 100000 && failures < 5; ++k) {
-        const Vec3 p{coordinate(rng), coordinate(rng), m.sensor_z_mm};
+        const Vec3 p{coordinate(rng), coordinate(rng), m.sensor.z_mm};
         Vec3 q;
         if (with_main_lens)
             q = (dot(n, centre) / dot(n, p)) * p;  // line from the main-lens centre
@@ -235,7 +235,7 @@ struct RoundTripCase {
 
 // Traces a generated ray backwards through the same ideal elements, computed here independently,
 // to the sensor plane.
-Vec3 trace_back(const Model& m, const CameraParams& params, const OpticsRay& ray, std::string* failure)
+Vec3 trace_back(const PlenopticCamera& m, const CameraParams& params, const OpticsRay& ray, std::string* failure)
 {
     const double* deg = params.array.rotate_deg;
     Vec3 at = origin_of(ray);
@@ -243,12 +243,12 @@ Vec3 trace_back(const Model& m, const CameraParams& params, const OpticsRay& ray
     const Vec3 d = dir_of(ray);
     if (test::lens_kind(m) == "thin_lens") {
         // Undo w' = w - m/F at the main lens.
-        back = -Vec3{d.x / d.z + at.x / m.focal_length_mm, d.y / d.z + at.y / m.focal_length_mm, 1};
+        back = -Vec3{d.x / d.z + at.x / m.focal_length_mm(), d.y / d.z + at.y / m.focal_length_mm(), 1};
     } else {
         back = -d;
     }
-    if (m.grid == GridType::None) {
-        const double t = (m.sensor_z_mm - at.z) / back.z;
+    if (m.array.grid == GridType::None) {
+        const double t = (m.sensor.z_mm - at.z) / back.z;
         return at + t * back;
     }
     // Meet the posed array plane.
@@ -260,25 +260,25 @@ Vec3 trace_back(const Model& m, const CameraParams& params, const OpticsRay& ray
         at = at + t * back;
     }
     const Vec3 h_local = test::reference_unrotate(deg, at - centre);
-    const LensIndex lens = test::brute_force_nearest(m.grid, m.pitch_mm, h_local.x, h_local.y);
-    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+    const LensIndex lens = test::brute_force_nearest(m.array.grid, m.array.pitch_mm, h_local.x, h_local.y);
+    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
     Vec3 w = test::reference_unrotate(deg, back);
     w = (1 / -w.z) * w;  // unit travel along -z_local
-    if (m.microlens == MicrolensType::ThinLens) {
+    if (m.array.microlens == MicrolensType::ThinLens) {
         // Type rule written out here: skew k = k - floor(l/2), type = (k_s - l) mod 3.
         int type = 0;
-        if (m.lens_type_count == 3) {
+        if (m.array.lens_type_count == 3) {
             const long long l = lens.l, ks = lens.k - (l >= 0 ? l / 2 : -((-l + 1) / 2));
             type = int((((ks - l) % 3) + 3) % 3);
         }
-        const double f = m.microlens_focal_mm[type];
+        const double f = m.array.focal_mm[type];
         // Undo the microlens: sensor-side slope = scene-side slope - (h - c)/f for this direction.
         w = Vec3{w.x - (h_local.x - c.x) / f, w.y - (h_local.y - c.y) / f, -1};
     } else if (std::hypot(h_local.x - c.x, h_local.y - c.y) > 1e-9) {
         *failure = "ray does not pass the pinhole's centre";
     }
     const Vec3 down = test::reference_rotate(deg, w);
-    const double t = (m.sensor_z_mm - at.z) / down.z;
+    const double t = (m.sensor.z_mm - at.z) / down.z;
     return at + t * down;
 }
 
@@ -314,7 +314,7 @@ TEST(Optics, PixelToRayToSensorRoundTrip)
     for (RoundTripCase& c : cases) {
         c.params.sensor.pixel_size_mm[0] = c.params.sensor.pixel_size_mm[1] = 0.02;
         ASSERT_EQ(check_camera(c.params), "") << c.name;
-        const Model m = with_film(make_model(c.params), W, H);
+        const PlenopticCamera m = with_film(make_camera(c.params), W, H);
         int traced = 0;
         double worst = 0;
         for (int j = 0; j < H; j += 7) {
@@ -322,7 +322,7 @@ TEST(Optics, PixelToRayToSensorRoundTrip)
                 for (int n = 0; n < 8; ++n) {
                     const CameraSample s = make_sample(i, j, n, 8);
                     OpticsRay ray;
-                    if (!(ray = generate_ray(m, i, j, s, nullptr)).passed)
+                    if (!(ray = m.generate_ray(i, j, s)).passed)
                         continue;
                     std::string failure;
                     const Vec3 back = trace_back(m, c.params, ray, &failure);
@@ -347,9 +347,9 @@ void check_overlap_pruning(const char* name, CameraParams params, double max_kep
 {
     params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.01;
     ASSERT_EQ(check_camera(params), "") << name;
-    const Model m = make_model(params);
-    ASSERT_TRUE(m.model_overlap) << name;
-    const int W = 160, H = 120, R = m.overlap_rings;
+    const PlenopticCamera m = make_camera(params);
+    ASSERT_TRUE(m.overlap.modelled) << name;
+    const int W = 160, H = 120, R = m.overlap.rings;
     LensIndex lenses[kMaxOverlapLenses];
     long long kept = 0, candidates = 0, lit_total = 0;
     int failures = 0;
@@ -359,11 +359,11 @@ void check_overlap_pruning(const char* name, CameraParams params, double max_kep
             ASSERT_GE(count, 1) << name;
             kept += count;
             const LensIndex own = lenses[0];
-            const std::int64_t own_skew = skew_k(m.grid, own);
+            const std::int64_t own_skew = skew_k(m.array.grid, own);
             for (int dl = -R - 1; dl <= R + 1; ++dl) {
                 for (int dk = -R - 1; dk <= R + 1; ++dk) {
-                    const LensIndex lens = from_skew(m.grid, own_skew + dk, own.l + dl);
-                    const bool in_rings = m.grid == GridType::Hexagonal
+                    const LensIndex lens = from_skew(m.array.grid, own_skew + dk, own.l + dl);
+                    const bool in_rings = m.array.grid == GridType::Hexagonal
                                               ? std::max(std::abs(dk), std::max(std::abs(dl), std::abs(dk + dl))) <= R
                                               : std::max(std::abs(dk), std::abs(dl)) <= R;
                     if (in_rings)
@@ -423,7 +423,7 @@ TEST(Optics, OverlapPruningNeverDropsALensThatDeliversLight)
 TEST(Optics, OverlapLensesListsTheOwnLensFirst)
 {
     const int W = 200, H = 200;
-    const Model apart = with_film(make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 10, 50)), W, H);
+    const PlenopticCamera apart = with_film(make_camera(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 10, 50)), W, H);
     LensIndex lenses[kMaxOverlapLenses];
     EXPECT_EQ(overlap_lenses(apart, 10, 20, lenses, kMaxOverlapLenses), 1);
     const OwnLens own_lookup = own_lens(apart, sensor_point(apart, 10.5, 20.5));
@@ -431,7 +431,7 @@ TEST(Optics, OverlapLensesListsTheOwnLensFirst)
     const LensIndex own = own_lookup.lens;
     EXPECT_EQ(lenses[0], own);
 
-    const Model overlapping = with_film(make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 2.5, 50)), W, H);
+    const PlenopticCamera overlapping = with_film(make_camera(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 2.5, 50)), W, H);
     int most = 0;
     for (int j = 0; j < H; j += 3)
         for (int i = 0; i < W; i += 3)

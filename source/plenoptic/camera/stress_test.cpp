@@ -90,18 +90,18 @@ TEST(Stress, ExtremeParametersGiveFiniteUnitDirections)
     for (StressCase& c : stress_cases()) {
         c.params.sampling.samples = 4;
         ASSERT_EQ(check_camera(c.params), "") << c.name;
-        const Model m = with_film(make_model(c.params), W, H);
+        const PlenopticCamera m = with_film(make_camera(c.params), W, H);
         int unblocked = 0;
         for (int j = 0; j < H; ++j) {
             for (int i = 0; i < W; ++i) {
                 for (int n = 0; n < 4; ++n) {
                     OpticsRay ray;
-                    if ((ray = generate_ray(m, i, j, make_sample(i, j, n, 4), nullptr)).passed) {
+                    if ((ray = m.generate_ray(i, j, make_sample(i, j, n, 4))).passed) {
                         ++unblocked;
                         expect_unit_and_finite(ray, c.name + " generate_ray");
                     }
                 }
-                expect_unit_and_finite(chief_ray(m, i, j), c.name + " chief_ray");
+                expect_unit_and_finite(m.chief_ray(i, j), c.name + " chief_ray");
                 const Rgbt value = shade_pixel(m, i, j, [](const OpticsRay& r) {
                     return Rgbt{r.dir.x, r.dir.y, r.dir.z, 0};
                 });
@@ -112,8 +112,8 @@ TEST(Stress, ExtremeParametersGiveFiniteUnitDirections)
         }
         RecordProperty(c.name, unblocked);
         for (double z : {1.0, 60.0, 1e4, 1e9}) {
-            const double point[3] = {0.01 * z, -0.02 * z, z};
-            for (const PixelHit& hit : forward_project(m, point))
+            const Vec3 point{0.01 * z, -0.02 * z, z};
+            for (const PixelHit& hit : m.project(point))
                 ASSERT_TRUE(std::isfinite(hit.u) && std::isfinite(hit.v)) << c.name << " z " << z;
         }
         CameraFrame frame = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
@@ -130,14 +130,14 @@ TEST(Stress, HugeCoordinatesDoNotOverflowTheLattice)
     ASSERT_EQ(check_camera(p), "");
     EXPECT_NE(check_camera(plenoptic_camera(GridType::Hexagonal, 1e-200, 1e-200, 1e-200, 50, 4, 52)), "")
         << "lengths below 1 nm leave double precision in products: refused";
-    const Model m = with_film(make_model(p), 8, 8);
+    const PlenopticCamera m = with_film(make_camera(p), 8, 8);
     for (int n = 0; n < 16; ++n) {
         OpticsRay ray;
-        if ((ray = generate_ray(m, 0, 0, make_sample(0, 0, n, 16), nullptr)).passed)
+        if ((ray = m.generate_ray(0, 0, make_sample(0, 0, n, 16))).passed)
             expect_unit_and_finite(ray, "tiny pitch");
     }
-    const double point[3] = {1, 2, 1000};
-    EXPECT_TRUE(forward_project(m, point).size() <= 1u);
+    const Vec3 point{1, 2, 1000};
+    EXPECT_TRUE(m.project(point).size() <= 1u);
     const MicroimageLattice lattice = microimage_lattice(m);
     if (lattice.lftoolbox_valid) {
         for (double x : {lattice.h_spacing, lattice.v_spacing, lattice.h_offset, lattice.v_offset, lattice.rot})

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Progress of the long steps of a camera's setup (make_model), for whoever runs it: the tables a
+// Progress of the long steps of a camera's setup (make_camera), for whoever runs it: the tables a
 // traced main lens needs (pupil bounds, lit area) cost a fixed number of traces, each linear in
 // the lens's surfaces, so a lens of thousands of surfaces sets up for tens of seconds. Those
 // steps report here now and then; the caller installs a reporter for the thread that sets up

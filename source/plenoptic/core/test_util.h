@@ -8,7 +8,7 @@
 #include <sstream>
 #include <string>
 
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 #include "plenoptic/optics.h"
 #include "plenoptic/lens/prescription.h"
 
@@ -40,7 +40,7 @@ inline Prescription vignetting_triplet()
 }
 
 // The kind of a model's main lens, as the metadata names it ("none" without one).
-inline std::string lens_kind(const Model& m) { return m.lens ? m.lens->kind_name() : "none"; }
+inline std::string lens_kind(const PlenopticCamera& m) { return m.lens ? m.lens->kind_name() : "none"; }
 
 inline Vec3 origin_of(const OpticsRay& r) { return Vec3{r.origin_mm.x, r.origin_mm.y, r.origin_mm.z}; }
 inline Vec3 dir_of(const OpticsRay& r) { return Vec3{r.dir.x, r.dir.y, r.dir.z}; }

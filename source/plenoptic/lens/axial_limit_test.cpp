@@ -11,7 +11,7 @@
 #include <string>
 
 #include "plenoptic/lens/main_lens.h"
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 #include "plenoptic/camera/params.h"
 #include "plenoptic/lens/prescription.h"
 #include "plenoptic/sensor/white_image.h"
@@ -193,9 +193,9 @@ TEST(AxialLimit, StopWrittenWiderWarnsAndTheModelUsesTheRim)
     camera.main = singlet_main(60, 0, 0);  // as written, no f_number or aperture
     camera.sensor.pixel_size_mm[0] = camera.sensor.pixel_size_mm[1] = 0.01;
     ASSERT_EQ(check_camera(camera), "");
-    const Model m = make_model(camera);
-    EXPECT_NEAR(m.f_number, singlet_efl() / 40, 1e-9);
-    EXPECT_NEAR(m.aperture_mm, 60, 1e-12);  // the stop's diameter as written
+    const PlenopticCamera m = make_camera(camera);
+    EXPECT_NEAR(m.f_number(), singlet_efl() / 40, 1e-9);
+    EXPECT_NEAR(m.aperture_mm(), 60, 1e-12);  // the stop's diameter as written
     const double v = image_through_surface(-kT, kN, 1, kR2);
     EXPECT_NEAR(m.lens->exit_pupil_radius(), 20 * std::fabs(kN * v / -kT), 1e-9);
     const std::string warning = limiting_aperture_warning(m);
@@ -207,7 +207,7 @@ TEST(AxialLimit, StopWrittenWiderWarnsAndTheModelUsesTheRim)
     EXPECT_EQ(all[0], warning);
 
     camera.main = singlet_main(30, 0, 0);
-    EXPECT_EQ(limiting_aperture_warning(make_model(camera)), "");
+    EXPECT_EQ(limiting_aperture_warning(make_camera(camera)), "");
 }
 
 TEST(AxialLimit, WhiteImageFNumbersListedTwiceAreRefused)

@@ -70,12 +70,14 @@ class ThinMainLens : public MainLens {
 public:
     ThinMainLens(double focal_length_mm, double aperture_mm, double f_number)
         : focal_(focal_length_mm), aperture_(aperture_mm), f_number_(f_number), radius_(0.5 * aperture_mm),
-          distorted_(false), distortion_(DistortionParams{{0, 0, 0}, {0, 0}}), plane_z_(0) {}
+          given_distortion_(false), distorted_(false), distortion_(DistortionParams{{0, 0, 0}, {0, 0}}), plane_z_(0) {}
     ThinMainLens(double focal_length_mm, double aperture_mm, double f_number, const DistortionParams& distortion,
                  double plane_z)
         : focal_(focal_length_mm), aperture_(aperture_mm), f_number_(f_number), radius_(0.5 * aperture_mm),
-          distorted_(!is_identity(distortion) && plane_z < 0), distortion_(distortion), plane_z_(plane_z) {}
+          given_distortion_(true), distorted_(!is_identity(distortion) && plane_z < 0), distortion_(distortion),
+          plane_z_(plane_z) {}
     const char* kind_name() const override { return "thin_lens"; }
+    const DistortionParams* distortion() const override { return given_distortion_ ? &distortion_ : nullptr; }
     const char* chief_ray_description() const override { return "through the lens centre"; }
     double focal_length_mm() const override { return focal_; }
     double aperture_mm() const override { return aperture_; }
@@ -159,6 +161,7 @@ private:
     double aperture_;
     double f_number_;
     double radius_;
+    bool given_distortion_;  // made with a distortion (even one that moves nothing)
     bool distorted_;
     DistortionParams distortion_;
     double plane_z_;

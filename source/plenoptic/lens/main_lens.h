@@ -71,6 +71,9 @@ public:
     // for the ideal lenses.
     virtual const Prescription* prescription() const { return nullptr; }
     virtual const ParaxialData* paraxial() const { return nullptr; }
+    // A thin lens's parametric distortion (lens/distortion.h) as the scene gave it; nullptr when it
+    // was given none, and for every other kind.
+    virtual const DistortionParams* distortion() const { return nullptr; }
     // The window light from the scene crosses first (a prescription's first surface, the thin
     // lens's aperture, the thick lens's entrance pupil); false when the lens has none.
     virtual bool front_window(FrontWindow* window) const { (void)window; return false; }

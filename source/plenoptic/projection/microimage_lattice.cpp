@@ -15,7 +15,7 @@ namespace {
 using detail::to_optics;
 
 // Pixel coordinates (centre convention) of an array-local point projected onto the sensor.
-bool local_to_px(const Model& m, Vec2 local, Vec2* px)
+bool local_to_px(const PlenopticCamera& m, Vec2 local, Vec2* px)
 {
     const Vec3 c = to_optics(m, Vec3{local.x, local.y, 0});
     double x = c.x, y = c.y;
@@ -24,7 +24,7 @@ bool local_to_px(const Model& m, Vec2 local, Vec2* px)
         const Vec3 e = m.lens->exit_pupil_centre();
         if (!(c.z < e.z))
             return false;
-        const double s = (m.sensor_z_mm - e.z) / (c.z - e.z);
+        const double s = (m.sensor.z_mm - e.z) / (c.z - e.z);
         x = e.x + (c.x - e.x) * s;
         y = e.y + (c.y - e.y) * s;
     }
@@ -44,9 +44,9 @@ double wrap(double x, double m)
 // estimate: the grid origin's projections on the rotated axes are reduced to [0, HSpacing/2) and
 // [0, VSpacing) (1-based pixels), and the row parity decides FirstPosShiftRow. A perfect
 // LFToolbox estimate of the rendered white image gives these same numbers.
-void fit_lftoolbox(const Model& m, MicroimageLattice* lattice)
+void fit_lftoolbox(const PlenopticCamera& m, MicroimageLattice* lattice)
 {
-    const int W = m.film.width, H = m.film.height;
+    const int W = m.sensor.film.width, H = m.sensor.film.height;
     lattice->lftoolbox_valid = false;
     const Vec2 a{lattice->basis_a_px[0], lattice->basis_a_px[1]};
     const Vec2 b{lattice->basis_b_px[0], lattice->basis_b_px[1]};
@@ -64,7 +64,7 @@ void fit_lftoolbox(const Model& m, MicroimageLattice* lattice)
     if (!(W / h_spacing < 1e9 && H / v_spacing < 1e9))
         return;
 
-    const bool hexagonal = m.grid == GridType::Hexagonal;
+    const bool hexagonal = m.array.grid == GridType::Hexagonal;
     const Vec2 reference{lattice->origin_px[0] + 1, lattice->origin_px[1] + 1};  // lens (0, 0), 1-based
     double h_proj = dot(reference, e);
     const double v_proj = dot(reference, down);
@@ -117,29 +117,29 @@ void fit_lftoolbox(const Model& m, MicroimageLattice* lattice)
 
 } // namespace
 
-bool microimage_centre_px(const Model& m, LensIndex lens, double* u, double* v)
+bool microimage_centre_px(const PlenopticCamera& m, LensIndex lens, double* u, double* v)
 {
     Vec2 px;
-    if (m.grid == GridType::None || !local_to_px(m, lens_centre(m.grid, m.pitch_mm, lens), &px))
+    if (m.array.grid == GridType::None || !local_to_px(m, lens_centre(m.array.grid, m.array.pitch_mm, lens), &px))
         return false;
     *u = px.x;
     *v = px.y;
     return true;
 }
 
-MicroimageLattice microimage_lattice(const Model& m)
+MicroimageLattice microimage_lattice(const PlenopticCamera& m)
 {
     MicroimageLattice lattice = MicroimageLattice();
     lattice.valid = false;
     lattice.lftoolbox_valid = false;
-    if (m.grid == GridType::None)
+    if (m.array.grid == GridType::None)
         return lattice;
     Vec2 origin;
     if (!local_to_px(m, Vec2{0, 0}, &origin))
         return lattice;
-    const double p = m.pitch_mm;
+    const double p = m.array.pitch_mm;
     const Vec2 a_local{p, 0};
-    const Vec2 b_local = m.grid == GridType::Hexagonal ? Vec2{p / 2, row_spacing(m.grid, p)} : Vec2{0, p};
+    const Vec2 b_local = m.array.grid == GridType::Hexagonal ? Vec2{p / 2, row_spacing(m.array.grid, p)} : Vec2{0, p};
     // Central differences at the array centre: exact for an affine map, the tangent map otherwise.
     const double step = 1e-3;
     Vec2 basis[2];
@@ -160,7 +160,7 @@ MicroimageLattice microimage_lattice(const Model& m)
     lattice.basis_b_px[1] = basis[1].y;
     // Orthogonal projection (no main lens) of any plane is affine; central projection only of a
     // plane parallel to the sensor.
-    lattice.exact = !m.lens || !m.pose.tilted;
+    lattice.exact = !m.lens || !m.array.pose.tilted;
     fit_lftoolbox(m, &lattice);
     return lattice;
 }

@@ -5,13 +5,13 @@
 #define PLENOPTIC_MICROIMAGE_LATTICE_H
 
 #include "plenoptic/core/lattice.h"
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 
 namespace plenoptic {
 
 // Centre of lens `lens`'s microimage in pixels (centre convention): the central projection of the
 // posed lens centre from the main-lens centre onto the sensor (orthogonal without main lens).
-bool microimage_centre_px(const Model& model, LensIndex lens, double* u, double* v);
+bool microimage_centre_px(const PlenopticCamera& model, LensIndex lens, double* u, double* v);
 
 // The microimage-centre lattice in pixel coordinates (centre convention) and its LFToolbox form.
 // centre(k_s, l) = origin + k_s a + l b in skew indices (a = (p, 0); b = (p/2, p sqrt(3)/2)
@@ -40,7 +40,7 @@ struct MicroimageLattice {
     LensIndex first_lens;    // the lenslet at LFToolbox's (row 1, col 1), row form
 };
 
-MicroimageLattice microimage_lattice(const Model& model);
+MicroimageLattice microimage_lattice(const PlenopticCamera& model);
 
 } // namespace plenoptic
 

@@ -29,7 +29,7 @@ void check_lftoolbox(GridType grid, double rotate_z, double offset_x, double tx)
     test::set_pose(&params, 0, 0, rotate_z, tx, -0.011, 0);
     params.sensor.offset_mm[0] = offset_x;
     ASSERT_EQ(check_camera(params), "");
-    const Model m = make_model(params);
+    const PlenopticCamera m = make_camera(params);
     const int W = 320, H = 240;
     const MicroimageLattice lattice = microimage_lattice(with_film(m, W, H));
     ASSERT_TRUE(lattice.valid);
@@ -117,7 +117,7 @@ TEST(Optics, TiltedArrayLatticeIsMarkedApproximate)
 {
     CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.137, 0.7, 0.7, 50, 5, 52);
     test::set_pose(&params, 1, 0, 0, 0, 0, 0);
-    const Model m = with_film(make_model(params), 320, 240);
+    const PlenopticCamera m = with_film(make_camera(params), 320, 240);
     const MicroimageLattice lattice = microimage_lattice(m);
     ASSERT_TRUE(lattice.valid);
     EXPECT_FALSE(lattice.exact);
@@ -135,7 +135,7 @@ TEST(Optics, MicroimageCentreIsTheCentralProjectionOfTheLensCentre)
     // centre.
     CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.3, 0, 2, 50, 4, 52);
     test::set_pose(&params, 2, -1, 7, 0.02, 0.01, -0.1);
-    const Model m = make_model(params);
+    const PlenopticCamera m = make_camera(params);
     const int W = 300, H = 300;
     for (int k = -4; k <= 4; ++k) {
         const LensIndex lens{k, k / 2};

@@ -17,52 +17,52 @@ namespace plenoptic {
 
 namespace detail {
 
-bool sensor_hit_through_lens(const Model& m, LensIndex lens, Vec3 h, Vec3 towards_sensor, Vec3* hit)
+bool sensor_hit_through_lens(const PlenopticCamera& m, LensIndex lens, Vec3 h, Vec3 towards_sensor, Vec3* hit)
 {
     Vec3 direction = towards_sensor;
-    if (m.microlens == MicrolensType::ThinLens) {
-        const Vec3 w = mul_transposed(m.pose.rotation, towards_sensor);
+    if (m.array.microlens == MicrolensType::ThinLens) {
+        const Vec3 w = mul_transposed(m.array.pose.rotation, towards_sensor);
         if (!(w.z < 0))
             return false;
         const Vec3 h_local = to_local(m, h);
-        const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+        const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
         const double f = microlens_focal(m, lens);
         const Vec3 out_local{w.x / -w.z - (h_local.x - c.x) / f, w.y / -w.z - (h_local.y - c.y) / f, -1};
-        direction = mul(m.pose.rotation, out_local);
+        direction = mul(m.array.pose.rotation, out_local);
     }
     if (!(direction.z < 0))
         return false;
-    const double travel = (m.sensor_z_mm - h.z) / direction.z;
+    const double travel = (m.sensor.z_mm - h.z) / direction.z;
     if (!(travel > 0))
         return false;
     *hit = h + travel * direction;
     return is_finite(*hit);
 }
 
-int receiving_rings(const Model& m) { return m.model_overlap ? m.overlap_rings : 0; }
+int receiving_rings(const PlenopticCamera& m) { return m.overlap.modelled ? m.overlap.rings : 0; }
 
-bool within_rings(const Model& m, LensIndex a, LensIndex b, int rings)
+bool within_rings(const PlenopticCamera& m, LensIndex a, LensIndex b, int rings)
 {
-    const std::int64_t dk = skew_k(m.grid, a) - skew_k(m.grid, b);
+    const std::int64_t dk = skew_k(m.array.grid, a) - skew_k(m.array.grid, b);
     const std::int64_t dl = a.l - b.l;
     std::int64_t d = std::max(dk < 0 ? -dk : dk, dl < 0 ? -dl : dl);
-    if (m.grid == GridType::Hexagonal)
+    if (m.array.grid == GridType::Hexagonal)
         d = std::max(d, dk + dl < 0 ? -(dk + dl) : dk + dl);
     return d <= rings;
 }
 
-std::vector<Vec2> picture_polygon(const Model& m)
+std::vector<Vec2> picture_polygon(const PlenopticCamera& m)
 {
-    const int W = m.film.width, H = m.film.height;
+    const int W = m.sensor.film.width, H = m.sensor.film.height;
     const Vec3 a = sensor_point(m, 0, 0), b = sensor_point(m, W, H);
     return std::vector<Vec2>{Vec2{a.x, a.y}, Vec2{b.x, a.y}, Vec2{b.x, b.y}, Vec2{a.x, b.y}};
 }
 
-std::vector<Vec2> microimage_cell(const Model& m, LensIndex lens)
+std::vector<Vec2> microimage_cell(const PlenopticCamera& m, LensIndex lens)
 {
     Vec2 cell[6];
-    const int count = cell_polygon(m.grid, m.pitch_mm, cell);
-    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+    const int count = cell_polygon(m.array.grid, m.array.pitch_mm, cell);
+    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
     std::vector<Vec2> out;
     for (int i = 0; i < count; ++i) {
         const Vec3 q = to_optics(m, Vec3{c.x + cell[i].x, c.y + cell[i].y, 0});
@@ -70,22 +70,22 @@ std::vector<Vec2> microimage_cell(const Model& m, LensIndex lens)
         if (m.lens) {
             if (!(q.z < 0))
                 return std::vector<Vec2>();
-            s = m.sensor_z_mm / q.z;
+            s = m.sensor.z_mm / q.z;
         }
         out.push_back(Vec2{q.x * s, q.y * s});
     }
     return out;
 }
 
-bool delivered_point(const Model& m, LensIndex lens, Vec2 s)
+bool delivered_point(const PlenopticCamera& m, LensIndex lens, Vec2 s)
 {
     if (!sensor_to_pixel(m, s.x, s.y).inside)
         return false;
-    const OwnLens owner = own_lens(m, Vec3{s.x, s.y, m.sensor_z_mm});
+    const OwnLens owner = own_lens(m, Vec3{s.x, s.y, m.sensor.z_mm});
     return owner.found && within_rings(m, owner.lens, lens, receiving_rings(m));
 }
 
-void add_point_hit(const Model& m, LensIndex lens, Vec3 s, double fraction, std::vector<PixelHit>* hits)
+void add_point_hit(const PlenopticCamera& m, LensIndex lens, Vec3 s, double fraction, std::vector<PixelHit>* hits)
 {
     if (!delivered_point(m, lens, Vec2{s.x, s.y}))
         return;
@@ -181,9 +181,9 @@ bool overlap(Box a, Box b)
 
 // The part of the array plane whose lenses can image into the picture: the image corners
 // projected onto the array, grown by two pitches. Invalid if a corner does not project.
-Box sensor_box(const Model& m)
+Box sensor_box(const PlenopticCamera& m)
 {
-    const int W = m.film.width, H = m.film.height;
+    const int W = m.sensor.film.width, H = m.sensor.film.height;
     Box box{false, 0, 0, 0, 0};
     const double corners[4][2] = {{0, 0}, {double(W), 0}, {0, double(H)}, {double(W), double(H)}};
     for (int i = 0; i < 4; ++i) {
@@ -192,30 +192,30 @@ Box sensor_box(const Model& m)
             return Box{false, 0, 0, 0, 0};
         include(&box, q);
     }
-    return grow(box, 2 * m.pitch_mm);
+    return grow(box, 2 * m.array.pitch_mm);
 }
 
 // Calls visit(lens) for every lens whose centre lies in the box (array-local), row by row.
 template <class Visit>
-void for_each_lens_in_box(const Model& m, Box box, Visit visit)
+void for_each_lens_in_box(const PlenopticCamera& m, Box box, Visit visit)
 {
     if (!box.valid || !(box.x0 <= box.x1) || !(box.y0 <= box.y1))
         return;
-    const double row = row_spacing(m.grid, m.pitch_mm);
+    const double row = row_spacing(m.array.grid, m.array.pitch_mm);
     const double rows = std::floor(box.y1 / row) - std::ceil(box.y0 / row) + 1;
-    const double columns = (box.x1 - box.x0) / m.pitch_mm + 2;
+    const double columns = (box.x1 - box.x0) / m.array.pitch_mm + 2;
     if (!(rows * columns <= double(kMaxForwardLenses)))
         return;  // absurd sizes: give no hits rather than hang
     const double limit = double(kMaxLensIndex);
     if (!(std::fabs(box.y0 / row) < limit && std::fabs(box.y1 / row) < limit &&
-          std::fabs(box.x0 / m.pitch_mm) < limit && std::fabs(box.x1 / m.pitch_mm) < limit))
+          std::fabs(box.x0 / m.array.pitch_mm) < limit && std::fabs(box.x1 / m.array.pitch_mm) < limit))
         return;
     const std::int64_t l0 = std::int64_t(std::ceil(box.y0 / row));
     const std::int64_t l1 = std::int64_t(std::floor(box.y1 / row));
     for (std::int64_t l = l0; l <= l1; ++l) {
-        const double shift = (m.grid == GridType::Hexagonal && floor_mod(l, 2) == 1) ? 0.5 : 0.0;
-        const std::int64_t k0 = std::int64_t(std::ceil(box.x0 / m.pitch_mm - shift));
-        const std::int64_t k1 = std::int64_t(std::floor(box.x1 / m.pitch_mm - shift));
+        const double shift = (m.array.grid == GridType::Hexagonal && floor_mod(l, 2) == 1) ? 0.5 : 0.0;
+        const std::int64_t k0 = std::int64_t(std::ceil(box.x0 / m.array.pitch_mm - shift));
+        const std::int64_t k1 = std::int64_t(std::floor(box.x1 / m.array.pitch_mm - shift));
         for (std::int64_t k = k0; k <= k1; ++k)
             visit(LensIndex{k, l});
     }
@@ -244,22 +244,22 @@ double distance_to_origin(const Vec2* corner, int count)
 // Whether some ray from the object (thin-lens image `image`) through the main aperture passes
 // through the lens's cell (its centre only, for pinholes): the cell, projected from the image
 // point onto the main-lens plane, must meet the aperture disc.
-bool lens_sees(const Model& m, Homogeneous image, LensIndex lens)
+bool lens_sees(const PlenopticCamera& m, Homogeneous image, LensIndex lens)
 {
     const Vec3 pupil = m.lens->exit_pupil_centre();
-    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
     Vec2 local[6];
     int count = 1;
     local[0] = Vec2{0, 0};
-    if (m.microlens == MicrolensType::ThinLens)
-        count = cell_polygon(m.grid, m.pitch_mm, local);
+    if (m.array.microlens == MicrolensType::ThinLens)
+        count = cell_polygon(m.array.grid, m.array.pitch_mm, local);
     Vec2 projected[6];
     double first_sign = 0;
     for (int i = 0; i < count; ++i) {
         const Vec3 corner = to_optics(m, Vec3{c.x + local[i].x, c.y + local[i].y, 0});
         Homogeneous hit;
         if (!line_meets_plane(image, corner, Vec3{0, 0, 1}, pupil, &hit))
-            return m.microlens == MicrolensType::ThinLens;  // projection unbounded: keep (conservative)
+            return m.array.microlens == MicrolensType::ThinLens;  // projection unbounded: keep (conservative)
         const double sign = hit.w > 0 ? 1 : -1;
         if (i == 0)
             first_sign = sign;
@@ -278,7 +278,7 @@ bool lens_sees(const Model& m, Homogeneous image, LensIndex lens)
 // cross the plane as a bounded region.
 const int kFootprintSides = 96;
 
-bool cone_footprint(const Model& m, Homogeneous image, Vec2 footprint[kFootprintSides])
+bool cone_footprint(const PlenopticCamera& m, Homogeneous image, Vec2 footprint[kFootprintSides])
 {
     const Vec3 pupil = m.lens->exit_pupil_centre();
     const double r = m.lens->exit_pupil_radius();
@@ -286,8 +286,8 @@ bool cone_footprint(const Model& m, Homogeneous image, Vec2 footprint[kFootprint
     for (int i = 0; i < kFootprintSides; ++i) {
         const double angle = 2 * kPi * i / kFootprintSides;
         Homogeneous hit;
-        if (!line_meets_plane(image, pupil + Vec3{r * std::cos(angle), r * std::sin(angle), 0}, m.pose.normal,
-                              m.pose.centre_mm, &hit))
+        if (!line_meets_plane(image, pupil + Vec3{r * std::cos(angle), r * std::sin(angle), 0}, m.array.pose.normal,
+                              m.array.pose.centre_mm, &hit))
             return false;
         const double sign = hit.w > 0 ? 1 : -1;
         if (i == 0)
@@ -363,7 +363,7 @@ double area_centroid(const std::vector<Vec2>& poly, Vec2* centroid)
 // The part of `light` (a convex polygon on the sensor plane, x, y, mm, uniformly lit) that the
 // renderer delivers through `lens`: inside the picture and inside the microimage cells of the
 // lenses within the receiving rings. Returns its area and centroid.
-double delivered_area(const Model& m, LensIndex lens, const std::vector<Vec2>& light, Vec2* centroid)
+double delivered_area(const PlenopticCamera& m, LensIndex lens, const std::vector<Vec2>& light, Vec2* centroid)
 {
     const std::vector<Vec2> inside = clip_polygon(light, picture_polygon(m));
     if (inside.size() < 3)
@@ -371,15 +371,15 @@ double delivered_area(const Model& m, LensIndex lens, const std::vector<Vec2>& l
     const Box lit = bounding_box(inside);
     const double x0 = lit.x0, x1 = lit.x1, y0 = lit.y0, y1 = lit.y1;
     const int rings = receiving_rings(m);
-    if (!m.pose.tilted && m.lens) {
+    if (!m.array.pose.tilted && m.lens) {
         // Fast path: the cells within `rings` rings cover the disc of radius rings * row spacing
         // about the lens centre (ring r lies at least r row spacings away, and a point that far
         // is nearer to a lens within the rings than to any beyond), or the cell's inscribed
         // circle without overlap; an untilted array maps to the sensor by one scale factor.
         const Vec3 c = lens_centre_mm(m, lens);
         if (c.z < 0) {
-            const double scale = m.sensor_z_mm / c.z;
-            const double radius = scale * (rings > 0 ? rings * row_spacing(m.grid, m.pitch_mm) : m.cell_inradius_mm);
+            const double scale = m.sensor.z_mm / c.z;
+            const double radius = scale * (rings > 0 ? rings * row_spacing(m.array.grid, m.array.pitch_mm) : m.array.cell_inradius_mm);
             bool covered = true;
             for (const Vec2& q : inside)
                 covered = covered && length(q - Vec2{c.x * scale, c.y * scale}) <= radius * (1 - 1e-9);
@@ -387,19 +387,19 @@ double delivered_area(const Model& m, LensIndex lens, const std::vector<Vec2>& l
                 return area_centroid(inside, centroid);
         }
     }
-    const std::int64_t k0 = skew_k(m.grid, lens);
+    const std::int64_t k0 = skew_k(m.array.grid, lens);
     double area = 0, cx = 0, cy = 0;
     for (int dl = -rings; dl <= rings; ++dl) {
         for (int dk = -rings; dk <= rings; ++dk) {
-            const LensIndex other = from_skew(m.grid, k0 + dk, lens.l + dl);
+            const LensIndex other = from_skew(m.array.grid, k0 + dk, lens.l + dl);
             if (!within_rings(m, other, lens, rings))
                 continue;
-            if (!m.pose.tilted && m.lens) {
+            if (!m.array.pose.tilted && m.lens) {
                 // Cheap rejection: the cell's circumscribed circle, scaled onto the sensor.
                 const Vec3 oc = lens_centre_mm(m, other);
                 if (oc.z < 0) {
-                    const double scale = m.sensor_z_mm / oc.z;
-                    const double reach = scale * m.cell_circumradius_mm;
+                    const double scale = m.sensor.z_mm / oc.z;
+                    const double reach = scale * m.array.cell_circumradius_mm;
                     const double ox = oc.x * scale, oy = oc.y * scale;
                     if (ox + reach < x0 || ox - reach > x1 || oy + reach < y0 || oy - reach > y1)
                         continue;
@@ -428,12 +428,12 @@ double delivered_area(const Model& m, LensIndex lens, const std::vector<Vec2>& l
 // Adds the image of the light `light` (sensor plane, uniformly lit, carrying `fraction` of the
 // point's light) through `lens`: the centroid of the part the renderer delivers, with the fraction
 // scaled to that part. A spot smaller than a thousandth of a pixel is a point.
-void add_spot_hit(const Model& m, LensIndex lens, const std::vector<Vec2>& light, double fraction,
+void add_spot_hit(const PlenopticCamera& m, LensIndex lens, const std::vector<Vec2>& light, double fraction,
                   std::vector<PixelHit>* hits)
 {
     Vec2 centre{0, 0};
     const double area = area_centroid(light, &centre);
-    const double tiny = 1e-6 * m.pixel_size_mm[0] * m.pixel_size_mm[1];
+    const double tiny = 1e-6 * m.sensor.pixel_size_mm[0] * m.sensor.pixel_size_mm[1];
     if (!(area > tiny)) {
         if (light.empty())
             return;
@@ -441,7 +441,7 @@ void add_spot_hit(const Model& m, LensIndex lens, const std::vector<Vec2>& light
         for (const Vec2& q : light)
             mean = mean + q;
         mean = (1.0 / light.size()) * mean;
-        add_point_hit(m, lens, Vec3{mean.x, mean.y, m.sensor_z_mm}, fraction, hits);
+        add_point_hit(m, lens, Vec3{mean.x, mean.y, m.sensor.z_mm}, fraction, hits);
         return;
     }
     Vec2 centroid;
@@ -455,19 +455,19 @@ void add_spot_hit(const Model& m, LensIndex lens, const std::vector<Vec2>& light
 }
 
 // The picture on the sensor plane (x, y, mm), as a box.
-Box picture_box(const Model& m) { return bounding_box(picture_polygon(m)); }
+Box picture_box(const PlenopticCamera& m) { return bounding_box(picture_polygon(m)); }
 
 // Whether light through `lens` from a part of its cell (array-local corners) towards the sensor,
 // along lines from the image point, can land in the picture: false only when the bounding box of
 // the cell's corners carried to the sensor misses it (true when a corner cannot be carried).
-bool cell_spot_may_reach_picture(const Model& m, LensIndex lens, Homogeneous image,
+bool cell_spot_may_reach_picture(const PlenopticCamera& m, LensIndex lens, Homogeneous image,
                                  const std::vector<Vec2>& corners, Box picture)
 {
     Box spot{false, 0, 0, 0, 0};
     for (const Vec2& q : corners) {
         const Vec3 h = to_optics(m, Vec3{q.x, q.y, 0});
         Vec3 towards = image.w == 0 ? image.xyz : (1 / image.w) * image.xyz - h;
-        if (dot(towards, m.pose.normal) > 0)
+        if (dot(towards, m.array.pose.normal) > 0)
             towards = -towards;
         Vec3 hit;
         if (!sensor_hit_through_lens(m, lens, h, towards, &hit) || !is_finite(hit))
@@ -477,12 +477,12 @@ bool cell_spot_may_reach_picture(const Model& m, LensIndex lens, Homogeneous ima
     return !spot.valid || !picture.valid || overlap(spot, picture);
 }
 
-void project_through_thin_main(const Model& m, Vec3 point, std::vector<PixelHit>* hits)
+void project_through_thin_main(const PlenopticCamera& m, Vec3 point, std::vector<PixelHit>* hits)
 {
     const Homogeneous image = m.lens->paraxial_image(point);
     const Vec3 pupil = m.lens->exit_pupil_centre();
-    const Vec3 n = m.pose.normal;
-    const Vec3 centre = m.pose.centre_mm;
+    const Vec3 n = m.array.pose.normal;
+    const Vec3 centre = m.array.pose.centre_mm;
 
     // Footprint of the cone (main aperture -> image) on the array: project the aperture's
     // bounding square from the image point; bounded when all four corners project to one side.
@@ -507,10 +507,10 @@ void project_through_thin_main(const Model& m, Vec3 point, std::vector<PixelHit>
     if (!bounded)
         footprint.valid = false;
     else
-        footprint = grow(footprint, m.cell_circumradius_mm);
+        footprint = grow(footprint, m.array.cell_circumradius_mm);
     // With overlap modelling, light through a lens reaches the microimages of lenses up to
     // overlap_rings rings away (each ring at most a pitch further).
-    const Box box = intersect(footprint, grow(sensor_box(m), receiving_rings(m) * m.pitch_mm));
+    const Box box = intersect(footprint, grow(sensor_box(m), receiving_rings(m) * m.array.pitch_mm));
     if (!box.valid)
         return;
 
@@ -528,9 +528,9 @@ void project_through_thin_main(const Model& m, Vec3 point, std::vector<PixelHit>
             return;
         const Vec3 h = (1 / image.w) * image.xyz;
         const Vec3 h_local = to_local(m, h);
-        const LensIndex lens = nearest_lens(m.grid, m.pitch_mm, h_local.x, h_local.y);
-        if (m.microlens == MicrolensType::Pinhole) {
-            if (length(h - lens_centre_mm(m, lens)) > 1e-9 * m.pitch_mm)
+        const LensIndex lens = nearest_lens(m.array.grid, m.array.pitch_mm, h_local.x, h_local.y);
+        if (m.array.microlens == MicrolensType::Pinhole) {
+            if (length(h - lens_centre_mm(m, lens)) > 1e-9 * m.array.pitch_mm)
                 return;  // a pinhole passes light only at its centre
             Vec3 hit;
             if (sensor_hit_through_lens(m, lens, h, h - pupil, &hit))
@@ -560,10 +560,10 @@ void project_through_thin_main(const Model& m, Vec3 point, std::vector<PixelHit>
     // whose footprints are small, need the partial cells. The fraction is the part of the point's
     // light through the main aperture that arrives in that image.
     Vec2 cone[kFootprintSides];
-    const bool thin_microlenses = m.microlens == MicrolensType::ThinLens;
+    const bool thin_microlenses = m.array.microlens == MicrolensType::ThinLens;
     const bool use_footprint = thin_microlenses && cone_footprint(m, image, cone);
     Vec2 cell[6];
-    const int cell_count = thin_microlenses ? cell_polygon(m.grid, m.pitch_mm, cell) : 0;
+    const int cell_count = thin_microlenses ? cell_polygon(m.array.grid, m.array.pitch_mm, cell) : 0;
     const std::vector<Vec2> cone_polygon(cone, cone + (use_footprint ? kFootprintSides : 0));
     Vec2 unused;
     const double cone_area = use_footprint ? area_centroid(cone_polygon, &unused) : 0;
@@ -573,7 +573,7 @@ void project_through_thin_main(const Model& m, Vec3 point, std::vector<PixelHit>
         if (!lens_sees(m, image, lens))
             return;
         if (use_footprint && cone_area > 0) {
-            const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+            const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
             std::vector<Vec2> corners(cell_count);
             for (int i = 0; i < cell_count; ++i)
                 corners[i] = c + cell[i];
@@ -594,7 +594,7 @@ void project_through_thin_main(const Model& m, Vec3 point, std::vector<PixelHit>
             for (const Vec2& q : part) {
                 const Vec3 h = to_optics(m, Vec3{q.x, q.y, 0});
                 Vec3 towards = image.w == 0 ? image.xyz : (1 / image.w) * image.xyz - h;
-                if (dot(towards, m.pose.normal) > 0)
+                if (dot(towards, m.array.pose.normal) > 0)
                     towards = -towards;
                 Vec3 hit;
                 if (!sensor_hit_through_lens(m, lens, h, towards, &hit))
@@ -607,7 +607,7 @@ void project_through_thin_main(const Model& m, Vec3 point, std::vector<PixelHit>
         // Pinhole microlenses (or a cone that does not cross the array as a bounded region): the
         // line from X' through the lens centre (its chief ray), met with the sensor plane.
         Homogeneous meet;
-        if (!line_meets_plane(image, lens_centre_mm(m, lens), Vec3{0, 0, 1}, Vec3{0, 0, m.sensor_z_mm}, &meet))
+        if (!line_meets_plane(image, lens_centre_mm(m, lens), Vec3{0, 0, 1}, Vec3{0, 0, m.sensor.z_mm}, &meet))
             return;
         const Vec3 hit = (1 / meet.w) * meet.xyz;
         if (is_finite(hit))
@@ -615,35 +615,35 @@ void project_through_thin_main(const Model& m, Vec3 point, std::vector<PixelHit>
     });
 }
 
-void project_through_pinhole_main(const Model& m, Vec3 point, std::vector<PixelHit>* hits)
+void project_through_pinhole_main(const PlenopticCamera& m, Vec3 point, std::vector<PixelHit>* hits)
 {
-    if (m.microlens == MicrolensType::Pinhole)
+    if (m.array.microlens == MicrolensType::Pinhole)
         return;
     // The single ray: point -> pinhole -> array.
     const Vec3 towards_sensor = -point;
-    const double along = dot(m.pose.normal, towards_sensor);
-    const double t = dot(m.pose.normal, m.pose.centre_mm) / along;
+    const double along = dot(m.array.pose.normal, towards_sensor);
+    const double t = dot(m.array.pose.normal, m.array.pose.centre_mm) / along;
     if (!(t > 0) || !std::isfinite(t))
         return;
     const Vec3 h = t * towards_sensor;
     const Vec3 h_local = to_local(m, h);
-    const LensIndex lens = nearest_lens(m.grid, m.pitch_mm, h_local.x, h_local.y);
+    const LensIndex lens = nearest_lens(m.array.grid, m.array.pitch_mm, h_local.x, h_local.y);
     Vec3 hit;
     if (sensor_hit_through_lens(m, lens, h, towards_sensor, &hit))
         add_point_hit(m, lens, hit, 1.0, hits);
 }
 
-void project_without_main(const Model& m, Vec3 point, std::vector<PixelHit>* hits)
+void project_without_main(const PlenopticCamera& m, Vec3 point, std::vector<PixelHit>* hits)
 {
     const Vec3 local = to_local(m, point);
     if (!(local.z > 0))
         return;  // behind the array
     Box box = sensor_box(m);
-    if (!m.pose.tilted) {
+    if (!m.array.pose.tilted) {
         // A lens images the point into its own cell only if the point is within
         // R (z + d) / d of the lens centre, sideways.
-        const double reach = m.cell_circumradius_mm * (local.z / effective_array_distance_mm(m) + 1) +
-                             m.cell_circumradius_mm;
+        const double reach = m.array.cell_circumradius_mm * (local.z / effective_array_distance_mm(m) + 1) +
+                             m.array.cell_circumradius_mm;
         box = intersect(box, Box{true, local.x - reach, local.x + reach, local.y - reach, local.y + reach});
     }
     for_each_lens_in_box(m, box, [&](LensIndex lens) {
@@ -656,19 +656,18 @@ void project_without_main(const Model& m, Vec3 point, std::vector<PixelHit>* hit
 
 } // namespace
 
-std::vector<PixelHit> forward_project(const Model& m, const double point_mm[3])
+std::vector<PixelHit> forward_project(const PlenopticCamera& m, Vec3 point)
 {
     std::vector<PixelHit> hits;
-    const Vec3 point{point_mm[0], point_mm[1], point_mm[2]};
     if (!is_finite(point))
         return hits;
-    if ((m.lens && m.lens->traced()) || m.has_distortion)
+    if ((m.lens && m.lens->traced()) || m.distortion())
         return forward_project_traced(m, point, default_traced_projection_options());
-    if (m.grid == GridType::None) {
+    if (m.array.grid == GridType::None) {
         if (!(point.z > 0))
             return hits;
         // Pinhole, or the chief ray of a thin lens (the centre of its blur disc).
-        const double s = m.sensor_z_mm / point.z;
+        const double s = m.sensor.z_mm / point.z;
         const PixelPoint px = sensor_to_pixel(m, point.x * s, point.y * s);
         if (px.inside)
             hits.push_back(PixelHit{LensIndex{0, 0}, px.u, px.v, 1.0});
@@ -685,6 +684,11 @@ std::vector<PixelHit> forward_project(const Model& m, const double point_mm[3])
     else
         project_through_thin_main(m, point, &hits);
     return hits;
+}
+
+std::vector<PixelHit> PlenopticCamera::project(Vec3 point_mm) const
+{
+    return forward_project(*this, point_mm);
 }
 
 } // namespace plenoptic

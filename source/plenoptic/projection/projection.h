@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "plenoptic/core/lattice.h"
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 
 namespace plenoptic {
 
@@ -37,7 +37,7 @@ struct PixelHit {
 // A thick lens is the thin lens between its principal planes, its exit pupil the aperture. A traced
 // (prescription) lens and a distorted thin lens have no closed form: forward_project_traced
 // (projection/traced_projection.h).
-std::vector<PixelHit> forward_project(const Model& model, const double point_mm[3]);
+std::vector<PixelHit> forward_project(const PlenopticCamera& model, Vec3 point_mm);
 
 } // namespace plenoptic
 

@@ -8,7 +8,7 @@
 
 #include <vector>
 
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 #include "plenoptic/projection/projection.h"
 #include "plenoptic/core/vec.h"
 
@@ -18,30 +18,30 @@ namespace detail {
 // Sensor hit of a ray arriving at array point h (optics frame) with direction `towards_sensor`,
 // refracted by `lens` (the same rule w' = w - (h - c)/f with w normalised to unit travel along the
 // normal); pinholes pass it unchanged. False when it does not reach the sensor plane.
-bool sensor_hit_through_lens(const Model& m, LensIndex lens, Vec3 h, Vec3 towards_sensor, Vec3* hit);
+bool sensor_hit_through_lens(const PlenopticCamera& m, LensIndex lens, Vec3 h, Vec3 towards_sensor, Vec3* hit);
 
 // Lenses whose microimage cells may receive light through a lens: the renderer gives a sensor
 // point light through lens L only if L is its own lens (no overlap modelling: the own lens of
-// each sample's sensor point), or, with overlap modelling, if L lies within model.overlap_rings
+// each sample's sensor point), or, with overlap modelling, if L lies within model.overlap.rings
 // rings of the own lens of the pixel's centre (overlap_lenses; its reach test is conservative,
 // so it never refuses light that arrives). Rings in skew indices: max(|dk|, |dl|) rectangular,
 // max(|dk|, |dl|, |dk + dl|) hexagonal.
-int receiving_rings(const Model& m);
-bool within_rings(const Model& m, LensIndex a, LensIndex b, int rings);
+int receiving_rings(const PlenopticCamera& m);
+bool within_rings(const PlenopticCamera& m, LensIndex a, LensIndex b, int rings);
 
 // The picture on the sensor plane (x, y, mm).
-std::vector<Vec2> picture_polygon(const Model& m);
+std::vector<Vec2> picture_polygon(const PlenopticCamera& m);
 
 // Lens `lens`'s microimage cell on the sensor plane: its cell seen from the main-lens centre
 // (straight down without a main lens). Empty if a corner does not project.
-std::vector<Vec2> microimage_cell(const Model& m, LensIndex lens);
+std::vector<Vec2> microimage_cell(const PlenopticCamera& m, LensIndex lens);
 
 // Whether the renderer delivers light through `lens` to sensor point s (x, y, mm): inside the
 // picture and in the microimage cell of a lens within the receiving rings of `lens`.
-bool delivered_point(const Model& m, LensIndex lens, Vec2 s);
+bool delivered_point(const PlenopticCamera& m, LensIndex lens, Vec2 s);
 
 // Adds the image at sensor point s if the renderer delivers light there through `lens`.
-void add_point_hit(const Model& m, LensIndex lens, Vec3 s, double fraction, std::vector<PixelHit>* hits);
+void add_point_hit(const PlenopticCamera& m, LensIndex lens, Vec3 s, double fraction, std::vector<PixelHit>* hits);
 
 } // namespace detail
 } // namespace plenoptic

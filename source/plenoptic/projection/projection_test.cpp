@@ -32,10 +32,10 @@ TEST(Optics, FocusedOnTheArrayImagesToTheCentreOfTheOnAxisMicroimage)
     // Plenoptic 1.0: d = f; the on-axis point whose thin-lens image lies on the array.
     const double F = 50, D = 52;
     for (GridType grid : {GridType::Hexagonal, GridType::Rectangular}) {
-        const Model m = make_model(plenoptic_camera(grid, 0.5, 2, 2, F, 4, D));
+        const PlenopticCamera m = make_camera(plenoptic_camera(grid, 0.5, 2, 2, F, 4, D));
         const int W = 301, H = 201;
-        const double point[3] = {0, 0, F * D / (D - F)};
-        const std::vector<PixelHit> hits = forward_project(with_film(m, W, H), point);
+        const Vec3 point{0, 0, F * D / (D - F)};
+        const std::vector<PixelHit> hits = with_film(m, W, H).project(point);
         ASSERT_EQ(hits.size(), 1u) << "only the lens on which the point is focused sees it";
         EXPECT_EQ(hits[0].lens, (LensIndex{0, 0}));
         EXPECT_NEAR(hits[0].u, (W - 1) / 2.0, 1e-9);
@@ -50,34 +50,34 @@ TEST(Optics, FocusedOnTheArrayImagesToTheCentreOfTheOnAxisMicroimage)
 // Whether the cone of light from the main aperture to the thin-lens image of x covers lens's
 // cell only in part (thin lenses both; computed here without the code under test). Tilted
 // arrays use the untilted footprint with a margin of a pitch: an over-approximation.
-bool partly_covered(const Model& m, Vec3 x, LensIndex lens)
+bool partly_covered(const PlenopticCamera& m, Vec3 x, LensIndex lens)
 {
-    if (test::lens_kind(m) != "thin_lens" || m.microlens != MicrolensType::ThinLens)
+    if (test::lens_kind(m) != "thin_lens" || m.array.microlens != MicrolensType::ThinLens)
         return false;
-    const double F = m.focal_length_mm, D = m.distance_mm;
+    const double F = m.focal_length_mm(), D = m.distance_mm;
     const double b = F * x.z / (x.z - F);             // image distance behind the main lens
     const Vec2 image{-x.x * b / x.z, -x.y * b / x.z};  // image, laterally
     const Vec2 centre = (D / b) * image;               // cone axis at the array plane
-    const double radius = 0.5 * m.aperture_mm * std::fabs(b - D) / b;
+    const double radius = 0.5 * m.aperture_mm() * std::fabs(b - D) / b;
     const Vec3 c3 = lens_centre_mm(m, lens);
     const double to_centre = length(Vec2{c3.x, c3.y} - centre);
-    const double margin = m.pose.tilted ? m.pitch_mm : 1e-9;
-    return to_centre + m.cell_circumradius_mm + margin > radius;
+    const double margin = m.array.pose.tilted ? m.array.pitch_mm : 1e-9;
+    return to_centre + m.array.cell_circumradius_mm + margin > radius;
 }
 
 void check_forward_then_chief(const char* name, CameraParams params, int min_multi)
 {
     params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.01;
     ASSERT_EQ(check_camera(params), "") << name;
-    const Model m = make_model(params);
+    const PlenopticCamera m = make_camera(params);
     const int W = 401, H = 301;
     std::mt19937_64 rng(5);
     std::uniform_real_distribution<double> depth(150.0, 3000.0), side(-0.03, 0.03);
     int hits_total = 0, multi = 0;
     for (int k = 0; k < 200; ++k) {
         const double z = depth(rng);
-        const double point[3] = {side(rng) * z, side(rng) * z, z};
-        const std::vector<PixelHit> hits = forward_project(with_film(m, W, H), point);
+        const Vec3 point{side(rng) * z, side(rng) * z, z};
+        const std::vector<PixelHit> hits = with_film(m, W, H).project(point);
         hits_total += int(hits.size());
         if (hits.size() >= 2)
             ++multi;
@@ -87,7 +87,7 @@ void check_forward_then_chief(const char* name, CameraParams params, int min_mul
             EXPECT_LT(hit.u, W - 0.5);
             OpticsRay ray;
             ASSERT_TRUE((ray = chief_ray_through(with_film(m, W, H), hit.u + 0.5, hit.v + 0.5, &hit.lens)).passed) << name;
-            const Vec3 x{point[0], point[1], point[2]};
+            const Vec3 x{point.x, point.y, point.z};
             const double miss = test::distance_to_line(x, origin_of(ray), dir_of(ray));
             // A thin microlens that the point's cone of light covers only in part images it at
             // the centroid of that part, off the line through the lens centre
@@ -96,7 +96,7 @@ void check_forward_then_chief(const char* name, CameraParams params, int min_mul
                 continue;
             // Nor is a spot that the picture's edge cuts (the image is the centroid of the part
             // inside): skip hits within the spot's reach of the edge.
-            const double reach_px = (m.overlap_rings + 1) * m.pitch_mm * 2 / m.pixel_size_mm[0];
+            const double reach_px = (m.overlap.rings + 1) * m.array.pitch_mm * 2 / m.sensor.pixel_size_mm[0];
             if (hit.u < reach_px || hit.u > W - 1 - reach_px || hit.v < reach_px || hit.v > H - 1 - reach_px)
                 continue;
             EXPECT_LT(miss, 1e-7 * z) << name << ": point " << str(x) << " lens (" << hit.lens.k << ","
@@ -107,14 +107,14 @@ void check_forward_then_chief(const char* name, CameraParams params, int min_mul
             const OwnLens owner_lookup = own_lens(m, sensor_point(with_film(m, W, H), hit.u + 0.5, hit.v + 0.5));
             ASSERT_TRUE(owner_lookup.found);
             const LensIndex owner = owner_lookup.lens;
-            if (!m.model_overlap) {
+            if (!m.overlap.modelled) {
                 EXPECT_EQ(owner, hit.lens) << name;
             } else {
-                const long long dk = skew_k(m.grid, owner) - skew_k(m.grid, hit.lens), dl = owner.l - hit.lens.l;
+                const long long dk = skew_k(m.array.grid, owner) - skew_k(m.array.grid, hit.lens), dl = owner.l - hit.lens.l;
                 long long rings = std::max(std::llabs(dk), std::llabs(dl));
-                if (m.grid == GridType::Hexagonal)
+                if (m.array.grid == GridType::Hexagonal)
                     rings = std::max(rings, std::llabs(dk + dl));
-                EXPECT_LE(rings, m.overlap_rings) << name;
+                EXPECT_LE(rings, m.overlap.rings) << name;
             }
         }
     }
@@ -154,14 +154,14 @@ TEST(Optics, ForwardProjectedPositionsTurnBackIntoChiefRaysThroughThePoint)
 void check_forward_is_centroid(const char* name, const CameraParams& params, double max_px)
 {
     ASSERT_EQ(check_camera(params), "") << name;
-    const Model m = make_model(params);
+    const PlenopticCamera m = make_camera(params);
     const int W = 401, H = 301;
-    const double F = m.focal_length_mm, D = m.distance_mm, r = 0.5 * m.aperture_mm;
-    const double d = m.array_distance_mm, sx = m.pixel_size_mm[0], sy = m.pixel_size_mm[1];
+    const double F = m.focal_length_mm(), D = m.distance_mm, r = 0.5 * m.aperture_mm();
+    const double d = m.array.distance_mm, sx = m.sensor.pixel_size_mm[0], sy = m.sensor.pixel_size_mm[1];
     int compared = 0;
     const double xs[][3] = {{3, -2, 400}, {-10, 6, 900}, {20, 12, 1500}, {0.4, -0.3, F * D / (D - F) * 1.02}};
     for (const auto& p : xs) {
-        const std::vector<PixelHit> hits = forward_project(with_film(m, W, H), p);
+        const std::vector<PixelHit> hits = with_film(m, W, H).project(Vec3{p[0], p[1], p[2]});
         std::map<std::pair<long long, long long>, std::array<double, 3>> sums;  // u, v, count
         std::mt19937_64 rng(11);
         std::uniform_real_distribution<double> uni(0, 1);
@@ -171,9 +171,9 @@ void check_forward_is_centroid(const char* name, const CameraParams& params, dou
             // Slope (per unit +z) of the ray X -> aperture point, then undo the main lens.
             const double wx = (p[0] - mx) / p[2] + mx / F, wy = (p[1] - my) / p[2] + my / F;
             const double hx = mx - wx * D, hy = my - wy * D;
-            const LensIndex lens = test::brute_force_nearest(m.grid, m.pitch_mm, hx, hy);
-            const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
-            const double f = m.microlens_focal_mm[lens_type(lens, m.lens_type_count)];
+            const LensIndex lens = test::brute_force_nearest(m.array.grid, m.array.pitch_mm, hx, hy);
+            const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
+            const double f = m.array.focal_mm[lens_type(lens, m.array.lens_type_count)];
             const double bx = wx + (hx - c.x) / f, by = wy + (hy - c.y) / f;
             const double sxm = hx - bx * d, sym = hy - by * d;
             const double u = W / 2.0 - 0.5 - sxm / sx, v = H / 2.0 - 0.5 + sym / sy;
@@ -209,17 +209,17 @@ TEST(Optics, ForwardProjectionIsTheCentroidOfTheLightThroughEachLens)
 
 TEST(Optics, ForwardProjectionWithoutArrayIsThePerspectiveProjection)
 {
-    const Model m = make_model(thin_lens_camera(50, 4, 52));
+    const PlenopticCamera m = make_camera(thin_lens_camera(50, 4, 52));
     const int W = 640, H = 480;
-    const double point[3] = {100, -50, 2000};
-    const std::vector<PixelHit> hits = forward_project(with_film(m, W, H), point);
+    const Vec3 point{100, -50, 2000};
+    const std::vector<PixelHit> hits = with_film(m, W, H).project(point);
     ASSERT_EQ(hits.size(), 1u);
     // Inverted on the sensor: x = -100 * 52 / 2000 = -2.6 mm, y = +1.3 mm; read out upright:
     // right of the axis -> right of the image (u = 319.5 + 260), below -> below (v = 239.5 + 130).
     EXPECT_NEAR(hits[0].u, 319.5 + 2.6 / 0.01, 1e-9);
     EXPECT_NEAR(hits[0].v, 239.5 + 1.3 / 0.01, 1e-9);
-    const double behind[3] = {0, 0, -10};
-    EXPECT_TRUE(forward_project(with_film(m, W, H), behind).empty());
+    const Vec3 behind{0, 0, -10};
+    EXPECT_TRUE(with_film(m, W, H).project(behind).empty());
 }
 
 } // namespace

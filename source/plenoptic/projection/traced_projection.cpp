@@ -44,16 +44,16 @@ struct Box2 {
 };
 
 // The ray from the point through window point (x, y) at the window's z, traced to the image side.
-ImageRay trace_through(const Model& m, Vec3 point, double window_z, double x, double y, bool check_apertures)
+ImageRay trace_through(const PlenopticCamera& m, Vec3 point, double window_z, double x, double y, bool check_apertures)
 {
     return m.lens->to_image(point, Vec3{x, y, window_z} - point, check_apertures);
 }
 
 // Where a ray leaving the lens meets the array plane (optics frame); false if it does not.
-bool array_hit(const Model& m, const ImageRay& ray, Vec3* h)
+bool array_hit(const PlenopticCamera& m, const ImageRay& ray, Vec3* h)
 {
-    const double along = dot(m.pose.normal, ray.dir);
-    const double t = dot(m.pose.normal, m.pose.centre_mm - ray.origin) / along;
+    const double along = dot(m.array.pose.normal, ray.dir);
+    const double t = dot(m.array.pose.normal, m.array.pose.centre_mm - ray.origin) / along;
     if (!(t > 0) || !std::isfinite(t))
         return false;
     *h = ray.origin + t * ray.dir;
@@ -68,7 +68,7 @@ struct Coarse {
     double step;
 };
 
-Coarse coarse_pass(const Model& m, Vec3 point, double window_z, Square disc, int n)
+Coarse coarse_pass(const PlenopticCamera& m, Vec3 point, double window_z, Square disc, int n)
 {
     Coarse out{Box2{false, 0, 0, 0, 0}, Box2{false, 0, 0, 0, 0}, 2 * disc.half / n};
     for (int j = 0; j < n; ++j) {
@@ -81,7 +81,7 @@ Coarse coarse_pass(const Model& m, Vec3 point, double window_z, Square disc, int
                 continue;
             out.window.include(disc.x + dx, disc.y + dy);
             Vec3 h;
-            if (m.grid != GridType::None && array_hit(m, ray, &h)) {
+            if (m.array.grid != GridType::None && array_hit(m, ray, &h)) {
                 const Vec3 local = to_local(m, h);
                 out.array.include(local.x, local.y);
             }
@@ -102,9 +102,9 @@ typedef std::pair<std::int64_t, std::int64_t> RowKey;  // (l, k): row order
 
 // Newton's method for the window point whose ray meets the array at the centre of `lens`
 // (apertures ignored while iterating, so that a lens near the edge of the light converges).
-bool ray_through_centre(const Model& m, Vec3 point, double window_z, LensIndex lens, double step, double* x, double* y)
+bool ray_through_centre(const PlenopticCamera& m, Vec3 point, double window_z, LensIndex lens, double step, double* x, double* y)
 {
-    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
     auto miss = [&](double px, double py, Vec2* out) {
         const ImageRay ray = trace_through(m, point, window_z, px, py, false);
         Vec3 h;
@@ -114,7 +114,7 @@ bool ray_through_centre(const Model& m, Vec3 point, double window_z, LensIndex l
         *out = Vec2{local.x - c.x, local.y - c.y};
         return true;
     };
-    const double tolerance = 1e-10 * m.pitch_mm;
+    const double tolerance = 1e-10 * m.array.pitch_mm;
     const double delta = 1e-4 * step;
     for (int iteration = 0; iteration < 40; ++iteration) {
         Vec2 f;
@@ -158,7 +158,7 @@ struct Ray {
 // The ray from the point through window point (wx, wy): traced through the main lens, to the
 // array, through its microlens to the sensor; Delivered when the renderer gives it to the picture
 // (delivered_point); without an array, Delivered when it reaches the sensor plane.
-Ray sample(const Model& m, Vec3 point, double window_z, double wx, double wy)
+Ray sample(const PlenopticCamera& m, Vec3 point, double window_z, double wx, double wy)
 {
     Ray out{Ray::Blocked, RowKey(0, 0), 0, 0, 0, wx, wy, -1};
     const Vec3 to_window = Vec3{wx, wy, window_z} - point;
@@ -170,8 +170,8 @@ Ray sample(const Model& m, Vec3 point, double window_z, double wx, double wy)
     const double r = length(to_window);
     out.weight = 1 / (r * r * r);
     out.kind = Ray::Undelivered;
-    if (m.grid == GridType::None) {
-        const double t = (m.sensor_z_mm - ray.origin.z) / ray.dir.z;
+    if (m.array.grid == GridType::None) {
+        const double t = (m.sensor.z_mm - ray.origin.z) / ray.dir.z;
         if (t > 0 && std::isfinite(t)) {
             out.kind = Ray::Delivered;
             out.sx = ray.origin.x + t * ray.dir.x;
@@ -183,12 +183,12 @@ Ray sample(const Model& m, Vec3 point, double window_z, double wx, double wy)
     if (!array_hit(m, ray, &h))
         return out;
     const Vec3 local = to_local(m, h);
-    const LensIndex lens = nearest_lens(m.grid, m.pitch_mm, local.x, local.y);
-    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+    const LensIndex lens = nearest_lens(m.array.grid, m.array.pitch_mm, local.x, local.y);
+    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
     out.lens = RowKey(lens.l, lens.k);
     out.nearest2 = (local.x - c.x) * (local.x - c.x) + (local.y - c.y) * (local.y - c.y);
     Vec3 sensor;
-    if (m.microlens == MicrolensType::Pinhole || !sensor_hit_through_lens(m, lens, h, ray.dir, &sensor) ||
+    if (m.array.microlens == MicrolensType::Pinhole || !sensor_hit_through_lens(m, lens, h, ray.dir, &sensor) ||
         !delivered_point(m, lens, Vec2{sensor.x, sensor.y}))
         return out;
     out.kind = Ray::Delivered;
@@ -239,7 +239,7 @@ TracedProjectionOptions default_traced_projection_options()
     return options;
 }
 
-std::vector<PixelHit> forward_project_traced(const Model& m, Vec3 point,
+std::vector<PixelHit> forward_project_traced(const PlenopticCamera& m, Vec3 point,
                                              const TracedProjectionOptions& options)
 {
     std::vector<PixelHit> hits;
@@ -276,8 +276,8 @@ std::vector<PixelHit> forward_project_traced(const Model& m, Vec3 point,
     const double x0 = coarse.window.x0 - grow, x1 = coarse.window.x1 + grow;
     const double y0 = coarse.window.y0 - grow, y1 = coarse.window.y1 + grow;
     double lenses_across = 1;
-    if (m.grid != GridType::None && coarse.array.valid)
-        lenses_across += std::max(coarse.array.x1 - coarse.array.x0, coarse.array.y1 - coarse.array.y0) / m.pitch_mm;
+    if (m.array.grid != GridType::None && coarse.array.valid)
+        lenses_across += std::max(coarse.array.x1 - coarse.array.x0, coarse.array.y1 - coarse.array.y0) / m.array.pitch_mm;
     const double wanted = std::ceil(options.cells_per_pitch * lenses_across);
     const int n = int(std::min<double>(options.max_grid, std::max<double>(options.min_grid, wanted)));
     const double step_x = (x1 - x0) / n, step_y = (y1 - y0) / n;
@@ -300,7 +300,7 @@ std::vector<PixelHit> forward_project_traced(const Model& m, Vec3 point,
         node_row(j + 1, &above);
         for (int i = 0; i < n; ++i) {
             const Ray* corner[4] = {&below[i], &below[i + 1], &above[i], &above[i + 1]};
-            if (m.microlens == MicrolensType::Pinhole && m.grid != GridType::None) {
+            if (m.array.microlens == MicrolensType::Pinhole && m.array.grid != GridType::None) {
                 light.nearest(*corner[0]);  // pinholes need only the ray nearest each lens centre
                 continue;
             }
@@ -318,7 +318,7 @@ std::vector<PixelHit> forward_project_traced(const Model& m, Vec3 point,
                                      y0 + (j + (b + 0.5) / sub) * step_y),
                               1.0 / (sub * sub));
         }
-        if (m.microlens == MicrolensType::Pinhole && m.grid != GridType::None)
+        if (m.array.microlens == MicrolensType::Pinhole && m.array.grid != GridType::None)
             for (int i = 0; i < n; ++i)
                 light.nearest(above[i]);
         below.swap(above);
@@ -327,7 +327,7 @@ std::vector<PixelHit> forward_project_traced(const Model& m, Vec3 point,
     if (!(total > 0))
         return hits;
 
-    if (m.grid == GridType::None) {
+    if (m.array.grid == GridType::None) {
         const LensLight& spot = light.lenses[RowKey(0, 0)];
         if (!(spot.weight > 0))
             return hits;
@@ -339,7 +339,7 @@ std::vector<PixelHit> forward_project_traced(const Model& m, Vec3 point,
     for (const auto& entry : light.lenses) {
         const LensIndex lens{entry.first.second, entry.first.first};
         const LensLight& acc = entry.second;
-        if (m.microlens == MicrolensType::Pinhole) {
+        if (m.array.microlens == MicrolensType::Pinhole) {
             double wx = acc.wx, wy = acc.wy;
             if (!ray_through_centre(m, point, window.z, lens, std::max(step_x, step_y), &wx, &wy))
                 continue;

@@ -7,7 +7,7 @@
 
 #include <vector>
 
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 #include "plenoptic/projection/projection.h"
 
 namespace plenoptic {
@@ -41,7 +41,7 @@ TracedProjectionOptions default_traced_projection_options();
 //   when it lies in the picture; fraction 1.
 // Points not in front of the front window by more than twice its sag image nowhere. Needs a main
 // lens with an aperture (thin lens or prescription); deterministic (no threads, no randomness).
-std::vector<PixelHit> forward_project_traced(const Model& model, Vec3 point,
+std::vector<PixelHit> forward_project_traced(const PlenopticCamera& model, Vec3 point,
                                              const TracedProjectionOptions& options);
 
 } // namespace plenoptic

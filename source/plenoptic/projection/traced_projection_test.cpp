@@ -98,21 +98,21 @@ TEST(TracedProjection, ThroughAThinLensAgreesWithTheClosedForm)
                                 {10, 6, 700}, {-2, -9, 5000}, {0.13, 0.29, 1150},
                                 {0.3, -0.2, 400}, {-0.5, 0.3, 600}, {0.05, 0.02, 250}};
     for (const Case& c : thin_lens_cases()) {
-        const Model m = make_model(c.params);
+        const PlenopticCamera m = make_camera(c.params);
         ASSERT_EQ(test::lens_kind(m), "thin_lens");
-        const bool pinholes = m.microlens == MicrolensType::Pinhole && m.grid != GridType::None;
+        const bool pinholes = m.array.microlens == MicrolensType::Pinhole && m.array.grid != GridType::None;
         size_t images = 0;
         double worst_px = 0, worst_fraction = 0;
         for (const auto& p : points) {
             if (pinholes && p[0] == 0 && p[1] == 0 && p[2] == 1300)
                 continue;  // focused on a pinhole: every ray passes it (no single ray to find)
-            const std::vector<PixelHit> closed = forward_project(with_film(m, c.W, c.H), p);
+            const std::vector<PixelHit> closed = with_film(m, c.W, c.H).project(Vec3{p[0], p[1], p[2]});
             const std::vector<PixelHit> traced = forward_project_traced(with_film(m, c.W, c.H), Vec3{p[0], p[1], p[2]}, options);
             images += closed.size();
             // Pinholes: single rays, found by Newton's method to a tiny fraction of a pixel. No
             // array: the spot's centroid (weighted by solid angle) against the chief ray, within a
             // few thousandths. Thin microlenses: centroids of sampled light, a few hundredths.
-            const bool bare = m.grid == GridType::None;
+            const bool bare = m.array.grid == GridType::None;
             const Difference d = compare(closed, traced, pinholes || bare ? 0.0 : 0.02);
             const std::string where = c.name + " point (" + std::to_string(p[0]) + ", " + std::to_string(p[1]) +
                                       ", " + std::to_string(p[2]) + ")";
@@ -160,13 +160,13 @@ TEST(TracedProjection, AWeakSingletImagesWhereTheThinLensDoes)
     for (CameraParams* c : {&real, &thin}) {
         c->sensor.pixel_size_mm[0] = c->sensor.pixel_size_mm[1] = 0.01;
     }
-    const Model mr = with_film(make_model(real), 301, 201), mt = with_film(make_model(thin), 301, 201);
+    const PlenopticCamera mr = with_film(make_camera(real), 301, 201), mt = with_film(make_camera(thin), 301, 201);
     ASSERT_EQ(test::lens_kind(mr), "prescription");
     const double points[][3] = {{0, 0, 30000}, {5, -3, 25000}, {-20, 12, 50000}, {1, 0.5, 4000}};
     for (const auto& q : points) {
-        const std::vector<PixelHit> a = forward_project(mt, q);
-        const double in_real[3] = {q[0], q[1], q[2] + front_h};
-        const std::vector<PixelHit> b = forward_project(mr, in_real);
+        const std::vector<PixelHit> a = mt.project(Vec3{q[0], q[1], q[2]});
+        const Vec3 in_real{q[0], q[1], q[2] + front_h};
+        const std::vector<PixelHit> b = mr.project(in_real);
         ASSERT_FALSE(a.empty());
         const Difference d = compare(a, b, 0.05);
         EXPECT_EQ(d.unmatched, 0) << "point z " << q[2];
@@ -177,7 +177,7 @@ TEST(TracedProjection, AWeakSingletImagesWhereTheThinLensDoes)
 
 TEST(TracedProjection, RefusesPointsBehindTheFrontWindow)
 {
-    const Model m = with_film(make_model(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52)), 301, 201);
+    const PlenopticCamera m = with_film(make_camera(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52)), 301, 201);
     const TracedProjectionOptions options = default_traced_projection_options();
     EXPECT_TRUE(forward_project_traced(m, Vec3{0, 0, -10}, options).empty());
     EXPECT_TRUE(forward_project_traced(m, Vec3{0, 0, 0}, options).empty());

@@ -42,43 +42,43 @@ std::string check_diffraction(const DiffractionParams& diffraction, const Camera
     return "";
 }
 
-Diffraction diffraction_of(const Model& m, const DiffractionParams& params)
+Diffraction diffraction_of(const PlenopticCamera& m, const DiffractionParams& params)
 {
     Diffraction out;
     if (!params.given)
         return out;
-    if (m.grid != GridType::None) {
-        if (m.microlens != MicrolensType::ThinLens)
+    if (m.array.grid != GridType::None) {
+        if (m.array.microlens != MicrolensType::ThinLens)
             return out;
         out.aperture = "microlens";
-        out.aperture_diameter_mm = 2 * m.cell_inradius_mm;
+        out.aperture_diameter_mm = 2 * m.array.cell_inradius_mm;
         out.distance_mm = effective_array_distance_mm(m);
     } else {
         if (!m.lens || !(m.lens->exit_pupil_radius() > 0))
             return out;
         out.aperture = "main_lens";
         out.aperture_diameter_mm = 2 * m.lens->exit_pupil_radius();
-        out.distance_mm = m.lens->exit_pupil_centre().z - m.sensor_z_mm;
+        out.distance_mm = m.lens->exit_pupil_centre().z - m.sensor.z_mm;
     }
     out.applied = true;
     for (int c = 0; c < 3; ++c) {
         const double lambda_mm = params.wavelengths_nm[c] * 1e-6;
         out.airy_radius_mm[c] = 1.22 * lambda_mm * out.distance_mm / out.aperture_diameter_mm;
-        if (m.grid != GridType::None && m.lens && m.lens->exit_pupil_radius() > 0)
+        if (m.array.grid != GridType::None && m.lens && m.lens->exit_pupil_radius() > 0)
             out.main_lens_airy_radius_at_array_mm[c] =
                 1.22 * lambda_mm * effective_main_distance_mm(m) / (2 * m.lens->exit_pupil_radius());
     }
     return out;
 }
 
-std::string check_diffraction_size(const Model& m, const DiffractionParams& params)
+std::string check_diffraction_size(const PlenopticCamera& m, const DiffractionParams& params)
 {
     const Diffraction d = diffraction_of(m, params);
     if (!d.applied)
         return "";
     double largest = 0;
     for (int c = 0; c < 3; ++c)
-        largest = std::max(largest, d.airy_radius_mm[c] / std::min(m.pixel_size_mm[0], m.pixel_size_mm[1]));
+        largest = std::max(largest, d.airy_radius_mm[c] / std::min(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]));
     if (largest <= kMaxAiryRadiusPx)
         return "";
     return "diffraction would spread light over an Airy radius of " + format_number(largest) + " pixels (1.22 x " +
@@ -133,11 +133,11 @@ AiryKernel airy_kernel(double rx, double ry)
     return k;
 }
 
-std::vector<AiryKernel> channel_kernels(const Model& m, const Diffraction& d)
+std::vector<AiryKernel> channel_kernels(const PlenopticCamera& m, const Diffraction& d)
 {
     std::vector<AiryKernel> kernels;
     for (int c = 0; c < 3; ++c)
-        kernels.push_back(airy_kernel(d.airy_radius_mm[c] / m.pixel_size_mm[0], d.airy_radius_mm[c] / m.pixel_size_mm[1]));
+        kernels.push_back(airy_kernel(d.airy_radius_mm[c] / m.sensor.pixel_size_mm[0], d.airy_radius_mm[c] / m.sensor.pixel_size_mm[1]));
     return kernels;
 }
 

@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 
 namespace plenoptic {
 
@@ -38,7 +38,7 @@ const double kMaxAiryRadiusPx = 16;
 
 // "" when the model's Airy pattern (diffraction_of) fits kMaxAiryRadiusPx in every channel, else
 // the message (the radius, and what to change).
-std::string check_diffraction_size(const Model& model, const DiffractionParams& params);
+std::string check_diffraction_size(const PlenopticCamera& model, const DiffractionParams& params);
 
 // What the picture is convolved with.
 struct Diffraction {
@@ -51,7 +51,7 @@ struct Diffraction {
     double main_lens_airy_radius_at_array_mm[3] = {0, 0, 0};
 };
 
-Diffraction diffraction_of(const Model& model, const DiffractionParams& params);
+Diffraction diffraction_of(const PlenopticCamera& model, const DiffractionParams& params);
 
 // The Airy pattern (2 J1(x) / x)^2 with its first zero at `radius` (any unit), at distance r.
 double airy_intensity(double r, double radius);
@@ -75,7 +75,7 @@ bool convolve_channels(std::vector<float>& picture, int W, int H, int channels, 
                        const std::function<bool()>& cancelled, int threads = 0);
 
 // The kernels of the model's three channels for its pixel size.
-std::vector<AiryKernel> channel_kernels(const Model& model, const Diffraction& diffraction);
+std::vector<AiryKernel> channel_kernels(const PlenopticCamera& model, const Diffraction& diffraction);
 
 } // namespace plenoptic
 

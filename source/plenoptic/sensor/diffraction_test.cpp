@@ -87,7 +87,7 @@ TEST(Diffraction, LytroClassMicrolensesSpreadLightByAboutAPixel)
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.0014;
     p.diffraction.given = true;
     ASSERT_EQ(check_diffraction(p.diffraction, p), "");
-    const Model m = make_model(p);
+    const PlenopticCamera m = make_camera(p);
     const Diffraction d = diffraction_of(m, p.diffraction);
     ASSERT_TRUE(d.applied);
     EXPECT_STREQ(d.aperture, "microlens");
@@ -102,7 +102,7 @@ TEST(Diffraction, WithoutAnArrayTheExitPupilDiffracts)
     CameraParams p = test::thin_lens_camera(50, 8, 52);
     p.diffraction.given = true;
     p.diffraction.wavelengths_nm[1] = 500;
-    const Diffraction d = diffraction_of(make_model(p), p.diffraction);
+    const Diffraction d = diffraction_of(make_camera(p), p.diffraction);
     EXPECT_STREQ(d.aperture, "main_lens");
     EXPECT_NEAR(d.airy_radius_mm[1], 1.22 * 500e-6 * 52 / (50.0 / 8), 1e-12);
 }
@@ -129,13 +129,13 @@ TEST(Diffraction, RefusesAnAiryPatternWiderThanSixteenPixels)
     CameraParams p = test::thin_lens_camera(50, 8, 52);
     p.diffraction.given = true;
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.0005;
-    EXPECT_EQ(check_diffraction_size(make_model(p), p.diffraction), "");
+    EXPECT_EQ(check_diffraction_size(make_camera(p), p.diffraction), "");
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.0003;
-    const std::string message = check_diffraction_size(make_model(p), p.diffraction);
+    const std::string message = check_diffraction_size(make_camera(p), p.diffraction);
     EXPECT_NE(message.find("Airy radius of 20.6"), std::string::npos) << message;
     EXPECT_NE(message.find("more than 16"), std::string::npos) << message;
     p.diffraction.given = false;
-    EXPECT_EQ(check_diffraction_size(make_model(p), p.diffraction), "");
+    EXPECT_EQ(check_diffraction_size(make_camera(p), p.diffraction), "");
 }
 
 TEST(Diffraction, ConvolutionSpreadsAPointIntoTheKernelAndKeepsAFlatField)

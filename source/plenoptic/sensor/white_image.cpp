@@ -53,9 +53,9 @@ std::string repeated_white_f_number(const WhiteImageRequest& request)
     return "";
 }
 
-std::vector<float> white_image(const Model& model, const std::function<bool()>& cancelled, int threads)
+std::vector<float> white_image(const PlenopticCamera& model, const std::function<bool()>& cancelled, int threads)
 {
-    const int W = model.film.width, H = model.film.height;
+    const int W = model.sensor.film.width, H = model.sensor.film.height;
     std::vector<float> out(size_t(std::max(0, W)) * std::max(0, H), 0.0f);
     std::atomic<int> next_row(0);
     std::atomic<bool> stop(false);

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 
 namespace plenoptic {
 
@@ -41,7 +41,7 @@ std::string repeated_white_f_number(const WhiteImageRequest& request);
 // The W x H white image of `model`, rows from the top (pixel (i, j) at j W + i): each pixel's value
 // in a world of radiance 1. Rows are shared among `threads` threads (0: every hardware thread); the
 // result does not depend on their number. Returns an empty vector when `cancelled` says so.
-std::vector<float> white_image(const Model& model, const std::function<bool()>& cancelled, int threads = 0);
+std::vector<float> white_image(const PlenopticCamera& model, const std::function<bool()>& cancelled, int threads = 0);
 
 // What replaces the image's extension for f-number index k of a request: ".white.png" for the
 // camera's own aperture, ".white.f<N>.png" for f_numbers (N shortest: f2, f5.6).

@@ -6,7 +6,7 @@
 #define PLENOPTIC_BLUR_H
 
 #include "plenoptic/core/lattice.h"
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 
 namespace plenoptic {
 
@@ -24,7 +24,7 @@ namespace plenoptic {
 // Without an array: the main lens's own blur, exit-pupil radius x (s / b - 1) (s, b: sensor and
 // image distances from the exit pupil), with the same sign rule. 0 where each image is a single
 // ray (pinhole microlenses, a pinhole main lens); NaN where the point forms no image.
-double blur_radius_px(const Model& model, const double point_mm[3], LensIndex lens);
+double blur_radius_px(const PlenopticCamera& model, Vec3 point_mm, LensIndex lens);
 
 } // namespace plenoptic
 

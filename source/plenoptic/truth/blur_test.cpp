@@ -40,14 +40,14 @@ TEST(Blur, FocusedLensesAgainstTracedRays)
     for (double d : {0.75, 0.35}) {
         CameraParams p = plenoptic_camera(GridType::Rectangular, PITCH, 0.5, d, F, 2, D);
         p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = PIXEL;
-        const Model m = make_model(p);
+        const PlenopticCamera m = make_camera(p);
         for (double z : {700.0, 1000.0, 1200.0, 1500.0, 2500.0, 1e5})  // not 1300: b = D
             for (int k : {0, 3, -2}) {
                 const LensIndex lens{k, 1};
                 const Vec3 c = lens_centre_mm(m, lens);
-                const double point[3] = {c.x * -z / D, 0, z};  // on the line through the lens centre
+                const Vec3 point{c.x * -z / D, 0, z};  // on the line through the lens centre
                 const double b = F * z / (z - F);
-                const double xi = -point[0] * b / z;
+                const double xi = -point.x * b / z;
                 const double expected = traced_radius(xi, -b, c.x, 0.5, d) / PIXEL;
                 EXPECT_NEAR(blur_radius_px(m, point, lens), expected, 1e-6 * std::fabs(expected) + 1e-9)
                     << "d " << d << " z " << z << " k " << k;
@@ -65,8 +65,8 @@ TEST(Blur, MultiFocusTypesAndInfinity)
     p.array.focal_lengths_mm[1] = 0.6;
     p.array.focal_lengths_mm[2] = 0.8;
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = PIXEL;
-    const Model m = make_model(p);
-    const double point[3] = {10, -5, 2000};
+    const PlenopticCamera m = make_camera(p);
+    const Vec3 point{10, -5, 2000};
     const double b = F * 2000 / (2000 - F);
     for (int k = 0; k < 6; ++k) {
         const LensIndex lens{k, 2};
@@ -74,7 +74,7 @@ TEST(Blur, MultiFocusTypesAndInfinity)
         EXPECT_NEAR(blur_radius_px(m, point, lens), 0.5 * PITCH * 0.7 * (1 / f - 1 / (D - b) - 1 / 0.7) / PIXEL, 1e-9);
     }
     // On the front focal plane the main lens images the point at infinity: 1/a = 0.
-    const double focal[3] = {1, 1, F};
+    const Vec3 focal{1, 1, F};
     EXPECT_NEAR(blur_radius_px(m, focal, LensIndex{0, 0}), 0.5 * PITCH * 0.7 * (1 / 0.5 - 1 / 0.7) / PIXEL, 1e-6);
 }
 
@@ -83,17 +83,17 @@ TEST(Blur, WithoutArrayAndPinholes)
     // The thin lens alone: aperture radius A/2 = F / N / 2, sensor at D: (A/2)(D / b - 1).
     CameraParams lens_only = test::thin_lens_camera(F, 2, D);
     lens_only.sensor.pixel_size_mm[0] = lens_only.sensor.pixel_size_mm[1] = PIXEL;
-    const Model m = make_model(lens_only);
+    const PlenopticCamera m = make_camera(lens_only);
     for (double z : {600.0, 1300.0, 4000.0}) {
-        const double point[3] = {30, 20, z};
+        const Vec3 point{30, 20, z};
         const double b = F * z / (z - F);
         EXPECT_NEAR(blur_radius_px(m, point, LensIndex{0, 0}), 0.5 * F / 2 * (D / b - 1) / PIXEL, 1e-6) << z;
     }
     CameraParams pinholes = plenoptic_camera(GridType::Hexagonal, PITCH, 0.5, 0.7, F, 2, D);
     pinholes.array.lens = MicrolensType::Pinhole;
     pinholes.array.focal_length_count = 0;
-    const double point[3] = {0, 0, 900};
-    EXPECT_EQ(blur_radius_px(make_model(pinholes), point, LensIndex{0, 0}), 0);
+    const Vec3 point{0, 0, 900};
+    EXPECT_EQ(blur_radius_px(make_camera(pinholes), point, LensIndex{0, 0}), 0);
 }
 
 }  // namespace

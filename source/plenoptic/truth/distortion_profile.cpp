@@ -25,19 +25,19 @@ struct Conjugates {
 // and, for the secant, the group in front of the stop (no clear apertures) and the stop's z.
 class StopAim {
 public:
-    explicit StopAim(const Model& m) : m_(m), stop_index_(-1), stop_lens_z_(0)
+    explicit StopAim(const PlenopticCamera& m) : m_(m), stop_index_(-1), stop_lens_z_(0)
     {
         if (!m.lens || !m.lens->traced())
             return;
-        const std::vector<double> z = vertex_positions(m.prescription);
-        for (std::size_t i = 0; i < m.prescription.surfaces.size(); ++i) {
-            if (!m.prescription.surfaces[i].stop)
+        const std::vector<double> z = vertex_positions(m.prescription());
+        for (std::size_t i = 0; i < m.prescription().surfaces.size(); ++i) {
+            if (!m.prescription().surfaces[i].stop)
                 continue;
             stop_index_ = int(i);
             stop_lens_z_ = z[i];
         }
         for (int i = 0; i < stop_index_; ++i) {
-            LensSurface surface = m.prescription.surfaces[std::size_t(i)];
+            LensSurface surface = m.prescription().surfaces[std::size_t(i)];
             surface.aperture_mm = INFINITY;
             front_.surfaces.push_back(surface);
         }
@@ -46,7 +46,7 @@ public:
     // Height (along y) at which the ray crosses the stop's plane; NaN when it cannot.
     double stop_height(Vec3 origin, Vec3 direction) const
     {
-        const double length = m_.lens_length_mm;
+        const double length = m_.lens_length_mm();
         LensRay ray{Vec3{origin.x, origin.y, length - origin.z}, normalized(Vec3{direction.x, direction.y, -direction.z})};
         if (!front_.surfaces.empty()) {
             const Traced out = trace_from_object(front_, ray);
@@ -63,7 +63,7 @@ public:
     bool traced() const { return stop_index_ >= 0; }
 
 private:
-    const Model& m_;
+    const PlenopticCamera& m_;
     int stop_index_;
     double stop_lens_z_;
     Prescription front_;
@@ -87,28 +87,28 @@ ChiefRay ray_for(bool at_infinity, Vec3 object_or_direction, double pupil_z, dou
 
 } // namespace
 
-DistortionProfile distortion_profile(const Model& m, int count)
+DistortionProfile distortion_profile(const PlenopticCamera& m, int count)
 {
-    const int W = m.film.width, H = m.film.height;
+    const int W = m.sensor.film.width, H = m.sensor.film.height;
     DistortionProfile out = DistortionProfile();
     out.valid = false;
     if (!m.lens || !m.lens->forms_image() || count < 2 || W <= 0 || H <= 0)
         return out;
     // An ideal thin lens has no paraxial data of its own: its focal points are at +-F.
     const bool thin = !m.lens->paraxial();
-    if (!thin && !m.paraxial.valid)
+    if (!thin && !m.paraxial().valid)
         return out;
 
     Conjugates c;
     double pupil_z, start_z;  // the plane aimed at; a plane in front of the lens
     if (thin) {
-        c = Conjugates{m.focal_length_mm, m.focal_length_mm, -m.focal_length_mm};
+        c = Conjugates{m.focal_length_mm(), m.focal_length_mm(), -m.focal_length_mm()};
         pupil_z = 0;
         start_z = 1;
     } else {
-        const double L = m.lens_length_mm;
-        c = Conjugates{m.paraxial.efl_mm, L - m.paraxial.front_focal_z, L - m.paraxial.rear_focal_z};
-        pupil_z = L - m.paraxial.entrance_pupil_z;
+        const double L = m.lens_length_mm();
+        c = Conjugates{m.paraxial().efl_mm, L - m.paraxial().front_focal_z, L - m.paraxial().rear_focal_z};
+        pupil_z = L - m.paraxial().entrance_pupil_z;
         start_z = std::max(L, pupil_z) + 1;
     }
     out.image_plane_z_mm = -m.distance_mm;

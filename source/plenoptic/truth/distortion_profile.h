@@ -7,7 +7,7 @@
 
 #include <vector>
 
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 
 namespace plenoptic {
 
@@ -37,7 +37,7 @@ struct DistortionProfile {
 // lens's parametric distortion is part of its trace. The samples stop at the first height whose
 // chief ray does not exist (no ray through the stop's centre, or none reaching the image side).
 // A lens that images z = -D from no real object (D inside the focal length) has no profile.
-DistortionProfile distortion_profile(const Model& model, int count);
+DistortionProfile distortion_profile(const PlenopticCamera& model, int count);
 
 } // namespace plenoptic
 

@@ -25,7 +25,7 @@ TEST(DistortionProfile, IdealThinLensHasNone)
 {
     CameraParams p = thin_lens_camera(50, 4, 60);
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.02;
-    const Model m = with_film(make_model(p), 1200, 800);
+    const PlenopticCamera m = with_film(make_camera(p), 1200, 800);
     const DistortionProfile profile = distortion_profile(m, 17);
     ASSERT_TRUE(profile.valid);
     ASSERT_EQ(profile.samples.size(), 17u);
@@ -47,7 +47,7 @@ TEST(DistortionProfile, ThinLensRadialDistortionFollowsThePolynomial)
     p.main.has_distortion = true;
     p.main.distortion = DistortionParams{{-0.12, 0.03, -0.004}, {0, 0}};
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.02;
-    const Model m = with_film(make_model(p), 1200, 800);
+    const PlenopticCamera m = with_film(make_camera(p), 1200, 800);
     const DistortionProfile profile = distortion_profile(m, 9);
     ASSERT_TRUE(profile.valid);
     ASSERT_EQ(profile.samples.size(), 9u);
@@ -73,7 +73,7 @@ Prescription singlet_with_stop(double gap)
     return lens;
 }
 
-Model singlet_camera(double gap, MainLensType type)
+PlenopticCamera singlet_camera(double gap, MainLensType type)
 {
     const Prescription lens = singlet_with_stop(gap);
     CameraParams p = thin_lens_camera(50, 4, 0);
@@ -85,16 +85,16 @@ Model singlet_camera(double gap, MainLensType type)
     const ImageDistance focus = paraxial_image_distance(lens, 2000);
     p.main.distance_mm = focus.mm;
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.02;
-    return make_model(p);
+    return make_camera(p);
 }
 
 TEST(DistortionProfile, StopPositionGivesTheSignOfASinglesDistortion)
 {
     // Stop in front of a positive lens: barrel; behind it: pincushion. The thick-lens model of
     // the same prescription (paraxial) has none.
-    const Model front = with_film(singlet_camera(20, MainLensType::Prescription), 1500, 1000);
-    const Model behind = with_film(singlet_camera(-20, MainLensType::Prescription), 1500, 1000);
-    const Model thick = with_film(singlet_camera(20, MainLensType::ThickLens), 1500, 1000);
+    const PlenopticCamera front = with_film(singlet_camera(20, MainLensType::Prescription), 1500, 1000);
+    const PlenopticCamera behind = with_film(singlet_camera(-20, MainLensType::Prescription), 1500, 1000);
+    const PlenopticCamera thick = with_film(singlet_camera(20, MainLensType::ThickLens), 1500, 1000);
     ASSERT_EQ(test::lens_kind(front), "prescription");
     const DistortionProfile a = distortion_profile(front, 9);
     const DistortionProfile b = distortion_profile(behind, 9);
@@ -117,9 +117,9 @@ TEST(DistortionProfile, StopPositionGivesTheSignOfASinglesDistortion)
 TEST(DistortionProfile, NoneWithoutARealObjectOrALens)
 {
     CameraParams inside = thin_lens_camera(50, 4, 40);  // D < F: no real object images onto z = -D
-    EXPECT_FALSE(distortion_profile(with_film(make_model(inside), 100, 100), 9).valid);
+    EXPECT_FALSE(distortion_profile(with_film(make_camera(inside), 100, 100), 9).valid);
     CameraParams at_focus = thin_lens_camera(50, 4, 50);
-    const DistortionProfile infinity = distortion_profile(with_film(make_model(at_focus), 100, 100), 9);
+    const DistortionProfile infinity = distortion_profile(with_film(make_camera(at_focus), 100, 100), 9);
     ASSERT_TRUE(infinity.valid);
     EXPECT_TRUE(infinity.object_at_infinity);
     for (const DistortionSample& s : infinity.samples)

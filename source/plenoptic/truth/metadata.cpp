@@ -89,10 +89,10 @@ void layout(const Json& value, int depth, bool one_line, std::string* out)
 }
 
 // The surfaces as the render used them (the stop at its working diameter), object side first.
-Json prescription_json(const Model& m)
+Json prescription_json(const PlenopticCamera& m)
 {
     Json surfaces = Json::array();
-    for (const LensSurface& s : m.prescription.surfaces) {
+    for (const LensSurface& s : m.prescription().surfaces) {
         Json row = Json::object();
         row["stop"] = s.stop;
         row["radius_mm"] = number(s.radius_mm);
@@ -102,18 +102,18 @@ Json prescription_json(const Model& m)
         surfaces.push_back(row);
     }
     Json json = Json::object();
-    json["lens_file"] = m.lens_file.empty() ? Json(nullptr) : Json(m.lens_file);
-    json["blades"] = m.prescription.blades;
-    json["blade_rotation_deg"] = number(m.prescription.blade_rotation_deg);
+    json["lens_file"] = m.lens_file().empty() ? Json(nullptr) : Json(m.lens_file());
+    json["blades"] = m.prescription().blades;
+    json["blade_rotation_deg"] = number(m.prescription().blade_rotation_deg);
     json["surfaces"] = surfaces;
     return json;
 }
 
 // First-order data in the optics frame (z from the rear vertex towards the scene, mm).
-Json paraxial_json(const Model& m)
+Json paraxial_json(const PlenopticCamera& m)
 {
-    const ParaxialData& p = m.paraxial;
-    const double length = m.lens_length_mm;
+    const ParaxialData& p = m.paraxial();
+    const double length = m.lens_length_mm();
     const double exit_pupil_z = length - p.exit_pupil_z;
     Json json = Json::object();
     json["effective_focal_length_mm"] = number(p.efl_mm);
@@ -139,7 +139,7 @@ Json paraxial_json(const Model& m)
 
 // The chief ray's image height over the field against the paraxial one (null when the lens has
 // no profile).
-Json distortion_profile_json(const Model& m)
+Json distortion_profile_json(const PlenopticCamera& m)
 {
     const DistortionProfile profile = distortion_profile(m, kDistortionProfileSamples);
     if (!profile.valid)
@@ -159,25 +159,25 @@ Json distortion_profile_json(const Model& m)
     return json;
 }
 
-Json main_lens(const Model& m)
+Json main_lens(const PlenopticCamera& m)
 {
     const bool has_focal = m.lens && m.lens->forms_image();
     Json json = Json::object();
     json["type"] = m.lens ? m.lens->kind_name() : "none";
-    json["focal_length_mm"] = number_or_null(has_focal, m.focal_length_mm);
-    json["aperture_mm"] = number_or_null(has_focal, m.aperture_mm);
-    json["f_number"] = number_or_null(has_focal, m.f_number);
+    json["focal_length_mm"] = number_or_null(has_focal, m.focal_length_mm());
+    json["aperture_mm"] = number_or_null(has_focal, m.aperture_mm());
+    json["f_number"] = number_or_null(has_focal, m.f_number());
     json["distance_mm"] = number_or_null(bool(m.lens), m.distance_mm);
     json["focus_distance"] = number_or_null(m.has_focus_distance, m.focus_distance_units);
     if (m.lens && m.lens->prescription()) {
         json["prescription"] = prescription_json(m);
         json["paraxial"] = paraxial_json(m);
     }
-    if (m.has_distortion) {
+    if (const DistortionParams* given = m.distortion()) {
         // Radial-tangential polynomial on the plane z = -D, coordinates (x, y) / D.
         Json distortion = Json::object();
-        distortion["radial"] = numbers(m.distortion.radial, 3);
-        distortion["tangential"] = numbers(m.distortion.tangential, 2);
+        distortion["radial"] = numbers(given->radial, 3);
+        distortion["tangential"] = numbers(given->tangential, 2);
         distortion["plane_z_mm"] = number(-m.distance_mm);
         json["distortion"] = distortion;
     }
@@ -185,27 +185,27 @@ Json main_lens(const Model& m)
     return json;
 }
 
-Json microlens_array(const Model& m, const CameraParams& params)
+Json microlens_array(const PlenopticCamera& m, const CameraParams& params)
 {
-    if (m.grid == GridType::None)
+    if (m.array.grid == GridType::None)
         return nullptr;
     Json json = Json::object();
-    json["grid"] = m.grid == GridType::Hexagonal ? "hexagonal" : "rectangular";
-    json["lens"] = m.microlens == MicrolensType::ThinLens ? "thin_lens" : "pinhole";
-    json["pitch_mm"] = number(m.pitch_mm);
+    json["grid"] = m.array.grid == GridType::Hexagonal ? "hexagonal" : "rectangular";
+    json["lens"] = m.array.microlens == MicrolensType::ThinLens ? "thin_lens" : "pinhole";
+    json["pitch_mm"] = number(m.array.pitch_mm);
     json["focal_lengths_mm"] =
-        numbers(m.microlens_focal_mm, m.microlens == MicrolensType::ThinLens ? m.lens_type_count : 0);
-    json["distance_mm"] = number(m.array_distance_mm);
+        numbers(m.array.focal_mm, m.array.microlens == MicrolensType::ThinLens ? m.array.lens_type_count : 0);
+    json["distance_mm"] = number(m.array.distance_mm);
     json["rotate_deg"] = numbers(params.array.rotate_deg, 3);
     json["translate_mm"] = numbers(params.array.translate_mm, 3);
     return json;
 }
 
-Json lattice_json(const Model& m, const MicroimageLattice& lattice)
+Json lattice_json(const PlenopticCamera& m, const MicroimageLattice& lattice)
 {
     if (!lattice.valid)
         return nullptr;
-    const bool hexagonal = m.grid == GridType::Hexagonal;
+    const bool hexagonal = m.array.grid == GridType::Hexagonal;
     Json json = Json::object();
     json["origin_px"] = numbers(lattice.origin_px, 2);
     json["basis_px"] = Json::array({numbers(lattice.basis_a_px, 2), numbers(lattice.basis_b_px, 2)});
@@ -213,14 +213,14 @@ Json lattice_json(const Model& m, const MicroimageLattice& lattice)
                              ? "skew indices (k, l): hexagonal centres in the array are k*(p,0) + l*(p/2, p*sqrt(3)/2)"
                              : "skew indices (k, l): rectangular centres in the array are k*(p,0) + l*(0,p)";
     json["exact"] = lattice.exact;
-    const int types = m.microlens == MicrolensType::ThinLens ? m.lens_type_count : 1;
+    const int types = m.array.microlens == MicrolensType::ThinLens ? m.array.lens_type_count : 1;
     json["lens_types"] = types;
     json["lens_type_rule"] = types == 3 ? "type(k, l) = (k - l) mod 3, focal_lengths_mm[type]" : "type(k, l) = 0";
     // Diameter of the main lens's exit pupil imaged through a lens centre (the f-number-matched disc).
     const bool has_pupil = m.lens && m.lens->forms_image();
     const double pupil_mm = has_pupil ? 2 * m.lens->exit_pupil_radius() : 0;  // a thin lens's: A (2 * A/2, exact)
     json["microimage_diameter_px"] =
-        number_or_null(has_pupil, pupil_mm * effective_array_distance_mm(m) / effective_main_distance_mm(m) / m.pixel_size_mm[0]);
+        number_or_null(has_pupil, pupil_mm * effective_array_distance_mm(m) / effective_main_distance_mm(m) / m.sensor.pixel_size_mm[0]);
     return json;
 }
 
@@ -278,7 +278,7 @@ Json microimages_json(const MicroimageSummary* summary)
 
 // sensor.read_out: the chain from the noise-free picture to the raw (sensor/sensor_chain.h),
 // every parameter as used, or null without one.
-Json diffraction_json(const Diffraction& d, const DiffractionParams& params, const Model& m)
+Json diffraction_json(const Diffraction& d, const DiffractionParams& params, const PlenopticCamera& m)
 {
     if (!d.applied)
         return Json(nullptr);
@@ -291,7 +291,7 @@ Json diffraction_json(const Diffraction& d, const DiffractionParams& params, con
     double radius_um[3], radius_px[3], main_um[3];
     for (int c = 0; c < 3; ++c) {
         radius_um[c] = d.airy_radius_mm[c] * 1000;
-        radius_px[c] = d.airy_radius_mm[c] / m.pixel_size_mm[0];  // in pixel widths
+        radius_px[c] = d.airy_radius_mm[c] / m.sensor.pixel_size_mm[0];  // in pixel widths
         main_um[c] = d.main_lens_airy_radius_at_array_mm[c] * 1000;
     }
     json["airy_radius_um"] = numbers(radius_um, 3);
@@ -329,10 +329,10 @@ Json read_out_json(const SensorChainParams& c, const std::string& raw_file)
 
 } // namespace
 
-std::string metadata_json(const Model& m, const CameraParams& params, const CameraFrame& frame,
+std::string metadata_json(const PlenopticCamera& m, const CameraParams& params, const CameraFrame& frame,
                           const SidecarFiles& files)
 {
-    const int W = m.film.width, H = m.film.height;
+    const int W = m.sensor.film.width, H = m.sensor.film.height;
     Json json = Json::object();
     json["format"] = "povray-plenoptic-metadata";
     json["version"] = 1;
@@ -352,24 +352,24 @@ std::string metadata_json(const Model& m, const CameraParams& params, const Came
     json["microlens_array"] = microlens_array(m, params);
 
     Json sensor = Json::object();
-    sensor["pixel_size_mm"] = numbers(m.pixel_size_mm, 2);
-    sensor["offset_mm"] = numbers(m.sensor_offset_mm, 2);
-    sensor["plane_z_mm"] = number(m.sensor_z_mm);
+    sensor["pixel_size_mm"] = numbers(m.sensor.pixel_size_mm, 2);
+    sensor["offset_mm"] = numbers(m.sensor.offset_mm, 2);
+    sensor["plane_z_mm"] = number(m.sensor.z_mm);
     Json radiometry = Json::object();
-    radiometry["model"] = radiometry_name(m.radiometry);
+    radiometry["model"] = radiometry_name(m.sensor.radiometry);
     const double solid_angle = reference_projected_solid_angle_sr(m);
     radiometry["projected_solid_angle_sr"] = number_or_null(solid_angle > 0, solid_angle);
-    radiometry["angular_response"] = number(m.angular_exponent);
+    radiometry["angular_response"] = number(m.sensor.angular_exponent);
     sensor["radiometry"] = radiometry;
     sensor["read_out"] = read_out_json(params.sensor.chain, files.raw);
     json["sensor"] = sensor;
 
     Json samples = Json::object();
-    samples["adaptive"] = m.adaptive;
-    samples["min"] = m.samples_min;
-    samples["max"] = m.samples_max;
-    samples["confidence"] = number(m.confidence);
-    samples["variance"] = number(m.variance);
+    samples["adaptive"] = m.sampling.adaptive;
+    samples["min"] = m.sampling.samples_min;
+    samples["max"] = m.sampling.samples_max;
+    samples["confidence"] = number(m.sampling.confidence);
+    samples["variance"] = number(m.sampling.variance);
     json["samples"] = samples;
     json["diffraction"] = diffraction_json(diffraction_of(m, params.diffraction), params.diffraction, m);
 

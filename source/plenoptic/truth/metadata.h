@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "plenoptic/truth/microimages.h"
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 
 namespace plenoptic {
 
@@ -50,7 +50,7 @@ struct SidecarFiles {
     SidecarFiles(const char* depth_map_file) : depth_map(depth_map_file) {}
 };
 
-std::string metadata_json(const Model& model, const CameraParams& params,
+std::string metadata_json(const PlenopticCamera& model, const CameraParams& params,
                           const CameraFrame& frame, const SidecarFiles& files = SidecarFiles());
 
 } // namespace plenoptic

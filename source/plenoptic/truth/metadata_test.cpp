@@ -117,7 +117,7 @@ TEST(Metadata, PlenopticCameraWritesEveryField)
 {
     const CameraParams p = documented_camera();
     ASSERT_EQ(check_camera(p), "");
-    const Model m = with_film(make_model(p), 640, 480);
+    const PlenopticCamera m = with_film(make_camera(p), 640, 480);
     const std::string json = metadata_json(m, p, kFrame, "scene.depth.exr");
     parsed(json);
     const char* keys[] = {"\"format\": \"povray-plenoptic-metadata\"", "\"version\": 1", "\"image\"", "\"width\": 640",
@@ -148,7 +148,7 @@ TEST(Metadata, KeysComeInTheDocumentedOrder)
 {
     // docs/metadata.md is the contract: these names, in this order, at every level.
     const CameraParams p = documented_camera();
-    const Json doc = parsed(metadata_json(with_film(make_model(p), 640, 480), p, kFrame, "scene.depth.exr"));
+    const Json doc = parsed(metadata_json(with_film(make_camera(p), 640, 480), p, kFrame, "scene.depth.exr"));
     auto keys = [](const Json& object) {
         std::vector<std::string> names;
         for (auto it = object.begin(); it != object.end(); ++it)
@@ -189,7 +189,7 @@ TEST(Metadata, NumbersAreWrittenInTheirShortestRoundTripForm)
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.01;
     test::set_pose(&p, 0, 0, 0.3, 0.01, 0, 0);
     ASSERT_EQ(check_camera(p), "");
-    const Model m = with_film(make_model(p), 640, 480);
+    const PlenopticCamera m = with_film(make_camera(p), 640, 480);
     const std::string json = metadata_json(m, p, kFrame, "");
     parsed(json);
     EXPECT_TRUE(has(json, "\"pitch_mm\": 0.15,")) << json;
@@ -213,9 +213,9 @@ TEST(Metadata, ExtremeNumbersReadBackExactly)
     CameraParams p = plenoptic_camera(GridType::Rectangular, 0.1, 2.0, 2.0, 50, 4, 52);
     p.mm_per_unit = 1e-300;
     test::set_pose(&p, 4503599627370495.5, 0, 1e-9, 1.0 / 3, -5e-324, 0);  // below 2^52, not whole
-    Model m = make_model(p);
-    m.sensor_offset_mm[0] = 1e300;  // not from checked input; the writer must still be exact
-    m.sensor_offset_mm[1] = 9007199254740994.0;  // whole, above 2^53
+    PlenopticCamera m = make_camera(p);
+    m.sensor.offset_mm[0] = 1e300;  // not from checked input; the writer must still be exact
+    m.sensor.offset_mm[1] = 9007199254740994.0;  // whole, above 2^53
     const Json doc = parsed(metadata_json(with_film(m, 64, 48), p, kFrame, ""));
     EXPECT_EQ(doc["mm_per_unit"].get<double>(), 1e-300);
     EXPECT_EQ(doc["microlens_array"]["rotate_deg"][2].get<double>(), 1e-9);
@@ -229,7 +229,7 @@ TEST(Metadata, ExtremeNumbersReadBackExactly)
 TEST(Metadata, SensorReadOut)
 {
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.1, 0.4, 0.4, 50, 4, 52);
-    const Model m = with_film(make_model(p), 64, 48);
+    const PlenopticCamera m = with_film(make_camera(p), 64, 48);
     EXPECT_TRUE(parsed(metadata_json(m, p, kFrame, ""))["sensor"]["read_out"].is_null());
     SensorChainParams& c = p.sensor.chain;
     c.given = true;
@@ -258,7 +258,7 @@ TEST(Metadata, SensorReadOut)
 TEST(Metadata, StringsAreEscapedAndValidUtf8)
 {
     CameraParams p = plenoptic_camera(GridType::Rectangular, 0.1, 2.0, 2.0, 50, 4, 52);
-    const Model m = with_film(make_model(p), 64, 48);
+    const PlenopticCamera m = with_film(make_camera(p), 64, 48);
     std::string json = metadata_json(m, p, kFrame, "dir\\name \"quoted\"\t\xc3\xa9.exr");
     EXPECT_EQ(parsed(json)["depth_map"].get<std::string>(), "dir\\name \"quoted\"\t\xc3\xa9.exr");
     EXPECT_TRUE(has(json, "\"depth_map\": \"dir\\\\name \\\"quoted\\\"\\t\xc3\xa9.exr\"")) << json;
@@ -274,7 +274,7 @@ TEST(Metadata, StringsAreEscapedAndValidUtf8)
 TEST(Metadata, AbsentPartsAreNull)
 {
     const CameraParams lens_only = test::thin_lens_camera(50, 4, 52);
-    std::string json = metadata_json(with_film(make_model(lens_only), 64, 48), lens_only, kFrame, "");
+    std::string json = metadata_json(with_film(make_camera(lens_only), 64, 48), lens_only, kFrame, "");
     parsed(json);
     EXPECT_TRUE(has(json, "\"microlens_array\": null")) << json;
     EXPECT_TRUE(has(json, "\"microimage_lattice\": null")) << json;
@@ -284,7 +284,7 @@ TEST(Metadata, AbsentPartsAreNull)
 
     CameraParams bare;
     test::add_array(&bare, GridType::Hexagonal, 0.5, 0, 2);
-    json = metadata_json(with_film(make_model(bare), 64, 48), bare, kFrame, "");
+    json = metadata_json(with_film(make_camera(bare), 64, 48), bare, kFrame, "");
     parsed(json);
     EXPECT_TRUE(has(json, "\"type\": \"none\"")) << json;
     EXPECT_TRUE(has(json, "\"focal_length_mm\": null")) << json;
@@ -298,7 +298,7 @@ TEST(Metadata, AbsentPartsAreNull)
     multi.array.focal_length_count = 3;
     multi.array.focal_lengths_mm[1] = 2.1;
     multi.array.focal_lengths_mm[2] = 2.2;
-    json = metadata_json(with_film(make_model(multi), 64, 48), multi, kFrame, "");
+    json = metadata_json(with_film(make_camera(multi), 64, 48), multi, kFrame, "");
     EXPECT_TRUE(has(json, "\"lens_types\": 3")) << json;
     EXPECT_TRUE(has(json, "\"lens_type_rule\": \"type(k, l) = (k - l) mod 3, focal_lengths_mm[type]\"")) << json;
     EXPECT_TRUE(has(json, "\"focal_lengths_mm\": [2, 2.1, 2.2]")) << json;
@@ -307,9 +307,9 @@ TEST(Metadata, AbsentPartsAreNull)
 TEST(Metadata, NonFiniteNumbersAreWrittenAsNull)
 {
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2.0, 2.0, 50, 4, 52);
-    Model m = make_model(p);
-    m.sensor_offset_mm[0] = NAN;  // cannot come from checked input; the writer must still cope
-    m.sensor_offset_mm[1] = -INFINITY;
+    PlenopticCamera m = make_camera(p);
+    m.sensor.offset_mm[0] = NAN;  // cannot come from checked input; the writer must still cope
+    m.sensor.offset_mm[1] = -INFINITY;
     const std::string json = metadata_json(with_film(m, 64, 48), p, kFrame, "");
     parsed(json);
     EXPECT_TRUE(has(json, "\"offset_mm\": [null, null]")) << json;
@@ -320,7 +320,7 @@ TEST(Metadata, NonFiniteNumbersAreWrittenAsNull)
 TEST(Metadata, LayoutIsOneMemberPerLineWithArraysOnOneLine)
 {
     const CameraParams p = documented_camera();
-    const std::string json = metadata_json(with_film(make_model(p), 640, 480), p, kFrame, "");
+    const std::string json = metadata_json(with_film(make_camera(p), 640, 480), p, kFrame, "");
     EXPECT_EQ(json.rfind("{\n  \"format\": \"povray-plenoptic-metadata\",\n  \"version\": 1,\n", 0), 0u) << json;
     EXPECT_TRUE(has(json, "\n  \"image\": {\n    \"width\": 640,\n    \"height\": 480\n  },\n")) << json;
     EXPECT_TRUE(has(json, "\n  \"samples\": {\"adaptive\": false, \"min\": ")) << json;
@@ -334,7 +334,7 @@ TEST(Metadata, LatticeFieldsMatchTheMicroimageLattice)
 {
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2.0, 2.0, 50, 4, 52);
     test::set_pose(&p, 0, 0, 2, 0, 0, 0);
-    const Model m = with_film(make_model(p), 640, 480);
+    const PlenopticCamera m = with_film(make_camera(p), 640, 480);
     const MicroimageLattice lattice = microimage_lattice(m);
     const Json doc = parsed(metadata_json(m, p, kFrame, ""));
     const Json& grid = doc["lftoolbox_lenslet_grid_model"];
@@ -351,7 +351,7 @@ TEST(Metadata, LatticeFieldsMatchTheMicroimageLattice)
 TEST(Metadata, MicroimagesSummaryIsWrittenAsGiven)
 {
     const CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2.0, 2.0, 50, 4, 52);
-    const Model m = with_film(make_model(p), 640, 480);
+    const PlenopticCamera m = with_film(make_camera(p), 640, 480);
     MicroimageSummary summary = MicroimageSummary();
     summary.file = "scene.microimages.csv";
     summary.lenses = 12;
@@ -392,7 +392,7 @@ TEST(Metadata, DistortionProfileOfAThinLensWithDistortion)
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2.0, 2.0, 50, 4, 60);
     p.main.has_distortion = true;
     p.main.distortion = DistortionParams{{-0.1, 0, 0}, {0, 0}};
-    const Json doc = parsed(metadata_json(with_film(make_model(p), 640, 480), p, kFrame, ""));
+    const Json doc = parsed(metadata_json(with_film(make_camera(p), 640, 480), p, kFrame, ""));
     const Json& profile = doc["main_lens"]["distortion_profile"];
     ASSERT_TRUE(profile.is_object());
     EXPECT_EQ(profile["samples"].size(), 17u);
@@ -407,7 +407,7 @@ TEST(Metadata, DistortionProfileOfAThinLensWithDistortion)
     pinhole.main.type = MainLensType::Pinhole;
     pinhole.main.has_distortion = false;
     pinhole.array.lens = MicrolensType::ThinLens;
-    EXPECT_TRUE(parsed(metadata_json(with_film(make_model(pinhole), 640, 480), pinhole, kFrame, ""))["main_lens"]["distortion_profile"].is_null());
+    EXPECT_TRUE(parsed(metadata_json(with_film(make_camera(pinhole), 640, 480), pinhole, kFrame, ""))["main_lens"]["distortion_profile"].is_null());
 }
 
 } // namespace

@@ -38,7 +38,7 @@ struct Moments {
 // aperture sample (lens_u, lens_v), as the renderer decides it.
 class LensProbe {
 public:
-    LensProbe(const Model& m, LensIndex lens, double lens_u, double lens_v)
+    LensProbe(const PlenopticCamera& m, LensIndex lens, double lens_u, double lens_v)
         : m_(m), lens_(lens), lens_u_(lens_u), lens_v_(lens_v)
     {
     }
@@ -49,7 +49,7 @@ public:
         const OpticsRay ray = generate_ray(m_, 0, 0, sample, &lens_);
         if (!ray.passed)
             return false;
-        if (m_.model_overlap)
+        if (m_.overlap.modelled)
             return true;
         // Without overlap modelling the renderer gives a sensor point the light of its own lens only.
         const OwnLens own = own_lens(m_, sensor_point(m_, u, v));
@@ -57,7 +57,7 @@ public:
     }
 
 private:
-    const Model& m_;
+    const PlenopticCamera& m_;
     LensIndex lens_;
     double lens_u_, lens_v_;
 };
@@ -142,23 +142,23 @@ Moments region_moments(const LensProbe& probe, double gu, double gv, double sear
 
 // Sensor pixel (centre convention, unbounded) of an optics-frame point projected from the exit
 // pupil's centre onto the sensor plane.
-bool project_to_sensor_px(const Model& m, Vec3 q, Vec2* px)
+bool project_to_sensor_px(const PlenopticCamera& m, Vec3 q, Vec2* px)
 {
     const Vec3 e = m.lens->exit_pupil_centre();
     if (!(q.z < e.z))
         return false;
-    const double t = (m.sensor_z_mm - e.z) / (q.z - e.z);
+    const double t = (m.sensor.z_mm - e.z) / (q.z - e.z);
     const PixelPoint p = sensor_to_pixel(m, e.x + t * (q.x - e.x), e.y + t * (q.y - e.y));
     *px = Vec2{p.u, p.v};
     return is_finite(*px);
 }
 
 // Area (pixels^2) of the lens's cell projected from the exit pupil's centre onto the sensor.
-double microimage_cell_area_px(const Model& m, LensIndex lens)
+double microimage_cell_area_px(const PlenopticCamera& m, LensIndex lens)
 {
     Vec2 corners[6];
-    const int count = cell_polygon(m.grid, m.pitch_mm, corners);
-    const Vec2 c = lens_centre(m.grid, m.pitch_mm, lens);
+    const int count = cell_polygon(m.array.grid, m.array.pitch_mm, corners);
+    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
     Vec2 px[6];
     for (int i = 0; i < count; ++i)
         if (!project_to_sensor_px(m, to_optics(m, Vec3{c.x + corners[i].x, c.y + corners[i].y, 0}), &px[i]))
@@ -182,31 +182,31 @@ struct Guess {
 // point h - (h_z - sensor_z) (w' + (h - c) / f), w' = (q - h) / (q_z - h_z) (pinholes: no
 // (h - c) / f). Exact for an array parallel to the sensor, a guess otherwise (the bracket grows
 // where light reaches farther). A pinhole main lens has no pupil disc: the cell's image then.
-Guess guess_region(const Model& m, LensIndex lens, double lens_u, double lens_v, Vec2 lattice_px)
+Guess guess_region(const PlenopticCamera& m, LensIndex lens, double lens_u, double lens_v, Vec2 lattice_px)
 {
-    const double pixel = std::min(m.pixel_size_mm[0], m.pixel_size_mm[1]);
+    const double pixel = std::min(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]);
     const double behind = effective_array_distance_mm(m);
-    const Vec2 c_local = lens_centre(m.grid, m.pitch_mm, lens);
-    const bool thin = m.microlens == MicrolensType::ThinLens;
-    const Vec2 offset = thin ? sample_cell_uniform(m.grid, m.pitch_mm, lens_u, lens_v) : Vec2{0, 0};
+    const Vec2 c_local = lens_centre(m.array.grid, m.array.pitch_mm, lens);
+    const bool thin = m.array.microlens == MicrolensType::ThinLens;
+    const Vec2 offset = thin ? sample_cell_uniform(m.array.grid, m.array.pitch_mm, lens_u, lens_v) : Vec2{0, 0};
     const Vec3 h = to_optics(m, Vec3{c_local.x + offset.x, c_local.y + offset.y, 0});
     PupilDisc disc{m.lens->exit_pupil_centre(), m.lens->exit_pupil_radius()};
     if (m.pupil_bounds)
         disc = m.pupil_bounds->disc_for(h);
     if (!m.lens->forms_image() || !(disc.radius >= 0)) {
         const double main = effective_main_distance_mm(m);
-        const double cell = m.cell_circumradius_mm * (main > 0 ? (main + behind) / main : 1);
+        const double cell = m.array.cell_circumradius_mm * (main > 0 ? (main + behind) / main : 1);
         return Guess{true, lattice_px.x + 0.5, lattice_px.y + 0.5, 2 * cell / pixel + 2};
     }
     if (disc.radius == 0)
         return Guess{false, 0, 0, 0};
-    const double along = disc.centre.z - h.z, drop = h.z - m.sensor_z_mm;
+    const double along = disc.centre.z - h.z, drop = h.z - m.sensor.z_mm;
     if (!(along > 0) || !(drop > 0))
         return Guess{false, 0, 0, 0};
     double wx = (disc.centre.x - h.x) / along, wy = (disc.centre.y - h.y) / along;
     if (thin) {
         const double f = detail::microlens_focal(m, lens);
-        const Vec3 shift = mul(m.pose.rotation, Vec3{offset.x / f, offset.y / f, 0});
+        const Vec3 shift = mul(m.array.pose.rotation, Vec3{offset.x / f, offset.y / f, 0});
         wx += shift.x;
         wy += shift.y;
     }
@@ -222,9 +222,9 @@ Guess guess_region(const Model& m, LensIndex lens, double lens_u, double lens_v,
 }
 
 // The array-local box (x0, y0, x1, y1) that the picture's corners project to, or false.
-bool picture_on_array(const Model& m, double box[4])
+bool picture_on_array(const PlenopticCamera& m, double box[4])
 {
-    const int W = m.film.width, H = m.film.height;
+    const int W = m.sensor.film.width, H = m.sensor.film.height;
     box[0] = box[1] = INFINITY;
     box[2] = box[3] = -INFINITY;
     const double corners[4][2] = {{0, 0}, {double(W), 0}, {0, double(H)}, {double(W), double(H)}};
@@ -252,17 +252,17 @@ MicroimageOptions default_microimage_options()
     return options;
 }
 
-std::vector<MicroimageTruth> microimage_truth(const Model& m, const MicroimageOptions& options,
+std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const MicroimageOptions& options,
                                               const MicroimageProgress& progress, const MicroimageCancel& cancelled)
 {
-    const int W = m.film.width, H = m.film.height;
+    const int W = m.sensor.film.width, H = m.sensor.film.height;
     std::vector<MicroimageTruth> out;
-    if (m.grid == GridType::None || !m.lens || W <= 0 || H <= 0)
+    if (m.array.grid == GridType::None || !m.lens || W <= 0 || H <= 0)
         return out;
     double box[4];
     if (!picture_on_array(m, box))
         return out;
-    const double p = m.pitch_mm, rows = row_spacing(m.grid, p);
+    const double p = m.array.pitch_mm, rows = row_spacing(m.array.grid, p);
     // Margins of lenses: a lattice centre in the picture may belong to a lens whose centre
     // projects just outside the box of the corners (the centres project from the exit pupil).
     const double l0 = std::floor(box[1] / rows) - 2, l1 = std::ceil(box[3] / rows) + 2;
@@ -284,7 +284,7 @@ std::vector<MicroimageTruth> microimage_truth(const Model& m, const MicroimageOp
         }
     }
 
-    const bool thin = m.microlens == MicrolensType::ThinLens;
+    const bool thin = m.array.microlens == MicrolensType::ThinLens;
     const int n = thin ? std::max(1, options.aperture_points) : 1;
     auto measure = [&](std::size_t index) {
         MicroimageTruth& truth = out[index];
@@ -346,7 +346,7 @@ std::vector<MicroimageTruth> microimage_truth(const Model& m, const MicroimageOp
     return out;
 }
 
-LatticeFit fit_microimage_lattice(const Model& m, const std::vector<MicroimageTruth>& truth)
+LatticeFit fit_microimage_lattice(const PlenopticCamera& m, const std::vector<MicroimageTruth>& truth)
 {
     LatticeFit fit = LatticeFit();
     fit.valid = false;
@@ -356,7 +356,7 @@ LatticeFit fit_microimage_lattice(const Model& m, const std::vector<MicroimageTr
     for (const MicroimageTruth& t : truth) {
         if (!t.lit)
             continue;
-        mk += double(skew_k(m.grid, t.lens));
+        mk += double(skew_k(m.array.grid, t.lens));
         ml += double(t.lens.l);
         mu += t.u_px;
         mv += t.v_px;
@@ -372,7 +372,7 @@ LatticeFit fit_microimage_lattice(const Model& m, const std::vector<MicroimageTr
     for (const MicroimageTruth& t : truth) {
         if (!t.lit)
             continue;
-        const double dk = double(skew_k(m.grid, t.lens)) - mk, dl = double(t.lens.l) - ml;
+        const double dk = double(skew_k(m.array.grid, t.lens)) - mk, dl = double(t.lens.l) - ml;
         skk += dk * dk;
         skl += dk * dl;
         sll += dl * dl;
@@ -407,14 +407,14 @@ LatticeFit fit_microimage_lattice(const Model& m, const std::vector<MicroimageTr
     return fit;
 }
 
-Vec2 lattice_residual(const Model& m, const LatticeFit& fit, const MicroimageTruth& lens)
+Vec2 lattice_residual(const PlenopticCamera& m, const LatticeFit& fit, const MicroimageTruth& lens)
 {
-    const double k = double(skew_k(m.grid, lens.lens)), l = double(lens.lens.l);
+    const double k = double(skew_k(m.array.grid, lens.lens)), l = double(lens.lens.l);
     return Vec2{lens.u_px - (fit.origin_px[0] + k * fit.basis_a_px[0] + l * fit.basis_b_px[0]),
                 lens.v_px - (fit.origin_px[1] + k * fit.basis_a_px[1] + l * fit.basis_b_px[1])};
 }
 
-MicroimageSummary summarise_microimages(const Model& m, const std::vector<MicroimageTruth>& truth,
+MicroimageSummary summarise_microimages(const PlenopticCamera& m, const std::vector<MicroimageTruth>& truth,
                                         const MicroimageOptions& options, const std::string& file)
 {
     MicroimageSummary summary;
@@ -454,7 +454,7 @@ std::string shortest(double value)
 
 } // namespace
 
-std::string microimages_csv(const Model& m, const std::vector<MicroimageTruth>& truth, const LatticeFit& fit)
+std::string microimages_csv(const PlenopticCamera& m, const std::vector<MicroimageTruth>& truth, const LatticeFit& fit)
 {
     std::string out = "k,l,u,v,lit_fraction,residual_u,residual_v\n";
     for (const MicroimageTruth& t : truth) {

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "plenoptic/core/lattice.h"
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 
 namespace plenoptic {
 
@@ -64,7 +64,7 @@ MicroimageOptions default_microimage_options();
 // lattice centre, or the centroid of a coarse search when that point is dark): the region
 // between that point and the first boundary crossing along each direction. Needs a main lens and
 // an array (empty otherwise). Deterministic.
-std::vector<MicroimageTruth> microimage_truth(const Model& model, const MicroimageOptions& options,
+std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& model, const MicroimageOptions& options,
                                               const MicroimageProgress& progress = MicroimageProgress(),
                                               const MicroimageCancel& cancelled = MicroimageCancel());
 
@@ -81,10 +81,10 @@ struct LatticeFit {
     LensIndex worst;           // where the largest residual is
 };
 
-LatticeFit fit_microimage_lattice(const Model& model, const std::vector<MicroimageTruth>& truth);
+LatticeFit fit_microimage_lattice(const PlenopticCamera& model, const std::vector<MicroimageTruth>& truth);
 
 // The fit's residual for one lens (centre - fit), pixels.
-Vec2 lattice_residual(const Model& model, const LatticeFit& fit, const MicroimageTruth& lens);
+Vec2 lattice_residual(const PlenopticCamera& model, const LatticeFit& fit, const MicroimageTruth& lens);
 
 // What the metadata says about the microimages file (docs/metadata.md, "microimages").
 struct MicroimageSummary {
@@ -96,14 +96,14 @@ struct MicroimageSummary {
     double from_lattice_rms_px, from_lattice_max_px;
 };
 
-MicroimageSummary summarise_microimages(const Model& model, const std::vector<MicroimageTruth>& truth,
+MicroimageSummary summarise_microimages(const PlenopticCamera& model, const std::vector<MicroimageTruth>& truth,
                                         const MicroimageOptions& options, const std::string& file);
 
 // The CSV text: a header line "k,l,u,v,lit_fraction,residual_u,residual_v", then one line per
 // lens (row-form indices, centre-convention pixels, the residuals from the fit); u, v and the
 // residuals are empty for a dark lens, the residuals also when the fit is not valid. Numbers in
 // the shortest form that reads back to the same double.
-std::string microimages_csv(const Model& model, const std::vector<MicroimageTruth>& truth, const LatticeFit& fit);
+std::string microimages_csv(const PlenopticCamera& model, const std::vector<MicroimageTruth>& truth, const LatticeFit& fit);
 
 } // namespace plenoptic
 

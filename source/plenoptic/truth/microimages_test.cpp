@@ -38,7 +38,7 @@ TEST(MicroimageTruth, ThinLensMicroimagesAreThePupilDiscAboutTheLatticeCentres)
                                     ClosedFormCase{GridType::Hexagonal, 2}, ClosedFormCase{GridType::Rectangular, 1.5}}) {
         CameraParams params = plenoptic_camera(c.grid, p, c.micro_focal_mm, d, 50, 8, D);
         params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = pixel;
-        const Model m = make_model(params);
+        const PlenopticCamera m = make_camera(params);
         const int W = 161, H = 121;
         const std::vector<MicroimageTruth> truth = microimage_truth(with_film(m, W, H), default_microimage_options());
         ASSERT_GE(truth.size(), 6u);
@@ -92,7 +92,7 @@ TEST(MicroimageTruth, CatsEyesAgreeWithABruteForceCount)
     params.main.has_prescription = true;
     params.main.prescription = lens;
     params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.5;
-    const Model m = make_model(params);
+    const PlenopticCamera m = make_camera(params);
     ASSERT_EQ(test::lens_kind(m), "prescription");
     const int W = 120, H = 120;
     const std::vector<MicroimageTruth> truth = microimage_truth(with_film(m, W, H), default_microimage_options());
@@ -153,7 +153,7 @@ TEST(MicroimageTruth, ThinMicrolensesConvergeInApertureAndThreadsDoNotMatter)
     params.main.has_prescription = true;
     params.main.prescription = lens;
     params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.5;
-    const Model m = make_model(params);
+    const PlenopticCamera m = make_camera(params);
     const int W = 120, H = 120;
     MicroimageOptions coarse = default_microimage_options(), fine = coarse, one_thread = coarse;
     fine.aperture_points = 8;
@@ -181,7 +181,7 @@ TEST(MicroimageTruth, ThinMicrolensesConvergeInApertureAndThreadsDoNotMatter)
 
 TEST(MicroimageTruth, LatticeFitRecoversAGivenLattice)
 {
-    const Model m = make_model(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52));
+    const PlenopticCamera m = make_camera(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52));
     // Centres on a known skew lattice, plus a known residual pattern of zero mean that is
     // orthogonal to (1, k_s, l) over the set: +e on even k_s + l, -e on odd, balanced per row.
     const double o[2] = {100.25, 80.5}, a[2] = {14.2, 0.3}, b[2] = {7.1, 12.4};
@@ -221,7 +221,7 @@ TEST(MicroimageTruth, CancellingStopsAtTheNextLensAndReturnsNothing)
 {
     CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 8, 52);
     params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.01;
-    const Model m = with_film(make_model(params), 401, 301);
+    const PlenopticCamera m = with_film(make_camera(params), 401, 301);
     MicroimageOptions options = default_microimage_options();
     options.threads = 2;
     ASSERT_GT(microimage_truth(m, options).size(), 50u);
@@ -235,12 +235,12 @@ TEST(MicroimageTruth, CancellingStopsAtTheNextLensAndReturnsNothing)
 
 TEST(MicroimageTruth, NothingWithoutAnArrayOrAMainLens)
 {
-    const Model no_array = with_film(make_model(test::thin_lens_camera(50, 4, 52)), 100, 100);
+    const PlenopticCamera no_array = with_film(make_camera(test::thin_lens_camera(50, 4, 52)), 100, 100);
     EXPECT_TRUE(microimage_truth(no_array, default_microimage_options()).empty());
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52);
     p.main.given = false;
     p.main.type = MainLensType::None;
-    const Model no_main = with_film(make_model(p), 100, 100);
+    const PlenopticCamera no_main = with_film(make_camera(p), 100, 100);
     EXPECT_TRUE(microimage_truth(no_main, default_microimage_options()).empty());
 }
 

@@ -12,36 +12,36 @@
 
 namespace plenoptic {
 
-bool is_focused_camera(const Model& m)
+bool is_focused_camera(const PlenopticCamera& m)
 {
-    if (m.grid == GridType::None || m.microlens != MicrolensType::ThinLens || !m.lens || !m.lens->forms_image())
+    if (m.array.grid == GridType::None || m.array.microlens != MicrolensType::ThinLens || !m.lens || !m.lens->forms_image())
         return false;
     const double d = effective_array_distance_mm(m);
-    for (int t = 0; t < m.lens_type_count; ++t)
-        if (std::fabs(m.microlens_focal_mm[t] - d) > 1e-9 * d)
+    for (int t = 0; t < m.array.lens_type_count; ++t)
+        if (std::fabs(m.array.focal_mm[t] - d) > 1e-9 * d)
             return true;
     return false;
 }
 
-double virtual_depth(const Model& m, Vec3 point)
+double virtual_depth(const PlenopticCamera& m, Vec3 point)
 {
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    if (!m.lens || !m.lens->forms_image() || m.grid == GridType::None)
+    if (!m.lens || !m.lens->forms_image() || m.array.grid == GridType::None)
         return nan;
     const HomogeneousPoint image = m.lens->paraxial_image(point);
     if (!(image.w != 0))
         return nan;
     const Vec3 x = (1 / image.w) * image.xyz;
-    const double a = dot(m.pose.normal, x - m.pose.centre_mm);
+    const double a = dot(m.array.pose.normal, x - m.array.pose.centre_mm);
     const double v = -a / effective_array_distance_mm(m);
     return std::isfinite(v) ? v : nan;
 }
 
-float pixel_virtual_depth(const Model& m, int i, int j, float distance_units)
+float pixel_virtual_depth(const PlenopticCamera& m, int i, int j, float distance_units)
 {
     if (!(distance_units >= 0))
         return std::numeric_limits<float>::quiet_NaN();
-    const OpticsRay ray = chief_ray(m, i, j);
+    const OpticsRay ray = m.chief_ray(i, j);
     const Vec3 origin{ray.origin_mm.x, ray.origin_mm.y, ray.origin_mm.z};
     const Vec3 dir{ray.dir.x, ray.dir.y, ray.dir.z};
     // At infinity: a point as far as a length can be (1e12 mm) images within 1e-10 of the

@@ -28,24 +28,24 @@ double thin_lens_v(double z, double d)
 
 TEST(VirtualDepth, FocusedCamerasOnly)
 {
-    EXPECT_FALSE(is_focused_camera(make_model(plenoptic_camera(GridType::Hexagonal, PITCH, 0.6, 0.6, F, 4, D))));
-    EXPECT_TRUE(is_focused_camera(make_model(plenoptic_camera(GridType::Hexagonal, PITCH, 0.6, 0.9, F, 4, D))));
-    EXPECT_TRUE(is_focused_camera(make_model(plenoptic_camera(GridType::Rectangular, PITCH, 0.9, 0.6, F, 4, D))));
+    EXPECT_FALSE(is_focused_camera(make_camera(plenoptic_camera(GridType::Hexagonal, PITCH, 0.6, 0.6, F, 4, D))));
+    EXPECT_TRUE(is_focused_camera(make_camera(plenoptic_camera(GridType::Hexagonal, PITCH, 0.6, 0.9, F, 4, D))));
+    EXPECT_TRUE(is_focused_camera(make_camera(plenoptic_camera(GridType::Rectangular, PITCH, 0.9, 0.6, F, 4, D))));
     CameraParams multi = plenoptic_camera(GridType::Hexagonal, PITCH, 0.6, 0.6, F, 4, D);
     multi.array.focal_length_count = 3;
     multi.array.focal_lengths_mm[1] = 0.7;
     multi.array.focal_lengths_mm[2] = 0.8;
-    EXPECT_TRUE(is_focused_camera(make_model(multi)));
+    EXPECT_TRUE(is_focused_camera(make_camera(multi)));
     CameraParams pinholes = plenoptic_camera(GridType::Hexagonal, PITCH, 0.6, 0.9, F, 4, D);
     pinholes.array.lens = MicrolensType::Pinhole;
     pinholes.array.focal_length_count = 0;
-    EXPECT_FALSE(is_focused_camera(make_model(pinholes)));
+    EXPECT_FALSE(is_focused_camera(make_camera(pinholes)));
 }
 
 TEST(VirtualDepth, PointsAgainstTheThinLensEquation)
 {
     for (double d : {0.9, 0.4}) {  // Keplerian (d > f = 0.6) and Galilean (d < f)
-        const Model m = make_model(plenoptic_camera(GridType::Hexagonal, PITCH, 0.6, d, F, 4, D));
+        const PlenopticCamera m = make_camera(plenoptic_camera(GridType::Hexagonal, PITCH, 0.6, d, F, 4, D));
         for (double z : {300.0, 550.0, 1000.0, 5000.0, 1e6})
             for (double x : {0.0, 40.0, -120.0}) {
                 const double v = virtual_depth(m, Vec3{x, 0.5 * x, z});
@@ -64,7 +64,7 @@ TEST(VirtualDepth, TiltedArrayMeasuresAlongItsNormal)
 {
     CameraParams p = plenoptic_camera(GridType::Rectangular, PITCH, 0.6, 0.9, F, 4, D);
     test::set_pose(&p, 10, -5, 30, 0.3, -0.2, 0.1);
-    const Model m = make_model(p);
+    const PlenopticCamera m = make_camera(p);
     const double deg[3] = {10, -5, 30};
     const Vec3 normal = test::reference_rotate(deg, Vec3{0, 0, 1});
     const Vec3 centre{0.3, -0.2, -D + 0.1};
@@ -82,12 +82,12 @@ TEST(VirtualDepth, PixelsOfAFrontoParallelPlane)
     // The depth map's distance to a plane at z (mm) along pixel (i, j)'s chief ray is
     // (z - o_z) / w_z in scene units; its virtual depth is the plane's, whatever the pixel.
     const double d = 0.9;
-    const Model m = make_model(plenoptic_camera(GridType::Hexagonal, PITCH, 0.6, d, F, 4, D));
+    const PlenopticCamera m = make_camera(plenoptic_camera(GridType::Hexagonal, PITCH, 0.6, d, F, 4, D));
     const int W = 64, H = 48;
     for (double z : {350.0, 800.0, 3000.0})
         for (int j = 0; j < H; j += 7)
             for (int i = 0; i < W; i += 5) {
-                const OpticsRay ray = chief_ray(with_film(m, W, H), i, j);
+                const OpticsRay ray = with_film(m, W, H).chief_ray(i, j);
                 const float distance = float((z - ray.origin_mm.z) / ray.dir.z / m.mm_per_unit);
                 EXPECT_NEAR(pixel_virtual_depth(with_film(m, W, H), i, j, distance), thin_lens_v(z, d),
                             2e-5 * std::fabs(thin_lens_v(z, d)) + 1e-5) << z << " " << i << " " << j;

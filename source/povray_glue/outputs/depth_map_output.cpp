@@ -35,9 +35,9 @@ DepthMapOutput::DepthMapOutput(const Render& render, const RenderArea& area)
 
 float DepthMapOutput::depth_of(int column, int row, SceneProbe& scene) const
 {
-    if (!pixel_receives_light(render_.model(), column, row))
+    if (!render_.model().receives_light(column, row))
         return -1.0f;
-    return (float)scene.first_hit(chief_ray(render_.model(), column, row));
+    return (float)scene.first_hit(render_.model().chief_ray(column, row));
 }
 
 void DepthMapOutput::pixel_traced(int column, int row, SceneProbe& scene)

@@ -18,7 +18,7 @@ class MicroimagesOutput : public Output {
 public:
     bool write(const WrittenImage& image, SidecarFiles& files) override
     {
-        const Model& model = image.camera;
+        const PlenopticCamera& model = image.camera;
         const MicroimageOptions options = default_microimage_options();
         // Seconds for large arrays (about 0.5 ms a lens and thread behind a real lens): say how far.
         const MicroimageProgress progress = [](std::size_t done, std::size_t total) {
@@ -48,10 +48,10 @@ private:
 
 std::unique_ptr<Output> start_microimages(const Render& render, const RenderArea&)
 {
-    const Model& model = render.model();
+    const PlenopticCamera& model = render.model();
     const CameraSetup::MicroimageCentres asked = render.setup().microimage_centres;
-    const bool off_lattice = (model.lens && model.lens->traced()) || model.has_distortion;
-    if (model.grid == GridType::None || !model.lens ||
+    const bool off_lattice = (model.lens && model.lens->traced()) || model.distortion();
+    if (model.array.grid == GridType::None || !model.lens ||
         !(asked == CameraSetup::kWrite || (asked == CameraSetup::kDefault && off_lattice)))
         return nullptr;
     return std::unique_ptr<Output>(new MicroimagesOutput());

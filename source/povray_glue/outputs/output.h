@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 #include "plenoptic/camera/rays.h"
 #include "plenoptic/truth/depth_map.h"
 #include "plenoptic/truth/metadata.h"
@@ -67,13 +67,13 @@ public:
 
 // The image the front end has just written, as the outputs after it see it.
 struct WrittenImage {
-    WrittenImage(const std::string& image_path, const Picture& image_picture, const Model& image_camera,
+    WrittenImage(const std::string& image_path, const Picture& image_picture, const PlenopticCamera& image_camera,
                  CancelQuery cancel)
         : path(image_path), picture(image_picture), camera(image_camera), cancelled(cancel) {}
 
     std::string path;        // dir/name.ext
     const Picture& picture;  // what was written (after the stages before it)
-    Model camera;            // the render's camera with the film of the image written
+    PlenopticCamera camera;            // the render's camera with the film of the image written
     CancelQuery cancelled;
 
     // The file beside the image: dir/name<suffix>.

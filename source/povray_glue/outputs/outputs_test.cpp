@@ -34,7 +34,7 @@ std::shared_ptr<CameraSetup> setup_of(const CameraParams& params)
 {
     std::shared_ptr<CameraSetup> setup = std::make_shared<CameraSetup>();
     setup->params = params;
-    setup->model = make_model(params);
+    setup->model = make_camera(params);
     return setup;
 }
 
@@ -298,11 +298,11 @@ std::vector<float> read_depth(const std::string& path, int W, int H)
 
 // What the depth map must hold at (i, j): -1 where no sample passes, else the scene's distance
 // along the pixel's chief ray.
-float expected_depth(const Model& model, int i, int j)
+float expected_depth(const PlenopticCamera& model, int i, int j)
 {
-    if (!pixel_receives_light(model, i, j))
+    if (!model.receives_light(i, j))
         return -1.0f;
-    const OpticsRay ray = chief_ray(model, i, j);
+    const OpticsRay ray = model.chief_ray(i, j);
     return float(1000 + 100 * ray.dir.x + 10 * ray.dir.y);
 }
 
@@ -331,7 +331,7 @@ TEST(DepthMapOutput, ComputesEachTracedPixelAndAContinuedRendersOwedBlocks)
     int lit = 0;
     for (int j = 0; j < H; ++j)
         for (int i = 0; i < W; ++i)
-            lit += pixel_receives_light(render.model(), i, j) ? 1 : 0;
+            lit += render.model().receives_light(i, j) ? 1 : 0;
     EXPECT_EQ(lit, scene.hits);  // every pixel's depth once, traced or owed
     EXPECT_GT(traced, 0);
 

@@ -28,13 +28,13 @@ public:
 
     const CameraSetup& setup() const { return *setup_; }
     // The camera of this render: the parsed model with the render's film (width x height).
-    const Model& model() const { return model_; }
+    const PlenopticCamera& model() const { return model_; }
     // The optics frame in the scene: +x right, +y up, +z towards the scene, unit axes.
     const CameraFrame& frame() const { return frame_; }
     // right, up, direction orthonormal: a unit optics direction stays unit in the scene.
     bool frame_orthonormal() const { return frame_orthonormal_; }
-    int width() const { return model_.film.width; }
-    int height() const { return model_.film.height; }
+    int width() const { return model_.sensor.film.width; }
+    int height() const { return model_.sensor.film.height; }
     // A continued render (+C): some of its pixels come from the image an earlier run wrote.
     bool continued() const { return continued_; }
 
@@ -62,7 +62,7 @@ public:
 
 private:
     std::shared_ptr<const CameraSetup> setup_;
-    Model model_;
+    PlenopticCamera model_;
     CameraFrame frame_;
     bool frame_orthonormal_;
     bool continued_;

@@ -39,7 +39,7 @@ public:
 private:
     static bool write_exr(const std::string& path, const WrittenImage& image, const DepthMap& depth)
     {
-        const Model& model = image.camera;
+        const PlenopticCamera& model = image.camera;
         const int W = depth.width(), H = depth.height();
         if (size_t(W) * H >= 4000000)
             std::fprintf(stderr, "plenoptic camera: virtual depth of %d x %d pixels\n", W, H);

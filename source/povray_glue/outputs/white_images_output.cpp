@@ -21,15 +21,15 @@ namespace plenoptic {
 namespace {
 
 // The same camera, film included, at f-number N: the one place the white images get it from.
-Model camera_at_f_number(const Model& camera, double f_number) { return with_f_number(camera, f_number); }
+PlenopticCamera camera_at_f_number(const PlenopticCamera& camera, double f_number) { return with_f_number(camera, f_number); }
 
 // The PNG of white image index k (`values`: its grey irradiance per pixel, rows from the top) in
 // `png` (empty if libpng failed), and in `scale` what the linear values were divided by. false:
 // cancelled.
-bool white_png(const Model& optics, const std::vector<float>& values, const CameraParams& params, bool raw, int k,
+bool white_png(const PlenopticCamera& optics, const std::vector<float>& values, const CameraParams& params, bool raw, int k,
                CancelQuery cancelled, std::string& png, double& scale)
 {
-    const int W = optics.film.width, H = optics.film.height;
+    const int W = optics.sensor.film.width, H = optics.sensor.film.height;
     const SensorChainParams& chain = params.sensor.chain;
     // R, G and B of the grey white image, where they are needed: diffraction differs by colour
     // (the white image is then RGB), and the read-out reads three channels.
@@ -75,18 +75,18 @@ public:
     {
         const WhiteImageRequest& white = render_.setup().white_image;
         const CameraParams& params = render_.setup().params;
-        const Model& model = image.camera;
+        const PlenopticCamera& model = image.camera;
         bool ok = true;
         written_.clear();
         files.white_images = &written_;
         const int count = white.f_numbers.empty() ? 1 : int(white.f_numbers.size());
         for (int k = 0; k < count && !image.cancelled(); ++k) {
             const bool own = white.f_numbers.empty();
-            const double f_number = own ? model.f_number : white.f_numbers[size_t(k)];
-            std::unique_ptr<Model> other;
+            const double f_number = own ? model.f_number() : white.f_numbers[size_t(k)];
+            std::unique_ptr<PlenopticCamera> other;
             if (!own)
-                other.reset(new Model(camera_at_f_number(model, f_number)));
-            const Model& optics = own ? model : *other;
+                other.reset(new PlenopticCamera(camera_at_f_number(model, f_number)));
+            const PlenopticCamera& optics = own ? model : *other;
             const std::vector<float> values = white_image(optics, image.cancelled);
             if (values.empty())
                 break;  // cancelled

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "plenoptic/camera/model.h"
+#include "plenoptic/camera/plenoptic_camera.h"
 #include "plenoptic/core/test_util.h"
 
 namespace plenoptic {
@@ -31,54 +31,54 @@ TEST(Model, DistanceFromFocusDistanceObeysTheThinLensEquation)
         p.main.has_focus_distance = true;
         p.main.focus_distance_units = focus;
         ASSERT_EQ(check_camera(p), "") << focus;
-        const Model m = make_model(p);
+        const PlenopticCamera m = make_camera(p);
         const double z = focus * 1000;
         // 1/F = 1/z + 1/D
         EXPECT_NEAR(1 / m.distance_mm + 1 / z, 1 / 50.0, 1e-15) << "focus " << focus << " D " << m.distance_mm;
         EXPECT_TRUE(std::isfinite(m.distance_mm));
         EXPECT_TRUE(m.has_focus_distance);
-        EXPECT_EQ(m.sensor_z_mm, -m.distance_mm);
+        EXPECT_EQ(m.sensor.z_mm, -m.distance_mm);
     }
 }
 
 TEST(Model, ApertureAndFNumber)
 {
-    Model m = make_model(thin_lens_camera(50, 4, 52));
-    EXPECT_DOUBLE_EQ(m.aperture_mm, 12.5);
-    EXPECT_DOUBLE_EQ(m.f_number, 4);
+    PlenopticCamera m = make_camera(thin_lens_camera(50, 4, 52));
+    EXPECT_DOUBLE_EQ(m.aperture_mm(), 12.5);
+    EXPECT_DOUBLE_EQ(m.f_number(), 4);
     CameraParams p = thin_lens_camera(50, 4, 52);
     p.main.has_f_number = false;
     p.main.has_aperture = true;
     p.main.aperture_mm = 25;
-    m = make_model(p);
-    EXPECT_DOUBLE_EQ(m.f_number, 2);
+    m = make_camera(p);
+    EXPECT_DOUBLE_EQ(m.f_number(), 2);
 }
 
 TEST(Model, PlanesOfEachConfiguration)
 {
-    Model m = make_model(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52));
-    EXPECT_DOUBLE_EQ(m.pose.centre_mm.z, -52);
-    EXPECT_DOUBLE_EQ(m.sensor_z_mm, -54);
+    PlenopticCamera m = make_camera(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52));
+    EXPECT_DOUBLE_EQ(m.array.pose.centre_mm.z, -52);
+    EXPECT_DOUBLE_EQ(m.sensor.z_mm, -54);
 
     CameraParams bare;
     test::add_array(&bare, GridType::Rectangular, 0.5, 0, 2);
-    m = make_model(bare);
+    m = make_camera(bare);
     EXPECT_EQ(test::lens_kind(m), "none");
-    EXPECT_DOUBLE_EQ(m.pose.centre_mm.z, 0);
-    EXPECT_DOUBLE_EQ(m.sensor_z_mm, -2);
+    EXPECT_DOUBLE_EQ(m.array.pose.centre_mm.z, 0);
+    EXPECT_DOUBLE_EQ(m.sensor.z_mm, -2);
 
-    m = make_model(thin_lens_camera(50, 4, 52));
-    EXPECT_EQ(m.grid, GridType::None);
-    EXPECT_DOUBLE_EQ(m.sensor_z_mm, -52);
+    m = make_camera(thin_lens_camera(50, 4, 52));
+    EXPECT_EQ(m.array.grid, GridType::None);
+    EXPECT_DOUBLE_EQ(m.sensor.z_mm, -52);
 
     // The array's translation moves the array only, not the sensor.
     CameraParams moved = plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52);
     test::set_pose(&moved, 0, 0, 0, 0.1, -0.2, 0.3);
-    m = make_model(moved);
-    EXPECT_DOUBLE_EQ(m.pose.centre_mm.x, 0.1);
-    EXPECT_DOUBLE_EQ(m.pose.centre_mm.y, -0.2);
-    EXPECT_DOUBLE_EQ(m.pose.centre_mm.z, -51.7);
-    EXPECT_DOUBLE_EQ(m.sensor_z_mm, -54);
+    m = make_camera(moved);
+    EXPECT_DOUBLE_EQ(m.array.pose.centre_mm.x, 0.1);
+    EXPECT_DOUBLE_EQ(m.array.pose.centre_mm.y, -0.2);
+    EXPECT_DOUBLE_EQ(m.array.pose.centre_mm.z, -51.7);
+    EXPECT_DOUBLE_EQ(m.sensor.z_mm, -54);
     EXPECT_NEAR(effective_main_distance_mm(m), 51.7, 1e-12);
     EXPECT_NEAR(effective_array_distance_mm(m), 2.3, 1e-12);
 }
@@ -136,47 +136,47 @@ TEST(Model, TiltFlagOnlyForRotationAboutXOrY)
 {
     CameraParams p = plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52);
     test::set_pose(&p, 0, 0, 37, 0, 0, 0);
-    EXPECT_FALSE(make_model(p).pose.tilted);
+    EXPECT_FALSE(make_camera(p).array.pose.tilted);
     test::set_pose(&p, 1e-9, 0, 0, 0, 0, 0);
-    EXPECT_TRUE(make_model(p).pose.tilted);
+    EXPECT_TRUE(make_camera(p).array.pose.tilted);
     test::set_pose(&p, 0, 360, 0, 0, 0, 0);
-    EXPECT_FALSE(make_model(p).pose.tilted);
+    EXPECT_FALSE(make_camera(p).array.pose.tilted);
 }
 
 TEST(Model, OverlapDecision)
 {
     // Plenoptic 1.0, hexagonal, pitch 0.1, f = d = 0.5 (microlens f-number 5).
     // Main lens at twice the matched f-number: microimages stay apart.
-    Model m = make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 10, 50));
-    EXPECT_FALSE(m.model_overlap);
+    PlenopticCamera m = make_camera(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 10, 50));
+    EXPECT_FALSE(m.overlap.modelled);
     EXPECT_TRUE(warnings(m).empty()) << warnings(m)[0];
     // Matched: the cell corners spill a little; modelled, without a warning.
-    m = make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 5, 50));
-    EXPECT_TRUE(m.model_overlap);
-    EXPECT_GE(m.overlap_rings, 1);
+    m = make_camera(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 5, 50));
+    EXPECT_TRUE(m.overlap.modelled);
+    EXPECT_GE(m.overlap.rings, 1);
     EXPECT_FALSE(any_contains(warnings(m), "overlap"));
     // Half the matched f-number: real overlap, with a warning that names the cure.
-    m = make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 2.5, 50));
-    EXPECT_TRUE(m.model_overlap);
-    EXPECT_GE(m.overlap_rings, 2);
+    m = make_camera(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 2.5, 50));
+    EXPECT_TRUE(m.overlap.modelled);
+    EXPECT_GE(m.overlap.rings, 2);
     const std::vector<std::string> w = warnings(m);
     EXPECT_TRUE(any_contains(w, "microimages overlap")) << (w.empty() ? "no warning" : w[0]);
     EXPECT_TRUE(any_contains(w, "f_number of at least")) << (w.empty() ? "no warning" : w[0]);
     // No main lens: a baffled camera array, never overlap.
     CameraParams bare;
     test::add_array(&bare, GridType::Hexagonal, 0.1, 0.5, 0.5);
-    EXPECT_FALSE(make_model(bare).model_overlap);
+    EXPECT_FALSE(make_camera(bare).overlap.modelled);
     // A huge aperture asks for more rings than modelled: capped, with a warning.
-    m = make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 0.1, 50));
-    EXPECT_TRUE(m.overlap_rings_capped);
-    EXPECT_EQ(m.overlap_rings, kMaxOverlapRings);
+    m = make_camera(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 0.1, 50));
+    EXPECT_TRUE(m.overlap.rings_capped);
+    EXPECT_EQ(m.overlap.rings, kMaxOverlapRings);
     EXPECT_TRUE(any_contains(warnings(m), "ignored"));
 }
 
 TEST(Model, WarnsAboutTinyMicroimages)
 {
     CameraParams p = plenoptic_camera(GridType::Rectangular, 0.015, 0.075, 0.075, 50, 20, 50);
-    const std::vector<std::string> w = warnings(make_model(p));
+    const std::vector<std::string> w = warnings(make_camera(p));
     EXPECT_TRUE(any_contains(w, "pixels apart")) << (w.empty() ? "no warning" : w[0]);
 }
 
@@ -186,36 +186,36 @@ TEST(Model, AdaptiveSamplingTable)
     p.sampling.adaptive = true;
     p.sampling.samples_min = 4;
     p.sampling.samples_max = 64;
-    const Model m = make_model(p);
-    EXPECT_TRUE(m.adaptive);
-    EXPECT_EQ(m.samples_min, 4);
-    EXPECT_EQ(m.samples_max, 64);
-    ASSERT_EQ(m.thresholds.size(), 64u);
-    EXPECT_NEAR(m.thresholds[62], 1.0 / 128, 1e-15);
+    const PlenopticCamera m = make_camera(p);
+    EXPECT_TRUE(m.sampling.adaptive);
+    EXPECT_EQ(m.sampling.samples_min, 4);
+    EXPECT_EQ(m.sampling.samples_max, 64);
+    ASSERT_EQ(m.sampling.thresholds.size(), 64u);
+    EXPECT_NEAR(m.sampling.thresholds[62], 1.0 / 128, 1e-15);
 
     p.sampling = SamplingParams();
     p.sampling.samples = 9;
-    const Model fixed = make_model(p);
-    EXPECT_FALSE(fixed.adaptive);
-    EXPECT_EQ(fixed.samples_min, 9);
-    EXPECT_EQ(fixed.samples_max, 9);
+    const PlenopticCamera fixed = make_camera(p);
+    EXPECT_FALSE(fixed.sampling.adaptive);
+    EXPECT_EQ(fixed.sampling.samples_min, 9);
+    EXPECT_EQ(fixed.sampling.samples_max, 9);
 }
 
 TEST(Model, OmittedSamplesDependOnWhetherAnApertureIsSampled)
 {
     // A thin main lens alone, or thin microlenses: the aperture needs samples.
-    EXPECT_EQ(make_model(thin_lens_camera(50, 4, 52)).samples_max, kDefaultSamplesApertures);
+    EXPECT_EQ(make_camera(thin_lens_camera(50, 4, 52)).sampling.samples_max, kDefaultSamplesApertures);
     const CameraParams thin_array = plenoptic_camera(GridType::Hexagonal, 0.1, 0.4, 0.4, 50, 4, 52);
-    EXPECT_EQ(make_model(thin_array).samples_max, kDefaultSamplesApertures);
-    EXPECT_EQ(make_model(thin_array).samples_min, kDefaultSamplesApertures);
-    EXPECT_FALSE(make_model(thin_array).adaptive);
+    EXPECT_EQ(make_camera(thin_array).sampling.samples_max, kDefaultSamplesApertures);
+    EXPECT_EQ(make_camera(thin_array).sampling.samples_min, kDefaultSamplesApertures);
+    EXPECT_FALSE(make_camera(thin_array).sampling.adaptive);
     // Pinhole microlenses behind a thin main lens: one ray per point of the pixel.
-    EXPECT_EQ(make_model(plenoptic_camera(GridType::Hexagonal, 0.1, 0, 0.4, 50, 4, 52)).samples_max,
+    EXPECT_EQ(make_camera(plenoptic_camera(GridType::Hexagonal, 0.1, 0, 0.4, 50, 4, 52)).sampling.samples_max,
               kDefaultSamplesPinholes);
     // A given count always wins.
     CameraParams given = thin_array;
     given.sampling.samples = 3;
-    EXPECT_EQ(make_model(given).samples_max, 3);
+    EXPECT_EQ(make_camera(given).sampling.samples_max, 3);
     EXPECT_TRUE(check_camera(thin_array).empty()) << check_camera(thin_array);
 }
 

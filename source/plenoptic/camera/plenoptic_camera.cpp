@@ -1,0 +1,285 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Builds the plenoptic camera model once from checked parameters; warnings for odd but legal ones.
+
+#include "plenoptic/camera/plenoptic_camera.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "plenoptic/core/lattice.h"
+#include "plenoptic/camera/radiometry.h"
+#include "plenoptic/core/sampling.h"
+
+namespace plenoptic {
+
+namespace {
+
+// sin and cos of an angle in degrees, exact at multiples of 90 degrees so that an unrotated or
+// quarter-turned array stays exactly axis-aligned.
+void sin_cos_degrees(double degrees, double* s, double* c)
+{
+    const double reduced = std::fmod(degrees, 360.0);  // exact
+    const double quarter = reduced / 90.0;
+    if (quarter == std::floor(quarter)) {
+        static const double sines[4] = {0, 1, 0, -1};
+        const int q = int(((long long)quarter % 4 + 4) % 4);
+        *s = sines[q];
+        *c = sines[(q + 1) % 4];
+        return;
+    }
+    const double radians = reduced * (kPi / 180.0);
+    *s = std::sin(radians);
+    *c = std::cos(radians);
+}
+
+// Everything the overlap bound needs, measured at the array centre (see docs/camera-internals.md).
+struct OverlapGeometry {
+    double magnification;  // k = d / D: microimage-lattice scale is 1 + k
+    double disc_mm;        // radius of the main aperture's image through a lens centre
+    double blur_mm;        // reach of a lens cell's light beyond that, on the sensor
+    double blur_inradius_mm; // same with the cell's inradius (a round lens of diameter p)
+    double cell_mm;        // inradius of a microimage cell on the sensor
+};
+
+OverlapGeometry overlap_geometry(const PlenopticCamera& m)
+{
+    OverlapGeometry g{0, 0, 0, 0, 0};
+    const double main_distance = effective_main_distance_mm(m);
+    const double array_distance = effective_array_distance_mm(m);
+    g.magnification = array_distance / main_distance;
+    if (m.pupil_bounds)
+        g.disc_mm = m.pupil_bounds->reach_mm() * g.magnification;
+    else if (m.lens)
+        g.disc_mm = m.lens->exit_pupil_radius() * g.magnification;
+    if (m.array.microlens == MicrolensType::ThinLens) {
+        double worst = 0;
+        for (int t = 0; t < m.array.lens_type_count; ++t)
+            worst = std::max(worst, std::fabs(1 + g.magnification - array_distance / m.array.focal_mm[t]));
+        g.blur_mm = m.array.cell_circumradius_mm * worst;
+        g.blur_inradius_mm = m.array.cell_inradius_mm * worst;
+    }
+    g.cell_mm = m.array.cell_inradius_mm * (1 + g.magnification);
+    return g;
+}
+
+} // namespace
+
+Mat3 rotation_from_degrees(const double degrees[3])
+{
+    double sx, cx, sy, cy, sz, cz;
+    sin_cos_degrees(degrees[0], &sx, &cx);
+    sin_cos_degrees(degrees[1], &sy, &cy);
+    sin_cos_degrees(degrees[2], &sz, &cz);
+    // Column-vector forms of POV-Ray's row-vector matrices (its [1][2] = sin x is our [2][1]).
+    const Mat3 rx = {{{1, 0, 0}, {0, cx, -sx}, {0, sx, cx}}};
+    const Mat3 ry = {{{cy, 0, sy}, {0, 1, 0}, {-sy, 0, cy}}};
+    const Mat3 rz = {{{cz, -sz, 0}, {sz, cz, 0}, {0, 0, 1}}};
+    return mul(rz, mul(ry, rx));
+}
+
+double effective_main_distance_mm(const PlenopticCamera& model)
+{
+    return model.lens ? model.lens->exit_pupil_centre().z - model.array.pose.centre_mm.z : 0.0;
+}
+
+double effective_array_distance_mm(const PlenopticCamera& model)
+{
+    return model.array.pose.centre_mm.z - model.sensor.z_mm;
+}
+
+PlenopticCamera with_film(PlenopticCamera model, int width, int height)
+{
+    model.sensor.film = Film{width, height};
+    return model;
+}
+
+PlenopticCamera with_f_number(const PlenopticCamera& camera, double f_number)
+{
+    return with_film(make_camera(at_f_number(camera.spec, f_number)), camera.sensor.film.width, camera.sensor.film.height);
+}
+
+const Prescription& PlenopticCamera::prescription() const
+{
+    static const Prescription none = Prescription();
+    const Prescription* own = lens ? lens->prescription() : nullptr;
+    return own ? *own : none;
+}
+
+const ParaxialData& PlenopticCamera::paraxial() const
+{
+    static const ParaxialData none = ParaxialData();
+    const ParaxialData* own = lens ? lens->paraxial() : nullptr;
+    return own ? *own : none;
+}
+
+const std::string& PlenopticCamera::lens_file() const
+{
+    static const std::string none;
+    return lens && lens->paraxial() ? spec.main.lens_file : none;
+}
+
+PlenopticCamera make_camera(const CameraParams& params)
+{
+    PlenopticCamera m = PlenopticCamera();
+    m.spec = params;
+    m.mm_per_unit = params.mm_per_unit;
+    m.sensor.radiometry = params.radiometry;
+    m.sensor.irradiance_k_mm2 = 0;  // set once the geometry is known, below
+    m.sensor.angular_exponent = params.sensor.angular_exponent;
+
+    const MainLensParams& main = params.main;
+    m.distance_mm = main.given ? main_lens_distance_mm(main, params.mm_per_unit) : 0;
+    // A real lens's pupils and f-number are those of the aperture that limits the axial beam to the
+    // array (or sensor), D behind it.
+    m.lens = make_main_lens(main, m.distance_mm);
+    m.has_focus_distance = m.lens && main.has_focus_distance && m.lens->forms_image();
+    m.focus_distance_units = m.has_focus_distance ? main.focus_distance_units : 0;
+
+    const ArrayParams& array = params.array;
+    m.array.grid = array.given ? array.grid : GridType::None;
+    m.array.pitch_mm = 0;
+    m.array.microlens = MicrolensType::Pinhole;
+    m.array.lens_type_count = 1;
+    m.array.focal_mm[0] = m.array.focal_mm[1] = m.array.focal_mm[2] = 0;
+    m.array.distance_mm = 0;
+    m.array.cell_inradius_mm = 0;
+    m.array.cell_circumradius_mm = 0;
+
+    const double array_z = m.lens ? -m.distance_mm : 0.0;
+    const double no_rotation[3] = {0, 0, 0};
+    m.array.pose.rotation = rotation_from_degrees(m.array.grid == GridType::None ? no_rotation : array.rotate_deg);
+    m.array.pose.centre_mm = Vec3{0, 0, array_z};
+    if (m.array.grid != GridType::None) {
+        m.array.pitch_mm = array.pitch_mm;
+        m.array.microlens = array.lens;
+        if (array.lens == MicrolensType::ThinLens) {
+            m.array.lens_type_count = array.focal_length_count == 3 ? 3 : 1;
+            for (int t = 0; t < 3; ++t)
+                m.array.focal_mm[t] = array.focal_lengths_mm[m.array.lens_type_count == 3 ? t : 0];
+        }
+        m.array.distance_mm = array.distance_mm;
+        m.array.pose.centre_mm = Vec3{array.translate_mm[0], array.translate_mm[1], array_z + array.translate_mm[2]};
+        m.array.cell_inradius_mm = cell_inradius(m.array.grid, m.array.pitch_mm);
+        m.array.cell_circumradius_mm = cell_circumradius(m.array.grid, m.array.pitch_mm);
+    }
+    m.array.pose.normal = mul(m.array.pose.rotation, Vec3{0, 0, 1});
+    m.array.pose.tilted = !(m.array.pose.rotation.m[0][2] == 0 && m.array.pose.rotation.m[1][2] == 0);
+    m.array.pose.tilt_sine = std::hypot(m.array.pose.normal.x, m.array.pose.normal.y);
+
+    if (m.array.grid == GridType::None)
+        m.sensor.z_mm = -m.distance_mm;
+    else
+        m.sensor.z_mm = array_z - m.array.distance_mm;
+
+    m.sensor.irradiance_k_mm2 = irradiance_constant_mm2(m);
+
+    if (m.lens) {
+        // The lens says where light from the array's plane (or the sensor's) passes it.
+        m.pupil_bounds = m.lens->pupil_bounds(m.array.grid == GridType::None ? m.sensor.z_mm : m.array.pose.centre_mm.z);
+        if (m.pupil_bounds && m.array.grid == GridType::None)
+            m.lit_area = m.lens->lit_area(*m.pupil_bounds, m.sensor.irradiance_k_mm2, m.sensor.angular_exponent);
+    }
+
+    for (int a = 0; a < 2; ++a) {
+        m.sensor.pixel_size_mm[a] = params.sensor.pixel_size_mm[a];
+        m.sensor.offset_mm[a] = params.sensor.offset_mm[a];
+    }
+
+    // Overlap: a bound at the array centre says whether a neighbour's light can reach a
+    // microimage cell at all, and how many rings of neighbours a pixel must consider.
+    m.overlap.modelled = false;
+    m.overlap.rings = 0;
+    m.overlap.rings_capped = false;
+    if (m.array.grid != GridType::None && m.lens) {
+        const OverlapGeometry g = overlap_geometry(m);
+        const double reach = g.disc_mm + g.blur_mm;
+        if (reach > g.cell_mm) {
+            m.overlap.modelled = true;
+            const double pixel_reach = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]);
+            const double lattice_reach = (reach + pixel_reach) / (1 + g.magnification) + m.array.cell_circumradius_mm;
+            // Ring r of the lattice is at least r times this far from the own lens.
+            const double ring_step = row_spacing(m.array.grid, m.array.pitch_mm);
+            double rings = std::ceil(lattice_reach / ring_step) + (m.array.pose.tilted ? 1 : 0);
+            if (!(rings >= 1))
+                rings = 1;
+            if (!(rings <= kMaxOverlapRings)) {
+                rings = kMaxOverlapRings;
+                m.overlap.rings_capped = true;
+            }
+            m.overlap.rings = int(rings);
+        }
+    }
+
+    const SamplingParams& sampling = params.sampling;
+    m.sampling.adaptive = sampling.adaptive;
+    const int fixed_count = sampling.samples == kSamplesOmitted ? default_samples(params) : sampling.samples;
+    m.sampling.samples_min = sampling.adaptive ? sampling.samples_min : fixed_count;
+    m.sampling.samples_max = sampling.adaptive ? sampling.samples_max : fixed_count;
+    m.sampling.confidence = sampling.confidence;
+    m.sampling.variance = sampling.variance;
+    if (m.sampling.adaptive)
+        m.sampling.thresholds = adaptive_thresholds(m.sampling.samples_max, m.sampling.confidence, m.sampling.variance);
+    return m;
+}
+
+std::string limiting_aperture_warning(const PlenopticCamera& m)
+{
+    if (!m.lens || !m.lens->paraxial() || !m.paraxial().valid || m.paraxial().aperture_surface < 0)
+        return "";
+    const std::vector<LensSurface>& rows = m.prescription().surfaces;
+    const LensSurface& limiting = rows[size_t(m.paraxial().aperture_surface)];
+    if (limiting.stop)
+        return "";
+    int stop = 0;
+    while (!rows[size_t(stop)].stop)
+        ++stop;
+    return describe_surface(m.prescription(), stop, m.lens_file()) + " is written " + format_number(m.paraxial().stop_mm) +
+           " mm wide, wider than the lens can use: " +
+           describe_surface(m.prescription(), m.paraxial().aperture_surface, m.lens_file()) + ", clear aperture " +
+           format_number(limiting.aperture_mm) + " mm, limits the axial beam, so the lens works at f/" +
+           format_rounded(m.paraxial().f_number, true) + " (the stop alone would give f/" +
+           format_rounded(f_number_for_stop_diameter(m.prescription(), m.paraxial().stop_mm), true) +
+           "); the pupils, f-numbers and microimage diameter in the metadata are those of that surface. A stop of at "
+           "most " + format_rounded(m.paraxial().largest_stop_mm, false) + " mm (f_number " +
+           format_rounded(f_number_for_stop_diameter(m.prescription(), m.paraxial().largest_stop_mm), true) +
+           " or slower) limits the beam itself";
+}
+
+std::vector<std::string> warnings(const PlenopticCamera& m)
+{
+    std::vector<std::string> out;
+    const std::string aperture = limiting_aperture_warning(m);
+    if (!aperture.empty())
+        out.push_back(aperture);
+    if (m.array.grid == GridType::None)
+        return out;
+
+    const double magnification = m.lens ? effective_array_distance_mm(m) / effective_main_distance_mm(m) : 0.0;
+    const double spacing_mm = m.array.pitch_mm * (1 + magnification);
+    const double spacing_px = spacing_mm / std::max(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]);
+    if (spacing_px < 2)
+        out.push_back("microimages are only " + format_number(spacing_px) +
+                      " pixels apart (lens pitch " + format_number(m.array.pitch_mm) + " mm, pixel size " +
+                      format_number(std::max(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1])) +
+                      " mm): fewer than two pixels across leaves almost no angular resolution");
+
+    if (m.lens) {
+        const OverlapGeometry g = overlap_geometry(m);
+        // Warn about overlap a round microlens of diameter p would show too; the small spill
+        // through the cell corners of f-number-matched arrays is modelled without a warning.
+        if (g.disc_mm + g.blur_inradius_mm > g.cell_mm * (1 + 1e-9)) {
+            std::string message = "microimages overlap: light through one microlens reaches up to " +
+                                  format_number(g.disc_mm + g.blur_mm) + " mm from its microimage centre, "
+                                  "beyond its microimage cell (inradius " + format_number(g.cell_mm) +
+                                  " mm); the light of neighbouring lenses is added where they meet";
+            message += m.lens->overlap_advice(g.cell_mm - g.blur_inradius_mm, g.magnification);
+            out.push_back(message);
+        }
+    }
+    if (m.overlap.rings_capped)
+        out.push_back("microimages overlap by more than " + std::to_string(kMaxOverlapRings) +
+                      " rings of neighbouring lenses; light through lenses further away is ignored");
+    return out;
+}
+
+} // namespace plenoptic

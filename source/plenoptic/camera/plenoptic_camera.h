@@ -1,0 +1,183 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The plenoptic camera: its parts (main lens, microlens array, sensor, sampling), made once from
+// checked parameters.
+
+#ifndef PLENOPTIC_MODEL_H
+#define PLENOPTIC_MODEL_H
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "plenoptic/lens/main_lens.h"
+#include "plenoptic/core/lattice.h"
+#include "plenoptic/camera/params.h"
+#include "plenoptic/lens/lit_area.h"
+#include "plenoptic/lens/pupil_bounds.h"
+#include "plenoptic/core/vec.h"
+
+namespace plenoptic {
+
+// Most rings of neighbouring lenses whose light a pixel may receive when microimages overlap.
+const int kMaxOverlapRings = 8;
+// Lenses in that many rings of a rectangular grid (the larger of the two grids): (2*8+1)^2.
+const int kMaxOverlapLenses = (2 * kMaxOverlapRings + 1) * (2 * kMaxOverlapRings + 1);
+
+// Pose of the microlens array in the optics frame: q_optics = centre_mm + rotation * q_local.
+struct ArrayPose {
+    Mat3 rotation;   // array-local -> optics frame, Rz * Ry * Rx
+    Vec3 centre_mm;  // where the array's lens (0, 0) sits
+    Vec3 normal;     // rotation * (0, 0, 1): towards the scene
+    bool tilted;     // rotated about x or y: the array plane is not parallel to the sensor
+    double tilt_sine;// sine of the angle between the array's normal and the optical axis
+};
+
+// Above this tilt (sine of the angle, about 11.5 degrees) a pixel's overlap lenses are not pruned.
+const double kMaxPrunedTiltSine = 0.2;
+
+// The sensor's picture: its size in pixels. The scene parser knows no image size (POV-Ray's +W
+// and +H come with the render), so a model is made without one (0 x 0) and a render's camera
+// carries its own (with_film): everything that maps pixels to sensor points reads it here.
+struct Film {
+    int width;
+    int height;
+};
+
+// The microlens array as the camera holds it: its lattice, its lenses' kind and focal lengths,
+// and its pose. grid None: the camera has no array (every other field is then 0, pose identity).
+struct MicrolensArray {
+    GridType grid;
+    double pitch_mm;
+    MicrolensType microlens;
+    int lens_type_count;         // 1, or 3 for multi-focus arrays
+    double focal_mm[3];          // per lens type; 0 for pinholes
+    double distance_mm;          // d, to the sensor; 0 without array
+    ArrayPose pose;
+    double cell_inradius_mm;     // of a lens's lattice cell
+    double cell_circumradius_mm;
+    bool present() const { return grid != GridType::None; }
+};
+
+// Overlapping microimages: modelled only when the camera's geometry makes overlap possible.
+struct Overlap {
+    bool modelled;
+    int rings;                   // rings of neighbours a pixel may receive light through
+    bool rings_capped;           // the bound asked for more than kMaxOverlapRings
+};
+
+// The sensor: its picture (film), its plane and pixel grid, and what a pixel measures.
+struct Sensor {
+    Film film;                   // the picture's size in pixels (0 x 0 until with_film)
+    double z_mm;                 // -(D + d); -D without array; -d without main lens
+    double pixel_size_mm[2];
+    double offset_mm[2];
+    // What a pixel measures (camera/radiometry.h); under Irradiance each passing sample's colour
+    // is weighted by irradiance_weight with K = irradiance_k_mm2 (0 under Flat).
+    Radiometry radiometry;
+    double irradiance_k_mm2;
+    double angular_exponent;     // angular_response n: each sample also weighs cos^n(incidence)
+};
+
+// How many samples a pixel takes (fixed, or adaptive between a minimum and a maximum).
+struct Sampling {
+    bool adaptive;
+    int samples_min;             // == samples_max when not adaptive
+    int samples_max;
+    double confidence;
+    double variance;
+    std::vector<double> thresholds; // adaptive stop thresholds, index n-1 for n samples
+};
+
+struct OpticsRay;
+struct CameraSample;
+struct PixelHit;
+
+// The plenoptic camera: a main lens, an optional microlens array, a sensor with its film, and the
+// sampling settings, each part holding its own data; everything precomputed once from checked
+// parameters. The camera answers for itself (generate_ray, chief_ray, project, receives_light);
+// the functions that do the work live with their concern (camera/rays, projection/, camera/pixel)
+// and take the camera.
+//
+// Optics frame: origin at the main-lens centre (a real lens's rear vertex; the array centre when
+// there is no main lens), +z towards the scene, +x right, +y up; millimetres throughout.
+struct PlenopticCamera {
+    CameraParams spec;           // the checked parameters the camera was made from
+    double mm_per_unit;
+
+    // The main lens (it answers for its kind: lens/main_lens.h); nullptr without one. D is where
+    // this camera holds it: from its rear vertex (its plane) to the array, or to the sensor.
+    std::shared_ptr<const MainLens> lens;
+    double distance_mm;          // D; 0 without main lens
+    bool has_focus_distance;     // D came from focus_distance
+    double focus_distance_units; // as given; 0 when D was given directly
+    // Where light passes a traced real lens, for points of the sensor (no array) or of the array
+    // plane: what ray generation samples, and what the overlap bound reaches. nullptr otherwise.
+    // The lens makes it for the plane this camera puts behind it.
+    std::shared_ptr<const PupilBounds> pupil_bounds;
+    // Without an array, behind a traced lens with a round stop: the lit area of the exit pupil's
+    // plane per sensor radius (under irradiance radiometry weighted as the samples are), which
+    // replaces the per-pixel vignetting probes. nullptr otherwise.
+    std::shared_ptr<const LitAreaTable> lit_area;
+
+    MicrolensArray array;
+    Overlap overlap;
+    Sensor sensor;
+    Sampling sampling;
+
+    // What the main lens says, 0 (or empty) without one: F (a real lens's effective focal
+    // length), A (its diameter; a real lens's stop), the f-number (a real lens's: F / entrance-pupil
+    // diameter); a real lens's surfaces as used and their paraxial data, the file they came from
+    // ("" when inline), and its length from the front vertex (where the scene's location puts it)
+    // to the rear vertex (the frame's origin); a thin lens's parametric distortion (nullptr: none).
+    double focal_length_mm() const { return lens ? lens->focal_length_mm() : 0.0; }
+    double aperture_mm() const { return lens ? lens->aperture_mm() : 0.0; }
+    double f_number() const { return lens ? lens->f_number() : 0.0; }
+    const Prescription& prescription() const;
+    const ParaxialData& paraxial() const;
+    const std::string& lens_file() const;
+    double lens_length_mm() const { return paraxial().valid ? paraxial().rear_vertex_z : 0.0; }
+    const DistortionParams* distortion() const { return lens ? lens->distortion() : nullptr; }
+
+    // The camera's questions, answered where their concern lives:
+    // one sample's ray of pixel (i, j) (camera/rays.cpp: generate_ray);
+    OpticsRay generate_ray(int i, int j, const CameraSample& sample) const;
+    // the chief ray of pixel (i, j) (camera/rays.cpp: chief_ray);
+    OpticsRay chief_ray(int i, int j) const;
+    // where a scene point (optics frame, mm) images on the sensor (projection/: forward_project);
+    std::vector<PixelHit> project(Vec3 point_mm) const;
+    // whether pixel (i, j) can receive light at all (camera/pixel.h: pixel_receives_light).
+    bool receives_light(int i, int j) const;
+};
+
+// Builds the camera from parameters that passed check_camera. Pure: no image size, no state.
+PlenopticCamera make_camera(const CameraParams& params);
+
+// The same camera taking a picture of width x height pixels.
+PlenopticCamera with_film(PlenopticCamera model, int width, int height);
+// The same camera, film included, with its main lens's aperture set for f-number N (a thin lens's
+// A = F / N; a real lens's stop sized for it): what a white image at N is taken with. N must be
+// one the lens can take (check_white_image_f_numbers).
+PlenopticCamera with_f_number(const PlenopticCamera& camera, double f_number);
+
+// Legal but implausible parameters, one sentence each (empty when nothing is odd).
+std::vector<std::string> warnings(const PlenopticCamera& model);
+// The warning for a real lens whose stop, as written (no f_number or aperture), does not limit the
+// axial beam: names the stop, the limiting surface (row, line) and the f-number the lens works at;
+// "" when the stop limits it.
+std::string limiting_aperture_warning(const PlenopticCamera& model);
+
+// Rotation about x, then y, then z, in degrees: v -> Rz * Ry * Rx * v, with the same
+// matrices as POV-Ray's Compute_Rotation_Transform (which applies them to row vectors).
+// Multiples of 90 degrees are exact.
+Mat3 rotation_from_degrees(const double degrees[3]);
+
+// Main-lens -> array and array -> sensor distances measured at the array centre, including the
+// array's z translation. The first is measured from the main lens's exit-pupil centre, from which
+// microimage centres are projected (the lens's plane for a thin lens, the pinhole); without a main
+// lens it is 0.
+double effective_main_distance_mm(const PlenopticCamera& model);
+double effective_array_distance_mm(const PlenopticCamera& model);
+
+} // namespace plenoptic
+
+#endif
