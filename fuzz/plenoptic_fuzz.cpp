@@ -377,7 +377,12 @@ void check_origin(const PlenopticCamera& m, const OpticsRay& r, int i, int j)
                     o.x, o.y, o.z);
     } else if (lens_kind(m) == "thin_lens") {
         FUZZ_ASSERT(o.z == 0, "pixel (%d, %d): origin z %.17g off the main-lens plane", i, j, o.z);
-        FUZZ_ASSERT(std::hypot(o.x, o.y) <= 0.5 * m.aperture_mm() * (1 + 1e-12),
+        // The origin is where the line from the sensor point crosses the lens plane: it rounds at
+        // the sensor's magnitudes (a sensor offset of 1e9 mm moves it by 1e-7 mm).
+        const double sensor_scale = std::fabs(m.sensor.offset_mm[0]) + std::fabs(m.sensor.offset_mm[1]) +
+                                    m.sensor.film.width * m.sensor.pixel_size_mm[0] +
+                                    m.sensor.film.height * m.sensor.pixel_size_mm[1] + std::fabs(m.sensor.z_mm);
+        FUZZ_ASSERT(std::hypot(o.x, o.y) <= 0.5 * m.aperture_mm() * (1 + 1e-12) + 1e-15 * sensor_scale,
                     "pixel (%d, %d): origin (%g, %g) outside the aperture %.17g", i, j, o.x, o.y, m.aperture_mm());
     } else {
         const Vec3 local = mul_transposed(m.array.pose.rotation, o - m.array.pose.centre_mm);
