@@ -161,7 +161,7 @@ void count_pixel(const PlenopticCamera& m, int i, int j, int samples, double rea
         if (ray.passed)
             ++c->passed;
         if (m.array.grid == GridType::None && rear_radius_mm > 0) {
-            const Vec3 p = sensor_point(m, i + s.pixel_u, j + s.pixel_v);
+            const Vec3 p = m.sensor.point(i + s.pixel_u, j + s.pixel_v);
             const Vec2 d = concentric_disc(s.lens_u, s.lens_v);
             const Vec3 on_rear{rear_radius_mm * d.x, rear_radius_mm * d.y, 0};
             ++c->unbounded_generated;
@@ -276,7 +276,7 @@ int main(int argc, char** argv)
         for (int j = p.j0; j < p.j0 + patch; ++j)
             for (int i = p.i0; i < p.i0 + patch; ++i)
                 count_pixel(m, i, j, o.samples, unbounded ? rear_radius : 0, &block);
-        const Vec3 at = sensor_point(m, p.i + 0.5, p.j + 0.5);
+        const Vec3 at = m.sensor.point(p.i + 0.5, p.j + 0.5);
         std::printf("  {\"place\": \"%s\", \"pixel\": [%d, %d], \"field_radius_mm\": %.6f,\n", p.name, p.i, p.j,
                     std::hypot(at.x, at.y));
         std::printf("   \"pixel_counts\": %s,\n", counts_json(pixel, unbounded).c_str());
@@ -294,7 +294,7 @@ int main(int argc, char** argv)
         for (int j = j0; j < j0 + patch; ++j)
             for (int i = i0; i < i0 + patch; ++i)
                 count_pixel(m, i, j, o.samples, unbounded ? rear_radius : 0, &block);
-        const Vec3 at = sensor_point(m, i0 + 0.5 * patch, j0 + 0.5 * patch);
+        const Vec3 at = m.sensor.point(i0 + 0.5 * patch, j0 + 0.5 * patch);
         std::printf("  {\"patch_first_pixel\": [%d, %d], \"field_radius_mm\": %.6f, \"patch_counts\": %s}%s\n", i0, j0,
                     std::hypot(at.x, at.y), counts_json(block, unbounded).c_str(), k < kProfile ? "," : "");
     }

@@ -438,7 +438,7 @@ void read_all(const Json& root, RenderMetadata* out)
                 "the distances (main_lens.distance_mm, microlens_array.distance_mm, translate_mm)");
     double principal[2];
     numbers(root, "", "principal_point_px", 2, false, principal);
-    const Vec2 pp = principal_point_px(m);
+    const Vec2 pp = m.sensor.principal_point_px();
     check_close("principal_point_px[0]", principal[0], pp.x, out->width + 1.0, "image.width and sensor.offset_mm");
     check_close("principal_point_px[1]", principal[1], pp.y, out->height + 1.0, "image.height and sensor.offset_mm");
     const Json& lattice = member(root, "", "microimage_lattice");

@@ -92,7 +92,7 @@ TEST(OpticsExtremes, ThinMainLensRaysMeetAtTheConjugateFromFocalLength1e6To1e_6)
             params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = F * 1e-3;  // ~0.01 rad per pixel
             ASSERT_EQ(check_camera(params), "") << describe(params);
             const PlenopticCamera m = with_film(make_camera(params), W, H);
-            const Vec3 p = sensor_point(m, i + 0.5, j + 0.5);
+            const Vec3 p = m.sensor.point(i + 0.5, j + 0.5);
             // Independently, with divisions (the code under test has none): the image of p.
             const double u = 1 / (1 / F - 1 / m.distance_mm);
             const Vec3 conjugate{-p.x * u / m.distance_mm, -p.y * u / m.distance_mm, u};
@@ -122,7 +122,7 @@ TEST(OpticsExtremes, SensorAtTheFocalPlaneGivesParallelRaysAtEveryScale)
         CameraParams params = thin_main(F, 1.4, F);  // D = F exactly
         params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = F * 1e-3;
         const PlenopticCamera m = with_film(make_camera(params), W, H);
-        const Vec3 expected = normalized(-sensor_point(m, i + 0.5, j + 0.5));
+        const Vec3 expected = normalized(-m.sensor.point(i + 0.5, j + 0.5));
         for (const OpticsRay& r : rays_of_point(m, i, j, 64))
             EXPECT_LT(length(dir_of(r) - expected), 1e-14) << describe(params) << " " << str(dir_of(r));
     }
@@ -187,7 +187,7 @@ TEST(OpticsExtremes, PlenopticRaysOfASensorPointMeetAtTheSystemConjugate)
             const PlenopticCamera m = with_film(make_camera(params), W, H);
             int met = 0;
             for (const auto& px : pixels) {
-                const Vec3 p = sensor_point(m, px[0] + 0.5, px[1] + 0.5);
+                const Vec3 p = m.sensor.point(px[0] + 0.5, px[1] + 0.5);
                 const OwnLens lens_lookup = own_lens(m, p);
                 ASSERT_TRUE(lens_lookup.found);
                 const LensIndex lens = lens_lookup.lens;
@@ -225,7 +225,7 @@ TEST(OpticsExtremes, BareArrayRaysMeetAtTheMicrolensConjugateEvenTiltedNearlyEdg
                 const double* deg = params.array.rotate_deg;
                 for (int i : {5, 20, 37}) {
                     const int j = (i * 7) % H;
-                    const Vec3 p = sensor_point(m, i + 0.5, j + 0.5);
+                    const Vec3 p = m.sensor.point(i + 0.5, j + 0.5);
                     const OwnLens lens_lookup = own_lens(m, p);
                     if (!lens_lookup.found)
                         continue;

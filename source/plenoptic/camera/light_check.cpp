@@ -30,7 +30,7 @@ double lit_fraction_near_axis(const PlenopticCamera& camera)
     }
     // The camera taking a picture of just the patch.
     const PlenopticCamera model = with_film(camera, patch, patch);
-    const Vec2 axis = principal_point_px(model);
+    const Vec2 axis = model.sensor.principal_point_px();
     if (!std::isfinite(axis.x) || !std::isfinite(axis.y))
         return 0;
     const int i0 = int(std::floor(axis.x)) - patch / 2, j0 = int(std::floor(axis.y)) - patch / 2;

@@ -148,7 +148,7 @@ inline double mean_lit_area(const PlenopticCamera& model, int i, int j)
     double total = 0;
     for (int b = 0; b < kLitAreaGrid; ++b)
         for (int a = 0; a < kLitAreaGrid; ++a)
-            total += model.lit_area->at(sensor_point(model, i + (a + 0.5) / kLitAreaGrid, j + (b + 0.5) / kLitAreaGrid));
+            total += model.lit_area->at(model.sensor.point(i + (a + 0.5) / kLitAreaGrid, j + (b + 0.5) / kLitAreaGrid));
     return total / (kLitAreaGrid * kLitAreaGrid);
 }
 

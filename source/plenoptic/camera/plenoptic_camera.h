@@ -65,6 +65,13 @@ struct Overlap {
     bool rings_capped;           // the bound asked for more than kMaxOverlapRings
 };
 
+// A point of the picture in the centre convention used by the metadata (pixel (i, j)'s centre is
+// at (u, v) = (i, j)), and whether it lies inside the image.
+struct PixelPoint {
+    double u, v;
+    bool inside;
+};
+
 // The sensor: its picture (film), its plane and pixel grid, and what a pixel measures.
 struct Sensor {
     Film film;                   // the picture's size in pixels (0 x 0 until with_film)
@@ -76,6 +83,15 @@ struct Sensor {
     Radiometry radiometry;
     double irradiance_k_mm2;
     double angular_exponent;     // angular_response n: each sample also weighs cos^n(incidence)
+
+    // Point on the sensor (optics frame, mm) at continuous pixel coordinates (pu, pv), where pixel
+    // (i, j) spans [i, i+1) x [j, j+1); (i + 0.5, j + 0.5) is its centre:
+    //   x = -(pu - W/2) * sx + ox,  y = (pv - H/2) * sy + oy,  z = sensor plane.
+    Vec3 point(double pu, double pv) const;
+    // The inverse, in the centre convention.
+    PixelPoint to_pixel(double x_mm, double y_mm) const;
+    // Where the optical axis meets the sensor, centre convention.
+    Vec2 principal_point_px() const;
 };
 
 // How many samples a pixel takes (fixed, or adaptive between a minimum and a maximum).

@@ -212,24 +212,24 @@ bool lens_reaches_pixel(const PlenopticCamera& m, LensIndex lens, Vec3 p)
 
 } // namespace
 
-Vec3 sensor_point(const PlenopticCamera& m, double pu, double pv)
+Vec3 Sensor::point(double pu, double pv) const
 {
-    const int W = m.sensor.film.width, H = m.sensor.film.height;
-    return Vec3{-(pu - 0.5 * W) * m.sensor.pixel_size_mm[0] + m.sensor.offset_mm[0],
-                (pv - 0.5 * H) * m.sensor.pixel_size_mm[1] + m.sensor.offset_mm[1], m.sensor.z_mm};
+    const int W = film.width, H = film.height;
+    return Vec3{-(pu - 0.5 * W) * pixel_size_mm[0] + offset_mm[0], (pv - 0.5 * H) * pixel_size_mm[1] + offset_mm[1],
+                z_mm};
 }
 
-PixelPoint sensor_to_pixel(const PlenopticCamera& m, double x_mm, double y_mm)
+PixelPoint Sensor::to_pixel(double x_mm, double y_mm) const
 {
-    const int W = m.sensor.film.width, H = m.sensor.film.height;
-    const double u = 0.5 * W - 0.5 - (x_mm - m.sensor.offset_mm[0]) / m.sensor.pixel_size_mm[0];
-    const double v = 0.5 * H - 0.5 + (y_mm - m.sensor.offset_mm[1]) / m.sensor.pixel_size_mm[1];
+    const int W = film.width, H = film.height;
+    const double u = 0.5 * W - 0.5 - (x_mm - offset_mm[0]) / pixel_size_mm[0];
+    const double v = 0.5 * H - 0.5 + (y_mm - offset_mm[1]) / pixel_size_mm[1];
     return PixelPoint{u, v, u >= -0.5 && u < W - 0.5 && v >= -0.5 && v < H - 0.5};
 }
 
-Vec2 principal_point_px(const PlenopticCamera& m)
+Vec2 Sensor::principal_point_px() const
 {
-    const PixelPoint p = sensor_to_pixel(m, 0, 0);
+    const PixelPoint p = to_pixel(0, 0);
     return Vec2{p.u, p.v};
 }
 
@@ -249,7 +249,7 @@ OwnLens own_lens(const PlenopticCamera& m, Vec3 p)
 
 OpticsRay generate_ray(const PlenopticCamera& m, int i, int j, const CameraSample& sample, const LensIndex* lens)
 {
-    const Vec3 p = sensor_point(m, i + sample.pixel_u, j + sample.pixel_v);
+    const Vec3 p = m.sensor.point(i + sample.pixel_u, j + sample.pixel_v);
     OpticsRay ray;
     ray.passed = trace_sensor_point(m, p, lens, sample.lens_u, sample.lens_v, true, &ray);
     return ray;
@@ -259,7 +259,7 @@ int overlap_lenses(const PlenopticCamera& m, int i, int j, LensIndex* out, int c
 {
     if (capacity < 1 || m.array.grid == GridType::None)
         return 0;
-    const Vec3 p = sensor_point(m, i + 0.5, j + 0.5);
+    const Vec3 p = m.sensor.point(i + 0.5, j + 0.5);
     const OwnLens lookup = own_lens(m, p);
     if (!lookup.found)
         return 0;
@@ -291,7 +291,7 @@ int overlap_lenses(const PlenopticCamera& m, int i, int j, LensIndex* out, int c
 OpticsRay chief_ray_through(const PlenopticCamera& m, double pu, double pv, const LensIndex* lens)
 {
     OpticsRay ray;
-    ray.passed = trace_sensor_point(m, sensor_point(m, pu, pv), lens, 0.5, 0.5, false, &ray);
+    ray.passed = trace_sensor_point(m, m.sensor.point(pu, pv), lens, 0.5, 0.5, false, &ray);
     return ray;
 }
 
@@ -300,7 +300,7 @@ OpticsRay chief_ray(const PlenopticCamera& m, int i, int j)
     OpticsRay ray = chief_ray_through(m, i + 0.5, j + 0.5);
     if (ray.passed)
         return ray;
-    const Vec3 p = sensor_point(m, i + 0.5, j + 0.5);
+    const Vec3 p = m.sensor.point(i + 0.5, j + 0.5);
     const Vec3 e = m.lens ? m.lens->exit_pupil_centre() : Vec3{0, 0, 0};
     ray.passed = finish(e, e - p, &ray) || finish(e, Vec3{0, 0, 1}, &ray);
     return ray;

@@ -28,24 +28,6 @@ struct OpticsRay {
     bool passed;
 };
 
-// Point on the sensor (optics frame, mm) at continuous pixel coordinates (pu, pv), where pixel
-// (i, j) spans [i, i+1) x [j, j+1); (i + 0.5, j + 0.5) is its centre:
-//   x = -(pu - W/2) * sx + ox,  y = (pv - H/2) * sy + oy,  z = sensor plane.
-Vec3 sensor_point(const PlenopticCamera& model, double pu, double pv);
-
-// A point of the picture in the centre convention used by the metadata (pixel (i, j)'s centre is
-// at (u, v) = (i, j)), and whether it lies inside the image.
-struct PixelPoint {
-    double u, v;
-    bool inside;
-};
-
-// Inverse of sensor_point, in the centre convention.
-PixelPoint sensor_to_pixel(const PlenopticCamera& model, double x_mm, double y_mm);
-
-// Where the optical axis meets the sensor, centre convention.
-Vec2 principal_point_px(const PlenopticCamera& model);
-
 // Centre of a lens in the optics frame (posed array), mm.
 Vec3 lens_centre_mm(const PlenopticCamera& model, LensIndex lens);
 

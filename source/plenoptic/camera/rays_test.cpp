@@ -36,16 +36,16 @@ TEST(Optics, SensorPointConvention)
     const PlenopticCamera m = make_camera(p);
     const int W = 640, H = 480;
     // Pixel (i, j)'s centre: x = -((i + 0.5) - W/2) sx + ox, y = ((j + 0.5) - H/2) sy + oy.
-    const Vec3 c = sensor_point(with_film(m, W, H), 10 + 0.5, 20 + 0.5);
+    const Vec3 c = with_film(m, W, H).sensor.point(10 + 0.5, 20 + 0.5);
     EXPECT_DOUBLE_EQ(c.x, -((10 + 0.5) - 320) * 0.01 + 0.3);
     EXPECT_DOUBLE_EQ(c.y, ((20 + 0.5) - 240) * 0.02 - 0.1);
     EXPECT_DOUBLE_EQ(c.z, -52);
-    const PixelPoint px = sensor_to_pixel(with_film(m, W, H), c.x, c.y);
+    const PixelPoint px = with_film(m, W, H).sensor.to_pixel(c.x, c.y);
     EXPECT_TRUE(px.inside);
     const double u = px.u, v = px.v;
     EXPECT_NEAR(u, 10, 1e-9);
     EXPECT_NEAR(v, 20, 1e-9);
-    const Vec2 principal = principal_point_px(with_film(m, W, H));
+    const Vec2 principal = with_film(m, W, H).sensor.principal_point_px();
     EXPECT_NEAR(principal.x, 319.5 + 30, 1e-9);
     EXPECT_NEAR(principal.y, 239.5 + 5, 1e-9);
 }
@@ -91,7 +91,7 @@ TEST(Optics, RaysFromASensorPointMeetAtTheThinLensConjugate)
     const double F = 50, D = 60;
     const PlenopticCamera m = make_camera(thin_lens_camera(F, 2.8, D));
     const int W = 101, H = 101, i = 10, j = 80;
-    const Vec3 p = sensor_point(with_film(m, W, H), i + 0.5, j + 0.5);
+    const Vec3 p = with_film(m, W, H).sensor.point(i + 0.5, j + 0.5);
     // Independently: 1/u = 1/F - 1/D, lateral magnification -u/D.
     const double u = 1 / (1 / F - 1 / D);
     const Vec3 conjugate{-p.x * u / D, -p.y * u / D, u};
@@ -114,7 +114,7 @@ TEST(Optics, SensorAtTheFocalPlaneGivesParallelRays)
     const double F = 50;
     const PlenopticCamera m = make_camera(thin_lens_camera(F, 2.8, F));  // D = F exactly
     const int W = 101, H = 101, i = 3, j = 77;
-    const Vec3 p = sensor_point(with_film(m, W, H), i + 0.5, j + 0.5);
+    const Vec3 p = with_film(m, W, H).sensor.point(i + 0.5, j + 0.5);
     const Vec3 expected = normalized(-p);
     for (int n = 0; n < 100; ++n) {
         CameraSample s = make_sample(i, j, n, 100);
@@ -135,7 +135,7 @@ void check_microlens_conjugate(double f, double d, const double pose_deg[3])
     ASSERT_EQ(check_camera(params), "");
     const PlenopticCamera m = make_camera(params);
     const int W = 200, H = 200, i = 120, j = 61;
-    const Vec3 p = sensor_point(with_film(m, W, H), i + 0.5, j + 0.5);
+    const Vec3 p = with_film(m, W, H).sensor.point(i + 0.5, j + 0.5);
     // Lens and distances in the array's frame, computed here with the reference rotation.
     const Vec3 centre = m.array.pose.centre_mm;
     const Vec3 n = test::reference_rotate(pose_deg, Vec3{0, 0, 1});
@@ -326,7 +326,7 @@ TEST(Optics, PixelToRayToSensorRoundTrip)
                         continue;
                     std::string failure;
                     const Vec3 back = trace_back(m, c.params, ray, &failure);
-                    const Vec3 start = sensor_point(m, i + s.pixel_u, j + s.pixel_v);
+                    const Vec3 start = m.sensor.point(i + s.pixel_u, j + s.pixel_v);
                     EXPECT_TRUE(failure.empty()) << c.name << ": " << failure;
                     worst = std::max(worst, length(back - start));
                     EXPECT_LT(length(back - start), 1e-9) << c.name << " pixel " << i << "," << j << " sample " << n
@@ -426,7 +426,7 @@ TEST(Optics, OverlapLensesListsTheOwnLensFirst)
     const PlenopticCamera apart = with_film(make_camera(plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 10, 50)), W, H);
     LensIndex lenses[kMaxOverlapLenses];
     EXPECT_EQ(overlap_lenses(apart, 10, 20, lenses, kMaxOverlapLenses), 1);
-    const OwnLens own_lookup = own_lens(apart, sensor_point(apart, 10.5, 20.5));
+    const OwnLens own_lookup = own_lens(apart, apart.sensor.point(10.5, 20.5));
     ASSERT_TRUE(own_lookup.found);
     const LensIndex own = own_lookup.lens;
     EXPECT_EQ(lenses[0], own);

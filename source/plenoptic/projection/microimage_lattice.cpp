@@ -28,7 +28,7 @@ bool local_to_px(const PlenopticCamera& m, Vec2 local, Vec2* px)
         x = e.x + (c.x - e.x) * s;
         y = e.y + (c.y - e.y) * s;
     }
-    const PixelPoint p = sensor_to_pixel(m, x, y);
+    const PixelPoint p = m.sensor.to_pixel(x, y);
     *px = Vec2{p.u, p.v};
     return is_finite(*px);
 }
@@ -92,7 +92,7 @@ void fit_lftoolbox(const PlenopticCamera& m, MicroimageLattice* lattice)
     // The lenslet at (row 1, col 1).
     const double first_shift = shift_row == 1 ? h_spacing / 2 : 0.0;
     const double first_u = offset.x + first_shift * e.x - 1, first_v = offset.y + first_shift * e.y - 1;
-    const OwnLens first_lookup = own_lens(m, sensor_point(m, first_u + 0.5, first_v + 0.5));
+    const OwnLens first_lookup = own_lens(m, m.sensor.point(first_u + 0.5, first_v + 0.5));
     if (!first_lookup.found)
         return;
     const LensIndex first = first_lookup.lens;

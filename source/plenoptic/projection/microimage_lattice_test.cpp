@@ -67,7 +67,7 @@ void check_lftoolbox(GridType grid, double rotate_z, double offset_x, double tx)
             const double x = c * uu - s * vv + lattice.h_offset;  // 1-based
             const double y = s * uu + c * vv + lattice.v_offset;
             const double u = x - 1, v = y - 1;
-            const OwnLens lens_lookup = own_lens(m, sensor_point(with_film(m, W, H), u + 0.5, v + 0.5));
+            const OwnLens lens_lookup = own_lens(m, with_film(m, W, H).sensor.point(u + 0.5, v + 0.5));
             ASSERT_TRUE(lens_lookup.found);
             const LensIndex lens = lens_lookup.lens;
             double cu, cv;

@@ -54,7 +54,7 @@ bool within_rings(const PlenopticCamera& m, LensIndex a, LensIndex b, int rings)
 std::vector<Vec2> picture_polygon(const PlenopticCamera& m)
 {
     const int W = m.sensor.film.width, H = m.sensor.film.height;
-    const Vec3 a = sensor_point(m, 0, 0), b = sensor_point(m, W, H);
+    const Vec3 a = m.sensor.point(0, 0), b = m.sensor.point(W, H);
     return std::vector<Vec2>{Vec2{a.x, a.y}, Vec2{b.x, a.y}, Vec2{b.x, b.y}, Vec2{a.x, b.y}};
 }
 
@@ -79,7 +79,7 @@ std::vector<Vec2> microimage_cell(const PlenopticCamera& m, LensIndex lens)
 
 bool delivered_point(const PlenopticCamera& m, LensIndex lens, Vec2 s)
 {
-    if (!sensor_to_pixel(m, s.x, s.y).inside)
+    if (!m.sensor.to_pixel(s.x, s.y).inside)
         return false;
     const OwnLens owner = own_lens(m, Vec3{s.x, s.y, m.sensor.z_mm});
     return owner.found && within_rings(m, owner.lens, lens, receiving_rings(m));
@@ -89,7 +89,7 @@ void add_point_hit(const PlenopticCamera& m, LensIndex lens, Vec3 s, double frac
 {
     if (!delivered_point(m, lens, Vec2{s.x, s.y}))
         return;
-    const PixelPoint px = sensor_to_pixel(m, s.x, s.y);
+    const PixelPoint px = m.sensor.to_pixel(s.x, s.y);
     hits->push_back(PixelHit{lens, px.u, px.v, fraction});
 }
 
@@ -188,7 +188,7 @@ Box sensor_box(const PlenopticCamera& m)
     const double corners[4][2] = {{0, 0}, {double(W), 0}, {0, double(H)}, {double(W), double(H)}};
     for (int i = 0; i < 4; ++i) {
         Vec2 q;
-        if (!project_to_array(m, sensor_point(m, corners[i][0], corners[i][1]), &q))
+        if (!project_to_array(m, m.sensor.point(corners[i][0], corners[i][1]), &q))
             return Box{false, 0, 0, 0, 0};
         include(&box, q);
     }
@@ -448,7 +448,7 @@ void add_spot_hit(const PlenopticCamera& m, LensIndex lens, const std::vector<Ve
     const double kept = delivered_area(m, lens, light, &centroid);
     if (!(kept > 0))
         return;
-    const PixelPoint px = sensor_to_pixel(m, centroid.x, centroid.y);
+    const PixelPoint px = m.sensor.to_pixel(centroid.x, centroid.y);
     if (!px.inside)
         return;  // only by rounding, for light along the picture's edge
     hits->push_back(PixelHit{lens, px.u, px.v, fraction * std::min(1.0, kept / area)});
@@ -668,7 +668,7 @@ std::vector<PixelHit> forward_project(const PlenopticCamera& m, Vec3 point)
             return hits;
         // Pinhole, or the chief ray of a thin lens (the centre of its blur disc).
         const double s = m.sensor.z_mm / point.z;
-        const PixelPoint px = sensor_to_pixel(m, point.x * s, point.y * s);
+        const PixelPoint px = m.sensor.to_pixel(point.x * s, point.y * s);
         if (px.inside)
             hits.push_back(PixelHit{LensIndex{0, 0}, px.u, px.v, 1.0});
         return hits;

@@ -104,7 +104,7 @@ void check_forward_then_chief(const char* name, CameraParams params, int min_mul
                                       << miss << " mm";
             // The hit lies in that lens's microimage cell or, where overlap is modelled, in the cell
             // of a lens within overlap_rings rings of it (the pixels that receive its light).
-            const OwnLens owner_lookup = own_lens(m, sensor_point(with_film(m, W, H), hit.u + 0.5, hit.v + 0.5));
+            const OwnLens owner_lookup = own_lens(m, with_film(m, W, H).sensor.point(hit.u + 0.5, hit.v + 0.5));
             ASSERT_TRUE(owner_lookup.found);
             const LensIndex owner = owner_lookup.lens;
             if (!m.overlap.modelled) {

@@ -331,7 +331,7 @@ std::vector<PixelHit> forward_project_traced(const PlenopticCamera& m, Vec3 poin
         const LensLight& spot = light.lenses[RowKey(0, 0)];
         if (!(spot.weight > 0))
             return hits;
-        const PixelPoint px = sensor_to_pixel(m, spot.sx / spot.weight, spot.sy / spot.weight);
+        const PixelPoint px = m.sensor.to_pixel(spot.sx / spot.weight, spot.sy / spot.weight);
         if (px.inside)
             hits.push_back(PixelHit{LensIndex{0, 0}, px.u, px.v, 1.0});
         return hits;
@@ -351,7 +351,7 @@ std::vector<PixelHit> forward_project_traced(const PlenopticCamera& m, Vec3 poin
         }
         if (!(acc.weight > 0))
             continue;
-        const PixelPoint px = sensor_to_pixel(m, acc.sx / acc.weight, acc.sy / acc.weight);
+        const PixelPoint px = m.sensor.to_pixel(acc.sx / acc.weight, acc.sy / acc.weight);
         if (px.inside)
             hits.push_back(PixelHit{lens, px.u, px.v, std::min(1.0, acc.weight / total)});
     }

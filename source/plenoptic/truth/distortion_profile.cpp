@@ -126,7 +126,7 @@ DistortionProfile distortion_profile(const PlenopticCamera& m, int count)
     double largest = 0;
     const double corners[4][2] = {{0, 0}, {double(W), 0}, {0, double(H)}, {double(W), double(H)}};
     for (const auto& corner : corners) {
-        const Vec3 s = sensor_point(m, corner[0], corner[1]);
+        const Vec3 s = m.sensor.point(corner[0], corner[1]);
         largest = std::max(largest, std::hypot(s.x, s.y));
     }
 

@@ -373,7 +373,7 @@ std::string metadata_json(const PlenopticCamera& m, const CameraParams& params, 
     json["samples"] = samples;
     json["diffraction"] = diffraction_json(diffraction_of(m, params.diffraction), params.diffraction, m);
 
-    const Vec2 principal = principal_point_px(m);
+    const Vec2 principal = m.sensor.principal_point_px();
     const double principal_px[2] = {principal.x, principal.y};
     json["principal_point_px"] = numbers(principal_px, 2);
 

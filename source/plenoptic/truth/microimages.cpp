@@ -52,7 +52,7 @@ public:
         if (m_.overlap.modelled)
             return true;
         // Without overlap modelling the renderer gives a sensor point the light of its own lens only.
-        const OwnLens own = own_lens(m_, sensor_point(m_, u, v));
+        const OwnLens own = own_lens(m_, m_.sensor.point(u, v));
         return own.found && own.lens == lens_;
     }
 
@@ -148,7 +148,7 @@ bool project_to_sensor_px(const PlenopticCamera& m, Vec3 q, Vec2* px)
     if (!(q.z < e.z))
         return false;
     const double t = (m.sensor.z_mm - e.z) / (q.z - e.z);
-    const PixelPoint p = sensor_to_pixel(m, e.x + t * (q.x - e.x), e.y + t * (q.y - e.y));
+    const PixelPoint p = m.sensor.to_pixel(e.x + t * (q.x - e.x), e.y + t * (q.y - e.y));
     *px = Vec2{p.u, p.v};
     return is_finite(*px);
 }
@@ -211,7 +211,7 @@ Guess guess_region(const PlenopticCamera& m, LensIndex lens, double lens_u, doub
         wy += shift.y;
     }
     Guess guess{true, 0, 0, disc.radius * drop / along / pixel};
-    const PixelPoint centre = sensor_to_pixel(m, h.x - drop * wx, h.y - drop * wy);
+    const PixelPoint centre = m.sensor.to_pixel(h.x - drop * wx, h.y - drop * wy);
     guess.u = centre.u;
     guess.v = centre.v;
     guess.u += 0.5;
@@ -230,7 +230,7 @@ bool picture_on_array(const PlenopticCamera& m, double box[4])
     const double corners[4][2] = {{0, 0}, {double(W), 0}, {0, double(H)}, {double(W), double(H)}};
     for (const auto& corner : corners) {
         Vec2 q;
-        if (!project_to_array(m, sensor_point(m, corner[0], corner[1]), &q))
+        if (!project_to_array(m, m.sensor.point(corner[0], corner[1]), &q))
             return false;
         box[0] = std::min(box[0], q.x);
         box[1] = std::min(box[1], q.y);
