@@ -145,7 +145,7 @@ std::string check_thin_lens(const MainLensParams& main, double mm_per_unit)
     if (!main.has_focus_distance && !main.has_distance)
         return "main_lens thin_lens needs focus_distance (scene units) or distance (D in mm)";
     if (main.has_f_number) {
-        const double aperture = main.focal_length_mm / main.f_number;
+        const double aperture = thin_lens_aperture_mm(main);  // F / N: the aperture is not given
         // The same range as a given aperture: beyond it the aperture's area overflows.
         if (!(aperture >= kMinLengthMm && aperture <= kMaxLengthMm))
             return "main_lens: focal_length " + format_number(main.focal_length_mm) + " mm / f_number " +

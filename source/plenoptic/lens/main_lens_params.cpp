@@ -42,7 +42,7 @@ std::shared_ptr<const MainLens> make_main_lens(const MainLensParams& p, double d
     case MainLensType::Pinhole:
         return make_pinhole_lens();
     case MainLensType::ThinLens: {
-        const double aperture = p.has_aperture ? p.aperture_mm : p.focal_length_mm / p.f_number;
+        const double aperture = thin_lens_aperture_mm(p);
         const double f_number = p.has_f_number ? p.f_number : p.focal_length_mm / aperture;
         return make_thin_lens(p.focal_length_mm, aperture, f_number, p.has_distortion ? &p.distortion : nullptr,
                               -distance_mm);

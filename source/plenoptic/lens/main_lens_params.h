@@ -67,6 +67,12 @@ inline bool has_sized_aperture(const MainLensParams& main)
 // stop at the diameter that `aperture` or `f_number` asks for (as written when neither is given).
 Prescription effective_prescription(const MainLensParams& main);
 
+// A thin lens's aperture diameter A: as given, or F / N (the one place it is derived).
+inline double thin_lens_aperture_mm(const MainLensParams& main)
+{
+    return main.has_aperture ? main.aperture_mm : main.focal_length_mm / main.f_number;
+}
+
 // D for a main lens whose block passed check_main_lens: as given, or the paraxial image distance
 // of focus_distance (thin lens: F z / (z - F); prescription: from its rear vertex).
 double main_lens_distance_mm(const MainLensParams& main, double mm_per_unit);
