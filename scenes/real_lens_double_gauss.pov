@@ -4,8 +4,9 @@
 // p. 312), traced surface by surface near full aperture on a 36 x 24 mm sensor (render
 // +W480 +H320), no array: shallow depth of field (focused on the sphere 2.5 m away; the wall
 // behind and the floor in front blur), the vignetting of the clear apertures in the corners.
-// f_number 2.1: with its printed clear apertures the lens reaches f/2.073 (surface 3's rim cuts
-// the axial beam first; lenses/README.md), so the printed f/2 is refused.
+// f_number 2.1: with its printed clear apertures surface 3's rim cuts the axial beam before the
+// stop at f/2.073 focused at infinity, about f/2.06 at 2.5 m (lenses/README.md), so the printed f/2
+// is refused.
 // location is the front vertex of the lens.
 #version 3.7;
 global_settings { assumed_gamma 1 }

@@ -79,7 +79,7 @@ const std::vector<Published> kPublished = {
     // Double-Gauss, Tronnier, US 2,673,491, MLD p. 312, x 0.5. EFL 50.3582 mm: 0.72 % (0.358 mm)
     // above the nominal 50 mm (the book's table traces to 100.716 for its 100). Printed stop
     // 17.1 mm: f/2.030 (printed f/2). At full aperture surface 3's rim, not the stop, limits the
-    // axial beam to first order (the lens reaches f/2.073; lenses/README.md).
+    // axial beam to first order (the fastest f_number it accepts is 2.073 focused at infinity).
     {"double_gauss_50mm_tronnier_f2.dat", "Tronnier, US 2,673,491; Smith, Modern Lens Design p. 312, f/2",
      50.3582, 0.00005, 36.1059, 0.00005, 2.0, sixth_of_a_stop(2.0), 50.0, 0.5},
 
