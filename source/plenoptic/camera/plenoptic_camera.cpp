@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plenoptic/core/json.h"
 #include "plenoptic/core/lattice.h"
 #include "plenoptic/camera/radiometry.h"
 #include "plenoptic/core/sampling.h"
@@ -116,6 +117,33 @@ const std::string& PlenopticCamera::lens_file() const
 {
     static const std::string none;
     return lens && lens->paraxial() ? spec.main.lens_file : none;
+}
+
+MetadataJson Sensor::metadata(double projected_solid_angle_sr, const SensorChainParams& chain,
+                              const std::string& raw_file) const
+{
+    MetadataJson json = MetadataJson::object();
+    json["pixel_size_mm"] = json_numbers(pixel_size_mm, 2);
+    json["offset_mm"] = json_numbers(offset_mm, 2);
+    json["plane_z_mm"] = json_number(z_mm);
+    MetadataJson measures = MetadataJson::object();
+    measures["model"] = radiometry_name(radiometry);
+    measures["projected_solid_angle_sr"] = json_number_or_null(projected_solid_angle_sr > 0, projected_solid_angle_sr);
+    measures["angular_response"] = json_number(angular_exponent);
+    json["radiometry"] = measures;
+    json["read_out"] = read_out_metadata(chain, raw_file);
+    return json;
+}
+
+MetadataJson Sampling::metadata() const
+{
+    MetadataJson json = MetadataJson::object();
+    json["adaptive"] = adaptive;
+    json["min"] = samples_min;
+    json["max"] = samples_max;
+    json["confidence"] = json_number(confidence);
+    json["variance"] = json_number(variance);
+    return json;
 }
 
 PlenopticCamera make_camera(const CameraParams& params)

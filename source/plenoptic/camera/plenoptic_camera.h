@@ -15,6 +15,7 @@
 #include "plenoptic/lens/lit_area.h"
 #include "plenoptic/lens/pupil_bounds.h"
 #include "plenoptic/core/vec.h"
+#include "plenoptic/sensor/sensor_chain.h"
 
 namespace plenoptic {
 
@@ -92,6 +93,11 @@ struct Sensor {
     PixelPoint to_pixel(double x_mm, double y_mm) const;
     // Where the optical axis meets the sensor, centre convention.
     Vec2 principal_point_px() const;
+    // The metadata's sensor section: its plane and pixel grid, its radiometry with the camera's
+    // reference projected solid angle (camera/radiometry.h; 0 or less: null), and the read-out
+    // `chain` with the raw's file name (sensor/sensor_chain.h: read_out_metadata).
+    MetadataJson metadata(double projected_solid_angle_sr, const SensorChainParams& chain,
+                          const std::string& raw_file) const;
 };
 
 // How many samples a pixel takes (fixed, or adaptive between a minimum and a maximum).
@@ -102,6 +108,8 @@ struct Sampling {
     double confidence;
     double variance;
     std::vector<double> thresholds; // adaptive stop thresholds, index n-1 for n samples
+    // The metadata's samples section.
+    MetadataJson metadata() const;
 };
 
 struct OpticsRay;

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "plenoptic/core/format.h"
+#include "plenoptic/core/json.h"
 #include "plenoptic/lens/lit_area.h"
 #include "plenoptic/lens/pupil_bounds.h"
 #include "plenoptic/core/sampling.h"
@@ -32,6 +33,53 @@ bool through_origin(Vec3 origin, Vec3 direction)
     const Vec3 c = cross(to_pinhole, direction);
     return !(dot(c, c) > 1e-24 * dot(to_pinhole, to_pinhole) * dot(direction, direction)) &&
            dot(to_pinhole, direction) > 0;
+}
+
+// A real lens's members of the main_lens section: its surfaces as the render used them (the stop at
+// its working diameter, object side first), and its first-order data in the optics frame (z from
+// the rear vertex towards the scene, mm).
+void add_prescription_metadata(MetadataJson& section, const Prescription& lens, const ParaxialData& p,
+                               const LensPlacement& placement)
+{
+    MetadataJson surfaces = MetadataJson::array();
+    for (const LensSurface& s : lens.surfaces) {
+        MetadataJson row = MetadataJson::object();
+        row["stop"] = s.stop;
+        row["radius_mm"] = json_number(s.radius_mm);
+        row["thickness_mm"] = json_number(s.thickness_mm);
+        row["ior"] = json_number(s.ior);
+        row["aperture_mm"] = json_number(s.aperture_mm);
+        surfaces.push_back(row);
+    }
+    MetadataJson prescription = MetadataJson::object();
+    prescription["lens_file"] = placement.lens_file.empty() ? MetadataJson(nullptr) : MetadataJson(placement.lens_file);
+    prescription["blades"] = lens.blades;
+    prescription["blade_rotation_deg"] = json_number(lens.blade_rotation_deg);
+    prescription["surfaces"] = surfaces;
+    section["prescription"] = prescription;
+
+    const double length = p.valid ? p.rear_vertex_z : 0.0;
+    const double exit_pupil_z = length - p.exit_pupil_z;
+    MetadataJson paraxial = MetadataJson::object();
+    paraxial["effective_focal_length_mm"] = json_number(p.efl_mm);
+    paraxial["back_focal_distance_mm"] = json_number(p.bfd_mm);
+    paraxial["front_focal_distance_mm"] = json_number(p.ffd_mm);
+    paraxial["length_mm"] = json_number(length);
+    paraxial["front_vertex_z_mm"] = json_number(length);
+    paraxial["front_principal_plane_z_mm"] = json_number(length - p.front_principal_z);
+    paraxial["rear_principal_plane_z_mm"] = json_number(length - p.rear_principal_z);
+    paraxial["entrance_pupil_z_mm"] = json_number(length - p.entrance_pupil_z);
+    paraxial["entrance_pupil_diameter_mm"] = json_number(p.entrance_pupil_mm);
+    paraxial["exit_pupil_z_mm"] = json_number(exit_pupil_z);
+    paraxial["exit_pupil_diameter_mm"] = json_number(p.exit_pupil_mm);
+    paraxial["f_number"] = json_number(p.f_number);
+    // Image side, as f-number matching needs it: exit pupil to the array (or sensor) over its diameter.
+    paraxial["working_f_number"] = json_number((exit_pupil_z + placement.distance_mm) / p.exit_pupil_mm);
+    // The aperture the pupils image (index into prescription.surfaces: the stop's, unless a rim
+    // limits the axial beam), and the widest stop that still limits it (null: no rim ever does).
+    paraxial["limiting_surface"] = p.aperture_surface;
+    paraxial["largest_stop_diameter_mm"] = json_number(p.largest_stop_mm);
+    section["paraxial"] = paraxial;
 }
 
 // Every ray through it passes through the origin.
@@ -78,6 +126,17 @@ public:
           plane_z_(plane_z) {}
     const char* kind_name() const override { return "thin_lens"; }
     const DistortionParams* distortion() const override { return given_distortion_ ? &distortion_ : nullptr; }
+    void add_metadata(MetadataJson& section, const LensPlacement& placement) const override
+    {
+        if (!given_distortion_)
+            return;
+        // Radial-tangential polynomial on the plane z = -D, coordinates (x, y) / D.
+        MetadataJson distortion = MetadataJson::object();
+        distortion["radial"] = json_numbers(distortion_.radial, 3);
+        distortion["tangential"] = json_numbers(distortion_.tangential, 2);
+        distortion["plane_z_mm"] = json_number(-placement.distance_mm);
+        section["distortion"] = distortion;
+    }
     const char* chief_ray_description() const override { return "through the lens centre"; }
     double focal_length_mm() const override { return focal_; }
     double aperture_mm() const override { return aperture_; }
@@ -189,6 +248,10 @@ public:
     double f_number() const override { return paraxial_.f_number; }
     const Prescription* prescription() const override { return &lens_; }
     const ParaxialData* paraxial() const override { return &paraxial_; }
+    void add_metadata(MetadataJson& section, const LensPlacement& placement) const override
+    {
+        add_prescription_metadata(section, lens_, paraxial_, placement);
+    }
     bool front_window(FrontWindow* window) const override
     {
         *window = entrance_pupil();
@@ -289,6 +352,10 @@ public:
     bool traced() const override { return true; }
     const Prescription* prescription() const override { return paraxial_.prescription(); }
     const ParaxialData* paraxial() const override { return paraxial_.paraxial(); }
+    void add_metadata(MetadataJson& section, const LensPlacement& placement) const override
+    {
+        paraxial_.add_metadata(section, placement);  // the same surfaces and first-order data
+    }
     // The first surface: its vertex plane, clear radius and sag.
     bool front_window(FrontWindow* window) const override
     {
@@ -363,6 +430,21 @@ std::shared_ptr<const MainLens> make_prescription_lens(const Prescription& lens,
     if (!exact)
         return std::make_shared<ThickMainLens>(thick);
     return std::make_shared<ExactMainLens>(sized, length, thick, image_distance_mm);
+}
+
+MetadataJson main_lens_metadata(const MainLens* lens, const LensPlacement& placement)
+{
+    const bool forms_image = lens && lens->forms_image();
+    MetadataJson section = MetadataJson::object();
+    section["type"] = lens ? lens->kind_name() : "none";
+    section["focal_length_mm"] = json_number_or_null(forms_image, lens ? lens->focal_length_mm() : 0.0);
+    section["aperture_mm"] = json_number_or_null(forms_image, lens ? lens->aperture_mm() : 0.0);
+    section["f_number"] = json_number_or_null(forms_image, lens ? lens->f_number() : 0.0);
+    section["distance_mm"] = json_number_or_null(lens != nullptr, placement.distance_mm);
+    section["focus_distance"] = json_number_or_null(placement.has_focus_distance, placement.focus_distance_units);
+    if (lens)
+        lens->add_metadata(section, placement);
+    return section;
 }
 
 std::shared_ptr<const MainLens> make_pinhole_lens() { return std::make_shared<PinholeMainLens>(); }

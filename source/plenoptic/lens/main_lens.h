@@ -11,6 +11,8 @@
 #include <memory>
 #include <string>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "plenoptic/core/vec.h"
 #include "plenoptic/lens/distortion.h"
 #include "plenoptic/lens/prescription.h"
@@ -47,6 +49,19 @@ struct FrontWindow {
 
 class PupilBounds;
 class LitAreaTable;
+
+using MetadataJson = nlohmann::ordered_json;  // core/json.h
+
+// What the metadata's main_lens section states about where the camera holds the lens: D (from
+// the rear vertex, or the lens's plane, to the array or the sensor), the focus distance D came
+// from (scene units; none when D was given directly), and the file a prescription came from
+// ("" when it was written inline).
+struct LensPlacement {
+    double distance_mm;
+    bool has_focus_distance;
+    double focus_distance_units;
+    std::string lens_file;
+};
 
 class MainLens {
 public:
@@ -129,7 +144,22 @@ public:
     // The paraxial image of a scene point (optics frame), homogeneous so that an image at
     // infinity is fine. A pinhole forms none: it returns the point itself with w = 1 (unused).
     virtual HomogeneousPoint paraxial_image(Vec3 point) const = 0;
+
+    // The kind's own members of the metadata's main_lens section (docs/metadata.md), added after
+    // the members every lens writes (main_lens_metadata): a thin lens's distortion, a real lens's
+    // prescription and paraxial data.
+    virtual void add_metadata(MetadataJson& section, const LensPlacement& placement) const
+    {
+        (void)section;
+        (void)placement;
+    }
 };
+
+// The metadata's main_lens section for `lens` held at `placement` (nullptr: no main lens, type
+// "none"): type, focal length, aperture and f-number (null for a lens that forms no image), D,
+// the focus distance, then the kind's own members. The camera adds the distortion profile it
+// measures.
+MetadataJson main_lens_metadata(const MainLens* lens, const LensPlacement& placement);
 
 // A pinhole at the origin.
 std::shared_ptr<const MainLens> make_pinhole_lens();

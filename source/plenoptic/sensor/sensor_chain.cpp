@@ -13,6 +13,7 @@
 #include <boost/random/poisson_distribution.hpp>
 
 #include "plenoptic/core/format.h"
+#include "plenoptic/core/json.h"
 
 namespace plenoptic {
 
@@ -178,6 +179,32 @@ std::vector<std::uint16_t> sensor_raw(const SensorChainParams& c, const std::vec
         }
     }
     return raw;
+}
+
+MetadataJson read_out_metadata(const SensorChainParams& c, const std::string& raw_file)
+{
+    if (!c.given)
+        return MetadataJson(nullptr);
+    MetadataJson out = MetadataJson::object();
+    out["raw_file"] = raw_file.empty() ? MetadataJson(nullptr) : MetadataJson(raw_file);
+    out["bayer"] = c.bayer == BayerPattern::None ? MetadataJson(nullptr) : MetadataJson(bayer_name(c.bayer));
+    out["bit_depth"] = c.bit_depth;
+    out["full_well_e"] = json_number(c.full_well_e);
+    out["exposure_e"] = json_number(exposure_electrons(c));
+    out["read_noise_e"] = json_number(c.read_noise_e);
+    out["dark_current_e_per_s"] = json_number(c.dark_current_e_per_s);
+    out["exposure_time_s"] = json_number(c.exposure_time_s);
+    out["prnu"] = json_number(c.prnu);
+    out["dsnu_e"] = json_number(c.dsnu_e);
+    out["black_level_dn"] = c.black_level_dn;
+    out["seed"] = c.seed;
+    const double maximum_dn = std::ldexp(1.0, c.bit_depth) - 1;
+    out["gain_dn_per_e"] = json_number((maximum_dn - c.black_level_dn) / c.full_well_e);
+    out["chain"] = "signal = Poisson(exposure_e * value + dark_current_e_per_s * exposure_time_s); "
+                   "e = min(signal * (1 + prnu * g) + dsnu_e * h + read_noise_e * n, full_well_e), g and h fixed per "
+                   "site for the seed, n new per frame, all N(0, 1); DN = clamp(black_level_dn + round(e * "
+                   "gain_dn_per_e), 0, 2^bit_depth - 1)";
+    return out;
 }
 
 } // namespace plenoptic

@@ -24,6 +24,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 namespace plenoptic {
 
 // Which colour each site of a 2 x 2 Bayer cell records, named by its top-left, top-right,
@@ -63,6 +65,11 @@ inline double exposure_electrons(const SensorChainParams& c) { return c.has_expo
 
 // "" when the chain is consistent, else the message (the block's closing brace is the place).
 std::string check_sensor_chain(const SensorChainParams& chain);
+
+// The metadata's sensor.read_out section: the chain from the noise-free picture to the raw, every
+// parameter as used, the raw's file name (""; null: asked for but not written); null without a
+// chain.
+nlohmann::ordered_json read_out_metadata(const SensorChainParams& chain, const std::string& raw_file);
 
 // The colour channel (0 red, 1 green, 2 blue) of pixel (i, j)'s site (i: column, j: row from the
 // top), for a pattern other than None.
