@@ -105,13 +105,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 {
     const std::string text(reinterpret_cast<const char*>(data), size);
     g_text = &text;
-    RenderMetadata metadata;
-    std::string error;
-    if (!parse_metadata(text, &metadata, &error)) {
-        FUZZ_ASSERT(one_printable_line(error), "refusal message not one printable line: '%s'", error.c_str());
+    const MetadataReading reading = parse_metadata(text);
+    if (!reading.ok()) {
+        FUZZ_ASSERT(one_printable_line(reading.error), "refusal message not one printable line: '%s'",
+                    reading.error.c_str());
         g_text = nullptr;
         return 0;
     }
+    const RenderMetadata& metadata = reading.metadata;
     FUZZ_ASSERT(metadata.width >= 1 && metadata.height >= 1, "image %dx%d accepted", metadata.width, metadata.height);
     const std::string problem = check_camera(metadata.params);
     FUZZ_ASSERT(problem.empty(), "accepted a camera check_camera refuses: %s", problem.c_str());
@@ -121,10 +122,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     // Write what was read, read it again: the same camera, and the same text when written again.
     const std::string written =
         metadata_json(with_film(m, metadata.width, metadata.height), metadata.params, metadata.frame, metadata.depth_map);
-    RenderMetadata again;
-    std::string again_error;
-    FUZZ_ASSERT(parse_metadata(written, &again, &again_error), "the writer's own file is refused: %s\n%s",
-                again_error.c_str(), written.c_str());
+    const MetadataReading reread = parse_metadata(written);
+    FUZZ_ASSERT(reread.ok(), "the writer's own file is refused: %s\n%s", reread.error.c_str(), written.c_str());
+    const RenderMetadata& again = reread.metadata;
     expect_same_camera(metadata, again);
     const std::string rewritten =
         metadata_json(with_film(again.model, again.width, again.height), again.params, again.frame, again.depth_map);

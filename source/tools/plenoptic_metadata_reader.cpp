@@ -276,6 +276,73 @@ void read_prescription(const Json& v, const std::string& parent, MainLensParams*
     m->has_prescription = true;
 }
 
+// Each main-lens kind's own members of main_lens (what its add_metadata writes), read back into
+// the parameters that make the same lens. `main` is the section, `parent` its path.
+void read_pinhole(const Json& main, const std::string& parent, MainLensParams& m)
+{
+    (void)main;
+    (void)parent;
+    m.type = MainLensType::Pinhole;
+}
+
+void read_thin_lens(const Json& main, const std::string& parent, MainLensParams& m)
+{
+    m.type = MainLensType::ThinLens;
+    m.has_focal_length = true;
+    m.focal_length_mm = positive_number(member(main, parent, "focal_length_mm"), parent + ".focal_length_mm");
+    m.has_aperture = true;
+    m.aperture_mm = positive_number(member(main, parent, "aperture_mm"), parent + ".aperture_mm");
+    const Json& n = member(main, parent, "f_number");
+    const double f_number = positive_number(n, parent + ".f_number");
+    check_close(parent + ".f_number", f_number, m.focal_length_mm / m.aperture_mm, f_number,
+                "focal_length_mm / aperture_mm");
+    if (main.contains("distortion")) {
+        const std::string d = parent + ".distortion";
+        const Json& distortion = object_member(main, parent, "distortion");
+        numbers(distortion, d, "radial", 3, false, m.distortion.radial);
+        numbers(distortion, d, "tangential", 2, false, m.distortion.tangential);
+        m.has_distortion = true;
+        const double plane = finite_number(member(distortion, d, "plane_z_mm"), d + ".plane_z_mm");
+        const double D = positive_number(member(main, parent, "distance_mm"), parent + ".distance_mm");
+        check_close(d + ".plane_z_mm", plane, -D, D, "-main_lens.distance_mm");
+    }
+}
+
+// thick_lens and prescription: the same members, the surfaces and their paraxial data.
+void read_real_lens(const Json& main, const std::string& parent, MainLensParams& m)
+{
+    read_prescription(object_member(main, parent, "prescription"), parent + ".prescription", &m);
+    const double f_number = positive_number(member(main, parent, "f_number"), parent + ".f_number");
+    // The f-number of the aperture that limits the axial beam to the array (or sensor) at D.
+    const double D = positive_number(member(main, parent, "distance_mm"), parent + ".distance_mm");
+    check_close(parent + ".f_number", f_number, paraxial_data(effective_prescription(m), 0, D).f_number, f_number,
+                "the surfaces of main_lens.prescription and main_lens.distance_mm");
+}
+
+void read_thick_lens(const Json& main, const std::string& parent, MainLensParams& m)
+{
+    m.type = MainLensType::ThickLens;
+    read_real_lens(main, parent, m);
+}
+
+void read_traced_lens(const Json& main, const std::string& parent, MainLensParams& m)
+{
+    m.type = MainLensType::Prescription;
+    read_real_lens(main, parent, m);
+}
+
+// The kinds by the name main_lens.type gives them (MainLens::kind_name).
+struct MainLensReader {
+    const char* type;
+    void (*read)(const Json& main, const std::string& parent, MainLensParams& m);
+};
+const MainLensReader kMainLensReaders[] = {
+    {"pinhole", read_pinhole},
+    {"thin_lens", read_thin_lens},
+    {"thick_lens", read_thick_lens},
+    {"prescription", read_traced_lens},
+};
+
 void read_main_lens(const Json& root, CameraParams* params)
 {
     const std::string parent = "main_lens";
@@ -284,41 +351,15 @@ void read_main_lens(const Json& root, CameraParams* params)
     MainLensParams& m = params->main;
     if (type == "none")
         return;  // no main lens: given stays false
-    m.given = true;
-    if (type == "pinhole") {
-        m.type = MainLensType::Pinhole;
-    } else if (type == "thin_lens") {
-        m.type = MainLensType::ThinLens;
-        m.has_focal_length = true;
-        m.focal_length_mm = positive_number(member(main, parent, "focal_length_mm"), parent + ".focal_length_mm");
-        m.has_aperture = true;
-        m.aperture_mm = positive_number(member(main, parent, "aperture_mm"), parent + ".aperture_mm");
-        const Json& n = member(main, parent, "f_number");
-        const double f_number = positive_number(n, parent + ".f_number");
-        check_close(parent + ".f_number", f_number, m.focal_length_mm / m.aperture_mm, f_number,
-                    "focal_length_mm / aperture_mm");
-        if (main.contains("distortion")) {
-            const std::string d = parent + ".distortion";
-            const Json& distortion = object_member(main, parent, "distortion");
-            numbers(distortion, d, "radial", 3, false, m.distortion.radial);
-            numbers(distortion, d, "tangential", 2, false, m.distortion.tangential);
-            m.has_distortion = true;
-            const double plane = finite_number(member(distortion, d, "plane_z_mm"), d + ".plane_z_mm");
-            const double D = positive_number(member(main, parent, "distance_mm"), parent + ".distance_mm");
-            check_close(d + ".plane_z_mm", plane, -D, D, "-main_lens.distance_mm");
-        }
-    } else if (type == "thick_lens" || type == "prescription") {
-        m.type = type == "thick_lens" ? MainLensType::ThickLens : MainLensType::Prescription;
-        read_prescription(object_member(main, parent, "prescription"), parent + ".prescription", &m);
-        const double f_number = positive_number(member(main, parent, "f_number"), parent + ".f_number");
-        // The f-number of the aperture that limits the axial beam to the array (or sensor) at D.
-        const double D = positive_number(member(main, parent, "distance_mm"), parent + ".distance_mm");
-        check_close(parent + ".f_number", f_number, paraxial_data(effective_prescription(m), 0, D).f_number, f_number,
-                    "the surfaces of main_lens.prescription and main_lens.distance_mm");
-    } else {
+    const MainLensReader* reader = nullptr;
+    for (const MainLensReader& r : kMainLensReaders)
+        if (type == r.type)
+            reader = &r;
+    if (reader == nullptr)
         refuse(parent + ".type", "\"thin_lens\", \"pinhole\", \"thick_lens\", \"prescription\" or \"none\"",
                member(main, parent, "type"));
-    }
+    m.given = true;
+    reader->read(main, parent, m);
     // D as resolved by the render, whether the scene gave focus_distance or distance.
     m.has_distance = true;
     m.distance_mm = positive_number(member(main, parent, "distance_mm"), parent + ".distance_mm");
@@ -453,57 +494,58 @@ void read_all(const Json& root, RenderMetadata* out)
             refuse("microimage_lattice", "an object (the file has a microlens array)", lattice);
         double origin[2];
         numbers(lattice, "microimage_lattice", "origin_px", 2, false, origin);
-        double u, v;
-        if (microimage_centre_px(m, LensIndex{0, 0}, &u, &v)) {
+        const MicroimageCentre centre = microimage_centre_px(m, LensIndex{0, 0});
+        if (centre.valid) {
             const double scale = out->width + out->height + 1.0;
-            check_close("microimage_lattice.origin_px[0]", origin[0], u, scale, "the lens parameters");
-            check_close("microimage_lattice.origin_px[1]", origin[1], v, scale, "the lens parameters");
+            check_close("microimage_lattice.origin_px[0]", origin[0], centre.u, scale, "the lens parameters");
+            check_close("microimage_lattice.origin_px[1]", origin[1], centre.v, scale, "the lens parameters");
         }
     }
 }
 
 } // namespace
 
-bool parse_metadata(const std::string& text, RenderMetadata* out, std::string* error)
+MetadataReading parse_metadata(const std::string& text)
 {
-    *out = RenderMetadata();
+    MetadataReading reading;
     Json root;
     try {
         // Strict JSON: no comments; invalid UTF-8 and lone surrogates are parse errors.
         root = Json::parse(text, DuplicateKeyCheck());
     } catch (const FieldError& e) {
-        *error = e.what();
-        return false;
+        reading.error = e.what();
+        return reading;
     } catch (const Json::exception& e) {
-        *error = "not valid JSON (" + parse_message(e.what()) + ")";
-        return false;
+        reading.error = "not valid JSON (" + parse_message(e.what()) + ")";
+        return reading;
     }
     try {
-        read_all(root, out);
-        return true;
+        read_all(root, &reading.metadata);
+        return reading;
     } catch (const FieldError& e) {
-        *error = e.what();
-        return false;
+        reading.error = e.what();
     } catch (const Json::exception& e) {  // not expected: every access above checks its type
-        *error = "unexpected value (" + parse_message(e.what()) + ")";
-        return false;
+        reading.error = "unexpected value (" + parse_message(e.what()) + ")";
     }
+    reading.metadata = RenderMetadata();  // nothing half-read on refusal
+    return reading;
 }
 
-bool read_metadata_file(const std::string& path, RenderMetadata* out, std::string* error)
+MetadataReading read_metadata_file(const std::string& path)
 {
     std::ifstream in(path.c_str(), std::ios::binary);
+    MetadataReading reading;
     if (!in) {
-        *error = "cannot open the metadata file";
-        return false;
+        reading.error = "cannot open the metadata file";
+        return reading;
     }
     std::ostringstream text;
     text << in.rdbuf();
     if (in.bad()) {
-        *error = "cannot read the metadata file";
-        return false;
+        reading.error = "cannot read the metadata file";
+        return reading;
     }
-    return parse_metadata(text.str(), out, error);
+    return parse_metadata(text.str());
 }
 
 bool world_to_optics_mm(const RenderMetadata& md, const double world[3], double optics_mm[3])

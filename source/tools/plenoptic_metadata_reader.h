@@ -24,18 +24,25 @@ struct RenderMetadata {
     std::string depth_map;// file name of the depth EXR, empty when none
 };
 
+// What reading a metadata file gives: the camera it describes, or why it was refused.
+struct MetadataReading {
+    RenderMetadata metadata;  // the file's camera when ok(); default-constructed otherwise
+    std::string error;        // "" when the file was read; else one sentence, the cause first
+    bool ok() const { return error.empty(); }
+};
+
 // Rebuilds the camera from the text of a metadata file. The text must be strict JSON (RFC 8259,
 // parsed by nlohmann-json) in UTF-8: invalid UTF-8, an escaped lone surrogate (\ud800) and a key
-// that appears twice in one object are refused. On failure returns false and sets `error` to
-// one sentence with the cause first: "not valid JSON (line 3, column 7: ...)", "duplicate key
-// 'mm_per_unit' ...", or naming the offending field, e.g. "field 'main_lens.focal_length_mm'
-// must be a positive number, found null". Also checks that the stored derived values (sensor
-// plane, principal point, lattice origin) agree with the parameters, to catch edited files.
-bool parse_metadata(const std::string& text, RenderMetadata* out, std::string* error);
+// that appears twice in one object are refused. A refusal's error is one sentence with the cause
+// first: "not valid JSON (line 3, column 7: ...)", "duplicate key 'mm_per_unit' ...", or naming
+// the offending field, e.g. "field 'main_lens.focal_length_mm' must be a positive number, found
+// null". Also checks that the stored derived values (sensor plane, principal point, lattice
+// origin) agree with the parameters, to catch edited files.
+MetadataReading parse_metadata(const std::string& text);
 
 // Reads the file, then parse_metadata. Errors start with the cause ("cannot open", "not valid
 // JSON (...)", "field ..."); the caller names the file.
-bool read_metadata_file(const std::string& path, RenderMetadata* out, std::string* error);
+MetadataReading read_metadata_file(const std::string& path);
 
 // World point (scene units) -> optics frame (mm): solves location + (x right + y up + z direction)
 // / mm_per_unit = world. False when the frame is singular or the result is not finite.

@@ -66,9 +66,8 @@ std::string edited(const std::string& text, const std::string& from, const std::
 // The refusal message for `text` (a test failure when it is accepted).
 std::string refusal(const std::string& text)
 {
-    RenderMetadata metadata;
-    std::string error;
-    if (parse_metadata(text, &metadata, &error)) {
+    const std::string error = parse_metadata(text).error;
+    if (error.empty()) {
         ADD_FAILURE() << "accepted:\n" << text;
         return "";
     }
@@ -82,9 +81,9 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 
 TEST(MetadataReader, ReadsWhatTheWriterWrites)
 {
-    RenderMetadata metadata;
-    std::string error;
-    ASSERT_TRUE(parse_metadata(good_text(), &metadata, &error)) << error;
+    const MetadataReading reading = parse_metadata(good_text());
+    ASSERT_TRUE(reading.ok()) << reading.error;
+    const RenderMetadata& metadata = reading.metadata;
     const CameraParams p = hexagonal_camera();
     const PlenopticCamera m = make_camera(p);
     EXPECT_EQ(metadata.width, 320);
@@ -101,12 +100,11 @@ TEST(MetadataReader, ReadsWhatTheWriterWrites)
 
 TEST(MetadataReader, AcceptsUtf8AndSurrogatePairs)
 {
-    RenderMetadata metadata;
-    std::string error;
     // "\u00e9" escaped, U+1F600 as a surrogate pair, and raw UTF-8.
     const std::string text = edited(good_text(), "\"scene.depth.exr\"", "\"sc\\u00e9ne \\ud83d\\ude00 \xc3\xa9.exr\"");
-    ASSERT_TRUE(parse_metadata(text, &metadata, &error)) << error;
-    EXPECT_EQ(metadata.depth_map, "sc\xc3\xa9ne \xf0\x9f\x98\x80 \xc3\xa9.exr");
+    const MetadataReading reading = parse_metadata(text);
+    ASSERT_TRUE(reading.ok()) << reading.error;
+    EXPECT_EQ(reading.metadata.depth_map, "sc\xc3\xa9ne \xf0\x9f\x98\x80 \xc3\xa9.exr");
 }
 
 TEST(MetadataReader, RefusesLoneSurrogates)
@@ -147,8 +145,7 @@ TEST(MetadataReader, RefusesDuplicateKeys)
     error = refusal(edited(text, "\"VMax\":", "\"VMax\": 1, \"VMax\":"));
     EXPECT_TRUE(contains(error, "'lftoolbox_lenslet_grid_model'")) << error;
     // The same key in two different objects is fine (distance_mm is in main_lens and microlens_array).
-    RenderMetadata metadata;
-    EXPECT_TRUE(parse_metadata(text, &metadata, &error)) << error;
+    EXPECT_EQ(parse_metadata(text).error, "");
 }
 
 TEST(MetadataReader, RefusesTruncatedAndMalformedText)
@@ -186,20 +183,15 @@ TEST(MetadataReader, ExtremeShiftsKeepALatticeTheReaderTakesBack)
     ASSERT_EQ(check_camera(p), "");
     const std::string text = metadata_json(with_film(make_camera(p), 320, 240), p, kFrame, "");
     ASSERT_FALSE(contains(text, "\"microimage_lattice\": null")) << text;
-    RenderMetadata metadata;
-    std::string error;
-    EXPECT_TRUE(parse_metadata(text, &metadata, &error)) << error;
+    EXPECT_EQ(parse_metadata(text).error, "");
     // A lattice may not be dropped.
-    error = refusal(edited(good_text(), "\"microimage_lattice\": {", "\"microimage_lattice\": null, \"x\": {"));
+    const std::string error = refusal(edited(good_text(), "\"microimage_lattice\": {", "\"microimage_lattice\": null, \"x\": {"));
     EXPECT_TRUE(contains(error, "field 'microimage_lattice' must be an object")) << error;
 }
 
 TEST(MetadataReader, FileErrors)
 {
-    RenderMetadata metadata;
-    std::string error;
-    EXPECT_FALSE(read_metadata_file("/nonexistent/x.plenoptic.json", &metadata, &error));
-    EXPECT_EQ(error, "cannot open the metadata file");
+    EXPECT_EQ(read_metadata_file("/nonexistent/x.plenoptic.json").error, "cannot open the metadata file");
     char path[] = "/tmp/metadata_reader_testXXXXXX";
     const int fd = mkstemp(path);
     ASSERT_GE(fd, 0);
@@ -208,13 +200,15 @@ TEST(MetadataReader, FileErrors)
         std::ofstream out(path, std::ios::binary);
         out << edited(good_text(), "\"scene.depth.exr\"", "\"\\ud800\"");
     }
-    EXPECT_FALSE(read_metadata_file(path, &metadata, &error));
-    EXPECT_TRUE(contains(error, "surrogate")) << error;
+    const MetadataReading refused = read_metadata_file(path);
+    EXPECT_FALSE(refused.ok());
+    EXPECT_TRUE(contains(refused.error, "surrogate")) << refused.error;
     {
         std::ofstream out(path, std::ios::binary);
         out << good_text();
     }
-    EXPECT_TRUE(read_metadata_file(path, &metadata, &error)) << error;
+    const MetadataReading read = read_metadata_file(path);
+    EXPECT_TRUE(read.ok()) << read.error;
     std::remove(path);
 }
 

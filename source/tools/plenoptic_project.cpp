@@ -73,10 +73,10 @@ int main(int argc, char** argv)
         return fail("missing METADATA.json and points\n" + std::string(kUsage));
 
     const std::string path = args[0];
-    plenoptic::RenderMetadata metadata;
-    std::string error;
-    if (!plenoptic::read_metadata_file(path, &metadata, &error))
-        return fail(path + ": " + error);
+    const plenoptic::MetadataReading reading = plenoptic::read_metadata_file(path);
+    if (!reading.ok())
+        return fail(path + ": " + reading.error);
+    const plenoptic::RenderMetadata& metadata = reading.metadata;
 
     // The point coordinates, as text, from the command line or standard input.
     std::vector<std::string> words;

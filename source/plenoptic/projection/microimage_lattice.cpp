@@ -117,14 +117,12 @@ void fit_lftoolbox(const PlenopticCamera& m, MicroimageLattice* lattice)
 
 } // namespace
 
-bool microimage_centre_px(const PlenopticCamera& m, LensIndex lens, double* u, double* v)
+MicroimageCentre microimage_centre_px(const PlenopticCamera& m, LensIndex lens)
 {
     Vec2 px;
     if (m.array.grid == GridType::None || !local_to_px(m, lens_centre(m.array.grid, m.array.pitch_mm, lens), &px))
-        return false;
-    *u = px.x;
-    *v = px.y;
-    return true;
+        return MicroimageCentre{0, 0, false};
+    return MicroimageCentre{px.x, px.y, true};
 }
 
 MicroimageLattice microimage_lattice(const PlenopticCamera& m)

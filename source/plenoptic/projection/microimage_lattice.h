@@ -9,9 +9,16 @@
 
 namespace plenoptic {
 
+// A microimage centre in pixels (centre convention); valid false when there is none (no array, or
+// the projection is not finite).
+struct MicroimageCentre {
+    double u, v;
+    bool valid;
+};
+
 // Centre of lens `lens`'s microimage in pixels (centre convention): the central projection of the
 // posed lens centre from the main-lens centre onto the sensor (orthogonal without main lens).
-bool microimage_centre_px(const PlenopticCamera& model, LensIndex lens, double* u, double* v);
+MicroimageCentre microimage_centre_px(const PlenopticCamera& model, LensIndex lens);
 
 // The microimage-centre lattice in pixel coordinates (centre convention) and its LFToolbox form.
 // centre(k_s, l) = origin + k_s a + l b in skew indices (a = (p, 0); b = (p/2, p sqrt(3)/2)

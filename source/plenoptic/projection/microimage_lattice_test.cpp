@@ -71,7 +71,10 @@ void check_lftoolbox(GridType grid, double rotate_z, double offset_x, double tx)
             ASSERT_TRUE(lens_lookup.found);
             const LensIndex lens = lens_lookup.lens;
             double cu, cv;
-            ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), lens, &cu, &cv));
+            const MicroimageCentre centre_cu = microimage_centre_px(with_film(m, W, H), lens);
+            ASSERT_TRUE(centre_cu.valid);
+            cu = centre_cu.u;
+            cv = centre_cu.v;
             EXPECT_NEAR(cu, u, 1e-6) << "grid (" << row << "," << col << ") rotate " << rotate_z;
             EXPECT_NEAR(cv, v, 1e-6) << "grid (" << row << "," << col << ") rotate " << rotate_z;
             if (u >= -0.5 && u <= W - 1 && v >= -0.5 && v <= H - 1)
@@ -83,8 +86,14 @@ void check_lftoolbox(GridType grid, double rotate_z, double offset_x, double tx)
     }
     // The basis of the microimage lattice matches neighbouring lenses' centres.
     double u0, v0, u1, v1;
-    ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), from_skew(grid, 3, -2), &u0, &v0));
-    ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), from_skew(grid, 4, -1), &u1, &v1));
+    const MicroimageCentre centre_u0 = microimage_centre_px(with_film(m, W, H), from_skew(grid, 3, -2));
+    ASSERT_TRUE(centre_u0.valid);
+    u0 = centre_u0.u;
+    v0 = centre_u0.v;
+    const MicroimageCentre centre_u1 = microimage_centre_px(with_film(m, W, H), from_skew(grid, 4, -1));
+    ASSERT_TRUE(centre_u1.valid);
+    u1 = centre_u1.u;
+    v1 = centre_u1.v;
     EXPECT_NEAR(u1 - u0, lattice.basis_a_px[0] + lattice.basis_b_px[0], 1e-6);
     EXPECT_NEAR(v1 - v0, lattice.basis_a_px[1] + lattice.basis_b_px[1], 1e-6);
 
@@ -94,9 +103,9 @@ void check_lftoolbox(GridType grid, double rotate_z, double offset_x, double tx)
         int expected = 0;
         for (int l = -200; l <= 200; ++l) {
             for (int k = -200; k <= 200; ++k) {
-                double u, v;
-                microimage_centre_px(with_film(m, W, H), LensIndex{k, l}, &u, &v);
-                if (u >= -0.5 && u <= W - 1 && v >= -0.5 && v <= H - 1)
+                const MicroimageCentre c = microimage_centre_px(with_film(m, W, H), LensIndex{k, l});
+                const double u = c.u, v = c.v;
+                if (c.valid && u >= -0.5 && u <= W - 1 && v >= -0.5 && v <= H - 1)
                     ++expected;
             }
         }
@@ -123,8 +132,14 @@ TEST(Optics, TiltedArrayLatticeIsMarkedApproximate)
     EXPECT_FALSE(lattice.exact);
     // Still a tenth of a pixel near the centre.
     double u0, v0, u1, v1;
-    ASSERT_TRUE(microimage_centre_px(m, LensIndex{0, 0}, &u0, &v0));
-    ASSERT_TRUE(microimage_centre_px(m, LensIndex{1, 0}, &u1, &v1));
+    const MicroimageCentre centre_u0 = microimage_centre_px(m, LensIndex{0, 0});
+    ASSERT_TRUE(centre_u0.valid);
+    u0 = centre_u0.u;
+    v0 = centre_u0.v;
+    const MicroimageCentre centre_u1 = microimage_centre_px(m, LensIndex{1, 0});
+    ASSERT_TRUE(centre_u1.valid);
+    u1 = centre_u1.u;
+    v1 = centre_u1.v;
     EXPECT_NEAR(u1 - u0, lattice.basis_a_px[0], 0.1);
     EXPECT_NEAR(v1 - v0, lattice.basis_a_px[1], 0.1);
 }
@@ -140,7 +155,10 @@ TEST(Optics, MicroimageCentreIsTheCentralProjectionOfTheLensCentre)
     for (int k = -4; k <= 4; ++k) {
         const LensIndex lens{k, k / 2};
         double u, v;
-        ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), lens, &u, &v));
+        const MicroimageCentre centre_u = microimage_centre_px(with_film(m, W, H), lens);
+        ASSERT_TRUE(centre_u.valid);
+        u = centre_u.u;
+        v = centre_u.v;
         OpticsRay ray;
         ASSERT_TRUE((ray = chief_ray_through(with_film(m, W, H), u + 0.5, v + 0.5, &lens)).passed);
         EXPECT_LT(length(origin_of(ray)), 1e-9) << "lens " << k << " origin " << str(origin_of(ray));

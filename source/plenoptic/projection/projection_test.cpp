@@ -41,7 +41,10 @@ TEST(Optics, FocusedOnTheArrayImagesToTheCentreOfTheOnAxisMicroimage)
         EXPECT_NEAR(hits[0].u, (W - 1) / 2.0, 1e-9);
         EXPECT_NEAR(hits[0].v, (H - 1) / 2.0, 1e-9);
         double u, v;
-        ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), LensIndex{0, 0}, &u, &v));
+        const MicroimageCentre centre_u = microimage_centre_px(with_film(m, W, H), LensIndex{0, 0});
+        ASSERT_TRUE(centre_u.valid);
+        u = centre_u.u;
+        v = centre_u.v;
         EXPECT_NEAR(u, (W - 1) / 2.0, 1e-9);
         EXPECT_NEAR(v, (H - 1) / 2.0, 1e-9);
     }

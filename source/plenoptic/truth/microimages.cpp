@@ -273,8 +273,9 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     for (std::int64_t l = std::int64_t(l0); l <= std::int64_t(l1); ++l) {
         for (std::int64_t k = std::int64_t(k0); k <= std::int64_t(k1); ++k) {
             const LensIndex lens{k, l};
-            double cu, cv;
-            if (!microimage_centre_px(m, lens, &cu, &cv) || !(cu >= -0.5 && cu < W - 0.5) ||
+            const MicroimageCentre centre = microimage_centre_px(m, lens);
+            const double cu = centre.u, cv = centre.v;
+            if (!centre.valid || !(cu >= -0.5 && cu < W - 0.5) ||
                 !(cv >= -0.5 && cv < H - 0.5))
                 continue;  // the lattice centre is not in the picture
             MicroimageTruth truth = MicroimageTruth();
@@ -425,9 +426,12 @@ MicroimageSummary summarise_microimages(const PlenopticCamera& m, const std::vec
     summary.fit = fit_microimage_lattice(m, truth);
     double sum2 = 0, largest = 0;
     for (const MicroimageTruth& t : truth) {
-        double u, v;
-        if (!t.lit || !microimage_centre_px(m, t.lens, &u, &v))
+        if (!t.lit)
             continue;
+        const MicroimageCentre centre = microimage_centre_px(m, t.lens);
+        if (!centre.valid)
+            continue;
+        const double u = centre.u, v = centre.v;
         ++summary.lit_lenses;
         const double r = std::hypot(t.u_px - u, t.v_px - v);
         sum2 += r * r;

@@ -48,7 +48,10 @@ TEST(MicroimageTruth, ThinLensMicroimagesAreThePupilDiscAboutTheLatticeCentres)
         const double fraction = kPi * radius_px * radius_px / cell_px;
         for (const MicroimageTruth& t : truth) {
             double u, v;
-            ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), t.lens, &u, &v));
+            const MicroimageCentre centre_u = microimage_centre_px(with_film(m, W, H), t.lens);
+            ASSERT_TRUE(centre_u.valid);
+            u = centre_u.u;
+            v = centre_u.v;
             ASSERT_TRUE(t.lit);
             EXPECT_NEAR(t.u_px, u, 1e-3) << t.lens.k << "," << t.lens.l;
             EXPECT_NEAR(t.v_px, v, 1e-3) << t.lens.k << "," << t.lens.l;
@@ -59,9 +62,8 @@ TEST(MicroimageTruth, ThinLensMicroimagesAreThePupilDiscAboutTheLatticeCentres)
         int inside = 0;
         for (int l = -40; l <= 40; ++l)
             for (int k = -40; k <= 40; ++k) {
-                double u, v;
-                if (microimage_centre_px(with_film(m, W, H), LensIndex{k, l}, &u, &v) && u >= -0.5 && u < W - 0.5 && v >= -0.5 &&
-                    v < H - 0.5)
+                const MicroimageCentre c = microimage_centre_px(with_film(m, W, H), LensIndex{k, l});
+                if (c.valid && c.u >= -0.5 && c.u < W - 0.5 && c.v >= -0.5 && c.v < H - 0.5)
                     ++inside;
             }
         EXPECT_EQ(int(truth.size()), inside);
@@ -110,7 +112,10 @@ TEST(MicroimageTruth, CatsEyesAgreeWithABruteForceCount)
         ASSERT_NE(found, nullptr) << want.k << "," << want.l;
         ASSERT_TRUE(found->lit);
         double u0, v0;
-        ASSERT_TRUE(microimage_centre_px(with_film(m, W, H), want, &u0, &v0));
+        const MicroimageCentre centre_u0 = microimage_centre_px(with_film(m, W, H), want);
+        ASSERT_TRUE(centre_u0.valid);
+        u0 = centre_u0.u;
+        v0 = centre_u0.v;
         const int n = 600;
         const double half = 6, step = 2 * half / n;
         double count = 0, su = 0, sv = 0;
