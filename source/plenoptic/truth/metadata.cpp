@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // Writes the plenoptic render metadata (docs/metadata.md) with nlohmann-json: the document is
-// built as an ordered_json (members in the documented order), every number and string is
-// serialised by the library; only the line layout is chosen here.
+// built as an ordered_json (members in the documented order) from the sections the camera's parts
+// write (the main lens, the sensor, the sampling) and the camera-level ones written here; every
+// number and string is serialised by the library; only the line layout is chosen here.
 
 #include "plenoptic/truth/metadata.h"
 
