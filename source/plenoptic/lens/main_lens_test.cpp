@@ -8,6 +8,7 @@
 #include <cmath>
 #include <vector>
 
+#include "plenoptic/core/json.h"
 #include "plenoptic/lens/main_lens.h"
 #include "plenoptic/lens/main_lens_params.h"
 #include "plenoptic/lens/prescription.h"
@@ -143,6 +144,69 @@ TEST(MainLens, ToImageRetracesToScene)
         EXPECT_GT(passed, 20) << "lens " << which;
         EXPECT_GT(blocked, 10) << "lens " << which << ": its aperture blocks some of these rays";
     }
+}
+
+// The main_lens section (docs/metadata.md): the members every lens writes, in order, then the
+// kind's own; D, the focus distance and the lens file come from where the camera holds the lens.
+std::vector<std::string> keys(const MetadataJson& section)
+{
+    std::vector<std::string> out;
+    for (auto it = section.begin(); it != section.end(); ++it)
+        out.push_back(it.key());
+    return out;
+}
+
+TEST(MainLens, EachKindWritesItsMetadataSection)
+{
+    const std::vector<std::string> common = {"type", "focal_length_mm", "aperture_mm", "f_number", "distance_mm",
+                                             "focus_distance"};
+    const LensPlacement at_30{30, false, 0, ""};
+
+    const MetadataJson none = main_lens_metadata(nullptr, at_30);
+    EXPECT_EQ(keys(none), common);
+    EXPECT_EQ(none["type"], "none");
+    EXPECT_TRUE(none["distance_mm"].is_null());
+
+    const MetadataJson pinhole = main_lens_metadata(make_pinhole_lens().get(), at_30);
+    EXPECT_EQ(keys(pinhole), common);
+    EXPECT_EQ(pinhole["type"], "pinhole");
+    EXPECT_TRUE(pinhole["focal_length_mm"].is_null() && pinhole["aperture_mm"].is_null() && pinhole["f_number"].is_null());
+    EXPECT_EQ(pinhole["distance_mm"], 30);
+
+    const MetadataJson thin = main_lens_metadata(make_thin_lens(25, 5, 5, nullptr, -30).get(), LensPlacement{30, true, 2.5, ""});
+    EXPECT_EQ(keys(thin), common);
+    EXPECT_EQ(thin["focal_length_mm"], 25);
+    EXPECT_EQ(thin["f_number"], 5);
+    EXPECT_EQ(thin["focus_distance"], 2.5);
+
+    const DistortionParams distortion{{-0.1, 0.02, 0}, {0.001, 0}};
+    const MetadataJson distorted = main_lens_metadata(make_thin_lens(25, 5, 5, &distortion, -30).get(), at_30);
+    std::vector<std::string> with_distortion = common;
+    with_distortion.push_back("distortion");
+    EXPECT_EQ(keys(distorted), with_distortion);
+    EXPECT_EQ(distorted["distortion"]["radial"], MetadataJson::parse("[-0.1, 0.02, 0]"));
+    EXPECT_EQ(distorted["distortion"]["tangential"], MetadataJson::parse("[0.001, 0]"));
+    EXPECT_EQ(distorted["distortion"]["plane_z_mm"], -30);
+
+    // Both models of a prescription write its surfaces and first-order data; its length is the sum
+    // of the thicknesses (10 + 8 + 0 mm).
+    std::vector<std::string> with_prescription = common;
+    with_prescription.push_back("prescription");
+    with_prescription.push_back("paraxial");
+    const LensPlacement held{120, false, 0, "singlet.dat"};
+    const MetadataJson exact = main_lens_metadata(make_prescription_lens(singlet(), 0, true, 120).get(), held);
+    const MetadataJson thick = main_lens_metadata(make_prescription_lens(singlet(), 0, false, 120).get(), held);
+    EXPECT_EQ(keys(exact), with_prescription);
+    EXPECT_EQ(exact["type"], "prescription");
+    EXPECT_EQ(thick["type"], "thick_lens");
+    EXPECT_EQ(exact["prescription"], thick["prescription"]);
+    EXPECT_EQ(exact["paraxial"], thick["paraxial"]);
+    EXPECT_EQ(exact["prescription"]["lens_file"], "singlet.dat");
+    ASSERT_EQ(exact["prescription"]["surfaces"].size(), 3u);
+    EXPECT_EQ(exact["prescription"]["surfaces"][0]["stop"], true);
+    EXPECT_EQ(exact["prescription"]["surfaces"][1]["radius_mm"], 100);
+    EXPECT_EQ(exact["paraxial"]["length_mm"], 18);
+    EXPECT_EQ(exact["paraxial"]["front_vertex_z_mm"], 18);
 }
 
 } // namespace
