@@ -264,7 +264,7 @@ int main(int argc, char** argv)
                 m.lens->exit_pupil_radius(), rear_radius, m.pupil_bounds ? m.pupil_bounds->field_radius_mm() : -1.0);
     if (m.array.grid != GridType::None)
         std::printf(" \"array\": {\"grid\": \"hexagonal\", \"pitch_mm\": %.9g, \"focal_length_mm\": %.9g, "
-                    "\"distance_mm\": %.9g},\n", m.array.pitch_mm, m.array.focal_mm[0], m.array.distance_mm);
+                    "\"distance_mm\": %.9g},\n", m.array.pitch_mm, m.array.focal_length_mm(LensIndex{0, 0}), m.array.distance_mm);
     else
         std::printf(" \"array\": null,\n");
     std::printf(" \"sensor\": {\"width\": %d, \"height\": %d, \"pixel_size_mm\": %.9g}, \"samples\": %d, "

@@ -93,7 +93,7 @@ TEST(MetadataReader, ReadsWhatTheWriterWrites)
     // Shortest round-trip numbers: every value reads back bit for bit.
     EXPECT_EQ(metadata.model.distance_mm, m.distance_mm);
     EXPECT_EQ(metadata.model.array.pitch_mm, 0.15);
-    EXPECT_EQ(metadata.model.array.focal_mm[0], 0.6);
+    EXPECT_EQ(metadata.model.array.focal_length_mm(LensIndex{0, 0}), 0.6);
     EXPECT_EQ(metadata.model.sensor.z_mm, m.sensor.z_mm);
     EXPECT_EQ(metadata.params.array.rotate_deg[2], 0.3);
 }

@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "plenoptic/array/array_params.h"
 #include "plenoptic/core/format.h"
 #include "plenoptic/core/lattice.h"
 #include "plenoptic/lens/main_lens_params.h"
@@ -13,7 +14,6 @@
 
 namespace plenoptic {
 
-enum class MicrolensType { Pinhole, ThinLens };
 // What a pixel's value measures (camera/radiometry.h): Flat, the radiance times the share of
 // the sampled aperture that passes (the first phase's camera, equal to the stock cameras); or
 // Irradiance, the sensor irradiance with its cos^4 law, normalised so that an on-axis pixel of
@@ -41,22 +41,6 @@ const int kMaxSamples = 1000000;
 // squares of lengths would leave double precision.
 const double kMinLengthMm = 1e-12;
 const double kMaxLengthMm = 1e12;
-
-// microlens_array { ... }. `given` is false when the scene has no array (grid stays None).
-struct ArrayParams {
-    bool given = false;
-    GridType grid = GridType::None;         // None inside a given block: no grid keyword
-    bool has_pitch = false;
-    double pitch_mm = 0;
-    bool has_lens = false;                  // one of pinhole / focal_length / focal_lengths was read
-    MicrolensType lens = MicrolensType::Pinhole;
-    int focal_length_count = 0;             // 0 = pinhole, 1 = focal_length, 3 = focal_lengths
-    double focal_lengths_mm[3] = {0, 0, 0};
-    bool has_distance = false;
-    double distance_mm = 0;                 // d: array -> sensor
-    double rotate_deg[3] = {0, 0, 0};       // about x, then y, then z (POV-Ray's order)
-    double translate_mm[3] = {0, 0, 0};     // camera frame, after the rotation
-};
 
 // Largest exponent of `angular_response`: cos^64 of 10 degrees is 0.38, a pixel blind beyond 20.
 const double kMaxAngularExponent = 64;

@@ -15,24 +15,6 @@ namespace plenoptic {
 
 namespace {
 
-// sin and cos of an angle in degrees, exact at multiples of 90 degrees so that an unrotated or
-// quarter-turned array stays exactly axis-aligned.
-void sin_cos_degrees(double degrees, double* s, double* c)
-{
-    const double reduced = std::fmod(degrees, 360.0);  // exact
-    const double quarter = reduced / 90.0;
-    if (quarter == std::floor(quarter)) {
-        static const double sines[4] = {0, 1, 0, -1};
-        const int q = int(((long long)quarter % 4 + 4) % 4);
-        *s = sines[q];
-        *c = sines[(q + 1) % 4];
-        return;
-    }
-    const double radians = reduced * (kPi / 180.0);
-    *s = std::sin(radians);
-    *c = std::cos(radians);
-}
-
 // Everything the overlap bound needs, measured at the array centre (see docs/camera-internals.md).
 struct OverlapGeometry {
     double magnification;  // k = d / D: microimage-lattice scale is 1 + k
@@ -52,10 +34,10 @@ OverlapGeometry overlap_geometry(const PlenopticCamera& m)
         g.disc_mm = m.pupil_bounds->reach_mm() * g.magnification;
     else if (m.lens)
         g.disc_mm = m.lens->exit_pupil_radius() * g.magnification;
-    if (m.array.microlens == MicrolensType::ThinLens) {
+    if (m.array.microlens->forms_image()) {
         double worst = 0;
         for (int t = 0; t < m.array.lens_type_count; ++t)
-            worst = std::max(worst, std::fabs(1 + g.magnification - array_distance / m.array.focal_mm[t]));
+            worst = std::max(worst, std::fabs(1 + g.magnification - array_distance / m.array.microlens->focal_length_mm(t)));
         g.blur_mm = m.array.cell_circumradius_mm * worst;
         g.blur_inradius_mm = m.array.cell_inradius_mm * worst;
     }
@@ -64,19 +46,6 @@ OverlapGeometry overlap_geometry(const PlenopticCamera& m)
 }
 
 } // namespace
-
-Mat3 rotation_from_degrees(const double degrees[3])
-{
-    double sx, cx, sy, cy, sz, cz;
-    sin_cos_degrees(degrees[0], &sx, &cx);
-    sin_cos_degrees(degrees[1], &sy, &cy);
-    sin_cos_degrees(degrees[2], &sz, &cz);
-    // Column-vector forms of POV-Ray's row-vector matrices (its [1][2] = sin x is our [2][1]).
-    const Mat3 rx = {{{1, 0, 0}, {0, cx, -sx}, {0, sx, cx}}};
-    const Mat3 ry = {{{cy, 0, sy}, {0, 1, 0}, {-sy, 0, cy}}};
-    const Mat3 rz = {{{cz, -sz, 0}, {sz, cz, 0}, {0, 0, 1}}};
-    return mul(rz, mul(ry, rx));
-}
 
 double effective_main_distance_mm(const PlenopticCamera& model)
 {
@@ -163,36 +132,8 @@ PlenopticCamera make_camera(const CameraParams& params)
     m.has_focus_distance = m.lens && main.has_focus_distance && m.lens->forms_image();
     m.focus_distance_units = m.has_focus_distance ? main.focus_distance_units : 0;
 
-    const ArrayParams& array = params.array;
-    m.array.grid = array.given ? array.grid : GridType::None;
-    m.array.pitch_mm = 0;
-    m.array.microlens = MicrolensType::Pinhole;
-    m.array.lens_type_count = 1;
-    m.array.focal_mm[0] = m.array.focal_mm[1] = m.array.focal_mm[2] = 0;
-    m.array.distance_mm = 0;
-    m.array.cell_inradius_mm = 0;
-    m.array.cell_circumradius_mm = 0;
-
     const double array_z = m.lens ? -m.distance_mm : 0.0;
-    const double no_rotation[3] = {0, 0, 0};
-    m.array.pose.rotation = rotation_from_degrees(m.array.grid == GridType::None ? no_rotation : array.rotate_deg);
-    m.array.pose.centre_mm = Vec3{0, 0, array_z};
-    if (m.array.grid != GridType::None) {
-        m.array.pitch_mm = array.pitch_mm;
-        m.array.microlens = array.lens;
-        if (array.lens == MicrolensType::ThinLens) {
-            m.array.lens_type_count = array.focal_length_count == 3 ? 3 : 1;
-            for (int t = 0; t < 3; ++t)
-                m.array.focal_mm[t] = array.focal_lengths_mm[m.array.lens_type_count == 3 ? t : 0];
-        }
-        m.array.distance_mm = array.distance_mm;
-        m.array.pose.centre_mm = Vec3{array.translate_mm[0], array.translate_mm[1], array_z + array.translate_mm[2]};
-        m.array.cell_inradius_mm = cell_inradius(m.array.grid, m.array.pitch_mm);
-        m.array.cell_circumradius_mm = cell_circumradius(m.array.grid, m.array.pitch_mm);
-    }
-    m.array.pose.normal = mul(m.array.pose.rotation, Vec3{0, 0, 1});
-    m.array.pose.tilted = !(m.array.pose.rotation.m[0][2] == 0 && m.array.pose.rotation.m[1][2] == 0);
-    m.array.pose.tilt_sine = std::hypot(m.array.pose.normal.x, m.array.pose.normal.y);
+    m.array = make_microlens_array(params.array, array_z);
 
     if (m.array.grid == GridType::None)
         m.sensor.z_mm = -m.distance_mm;
@@ -226,7 +167,7 @@ PlenopticCamera make_camera(const CameraParams& params)
             const double pixel_reach = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]);
             const double lattice_reach = (reach + pixel_reach) / (1 + g.magnification) + m.array.cell_circumradius_mm;
             // Ring r of the lattice is at least r times this far from the own lens.
-            const double ring_step = row_spacing(m.array.grid, m.array.pitch_mm);
+            const double ring_step = m.array.row_spacing_mm();
             double rings = std::ceil(lattice_reach / ring_step) + (m.array.pose.tilted ? 1 : 0);
             if (!(rings >= 1))
                 rings = 1;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "plenoptic/array/microlens_array.h"
 #include "plenoptic/lens/main_lens.h"
 #include "plenoptic/core/lattice.h"
 #include "plenoptic/camera/params.h"
@@ -24,15 +25,6 @@ const int kMaxOverlapRings = 8;
 // Lenses in that many rings of a rectangular grid (the larger of the two grids): (2*8+1)^2.
 const int kMaxOverlapLenses = (2 * kMaxOverlapRings + 1) * (2 * kMaxOverlapRings + 1);
 
-// Pose of the microlens array in the optics frame: q_optics = centre_mm + rotation * q_local.
-struct ArrayPose {
-    Mat3 rotation;   // array-local -> optics frame, Rz * Ry * Rx
-    Vec3 centre_mm;  // where the array's lens (0, 0) sits
-    Vec3 normal;     // rotation * (0, 0, 1): towards the scene
-    bool tilted;     // rotated about x or y: the array plane is not parallel to the sensor
-    double tilt_sine;// sine of the angle between the array's normal and the optical axis
-};
-
 // Above this tilt (sine of the angle, about 11.5 degrees) a pixel's overlap lenses are not pruned.
 const double kMaxPrunedTiltSine = 0.2;
 
@@ -42,21 +34,6 @@ const double kMaxPrunedTiltSine = 0.2;
 struct Film {
     int width;
     int height;
-};
-
-// The microlens array as the camera holds it: its lattice, its lenses' kind and focal lengths,
-// and its pose. grid None: the camera has no array (every other field is then 0, pose identity).
-struct MicrolensArray {
-    GridType grid;
-    double pitch_mm;
-    MicrolensType microlens;
-    int lens_type_count;         // 1, or 3 for multi-focus arrays
-    double focal_mm[3];          // per lens type; 0 for pinholes
-    double distance_mm;          // d, to the sensor; 0 without array
-    ArrayPose pose;
-    double cell_inradius_mm;     // of a lens's lattice cell
-    double cell_circumradius_mm;
-    bool present() const { return grid != GridType::None; }
 };
 
 // Overlapping microimages: modelled only when the camera's geometry makes overlap possible.
@@ -189,11 +166,6 @@ std::vector<std::string> warnings(const PlenopticCamera& model);
 // axial beam: names the stop, the limiting surface (row, line) and the f-number the lens works at;
 // "" when the stop limits it.
 std::string limiting_aperture_warning(const PlenopticCamera& model);
-
-// Rotation about x, then y, then z, in degrees: v -> Rz * Ry * Rx * v, with the same
-// matrices as POV-Ray's Compute_Rotation_Transform (which applies them to row vectors).
-// Multiples of 90 degrees are exact.
-Mat3 rotation_from_degrees(const double degrees[3]);
 
 // Main-lens -> array and array -> sensor distances measured at the array centre, including the
 // array's z translation. The first is measured from the main lens's exit-pupil centre, from which

@@ -22,7 +22,7 @@ double mean_cos_power_over_cell(const PlenopticCamera& m, double d, double power
     double total = 0;
     for (int b = 0; b < kCellGrid; ++b)
         for (int a = 0; a < kCellGrid; ++a) {
-            const Vec2 q = sample_cell_uniform(m.array.grid, m.array.pitch_mm, (a + 0.5) / kCellGrid, (b + 0.5) / kCellGrid);
+            const Vec2 q = m.array.cell_point((a + 0.5) / kCellGrid, (b + 0.5) / kCellGrid);
             total += std::pow(d * d / (d * d + q.x * q.x + q.y * q.y), 0.5 * power);
         }
     return total / (kCellGrid * kCellGrid);
@@ -63,7 +63,7 @@ double irradiance_constant_mm2(const PlenopticCamera& m)
     // The pixel under the centre of a lens, at d, lit through the lens's whole cell: K = A / C
     // with C = A * mean(cos^m) / d^2 (a pinhole microlens's point: mean 1).
     const double d = effective_array_distance_mm(m);
-    if (m.array.microlens == MicrolensType::Pinhole)
+    if (!m.array.microlens->forms_image())
         return d * d;
     return d * d / mean_cos_power_over_cell(m, d, power);
 }
@@ -74,9 +74,9 @@ double reference_projected_solid_angle_sr(const PlenopticCamera& m)
         return 0;
     if (m.array.grid == GridType::None)
         return !m.lens->forms_image() ? 0 : kPi * std::pow(m.lens->exit_pupil_radius(), 2) / m.sensor.irradiance_k_mm2;
-    if (m.array.microlens == MicrolensType::Pinhole)
-        return 0;
-    return m.array.pitch_mm * row_spacing(m.array.grid, m.array.pitch_mm) / m.sensor.irradiance_k_mm2;  // A / K
+    if (!m.array.microlens->forms_image())
+        return 0;  // a pinhole microlens's point
+    return m.array.pitch_mm * m.array.row_spacing_mm() / m.sensor.irradiance_k_mm2;  // A / K
 }
 
 const char* radiometry_name(Radiometry radiometry)

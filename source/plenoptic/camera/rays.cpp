@@ -31,7 +31,7 @@ bool project_to_array(const PlenopticCamera& m, Vec3 p, Vec2* local)
             return false;
         q = e + s * (p - e);
     }
-    const Vec3 l = to_local(m, q);
+    const Vec3 l = m.array.to_local(q);
     *local = Vec2{l.x, l.y};
     return is_finite(*local);
 }
@@ -40,10 +40,7 @@ bool project_to_array(const PlenopticCamera& m, Vec3 p, Vec2* local)
 
 namespace {
 
-using detail::microlens_focal;
 using detail::project_to_array;
-using detail::to_local;
-using detail::to_optics;
 
 // The ray into the scene as the renderer takes it; false when it does not pass (blocked, not
 // finite, or bent back towards the camera body: see scene_ray).
@@ -58,35 +55,6 @@ bool emit(const SceneRay& ray, OpticsRay* out)
 }
 
 bool finish(Vec3 origin, Vec3 direction, OpticsRay* out) { return emit(scene_ray(origin, direction), out); }
-
-// Ray from sensor point p through the microlens `lens` to the pinhole main lens at the origin.
-// The microlens images the pinhole O to the homogeneous point I = (o, 1 - o_z/f) (lens-relative
-// coordinates); every ray from p aimed at I leaves the lens through O. No division by
-// (1 + D/d - D/f), so near-degenerate set-ups only block rays.
-bool through_pinhole_main(const PlenopticCamera& m, Vec3 p, LensIndex lens, bool check_cell, OpticsRay* out)
-{
-    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
-    const double f = microlens_focal(m, lens);
-    const Vec3 o = to_local(m, Vec3{0, 0, 0});
-    const Vec3 s = to_local(m, p);
-    if (!(o.z > 0) || !(s.z < 0))
-        return false;
-    const Vec3 o_rel{o.x - c.x, o.y - c.y, o.z};
-    const Vec3 p_rel{s.x - c.x, s.y - c.y, s.z};
-    const double w = 1 - o_rel.z / f;
-    Vec3 along = o_rel - w * p_rel;  // direction of the line p -> I
-    if (along.z < 0)
-        along = -along;
-    if (!(along.z > 0))
-        return false;
-    const double t = -p_rel.z / along.z;
-    const double hx = p_rel.x + t * along.x;
-    const double hy = p_rel.y + t * along.y;
-    if (check_cell && nearest_lens(m.array.grid, m.array.pitch_mm, c.x + hx, c.y + hy) != lens)
-        return false;
-    const Vec3 local_out{along.x / along.z - hx / f, along.y / along.z - hy / f, 1};
-    return finish(Vec3{0, 0, 0}, mul(m.array.pose.rotation, local_out), out);
-}
 
 // Under irradiance radiometry, weights a passing ray from sensor point s towards aperture point q
 // (on a plane of normal n) by the cos^4 law (camera/radiometry.h); returns `passed`.
@@ -134,37 +102,26 @@ bool trace_sensor_point(const PlenopticCamera& m, Vec3 p, const LensIndex* force
         Vec2 q;
         if (!project_to_array(m, p, &q))
             return false;
-        lens = nearest_lens(m.array.grid, m.array.pitch_mm, q.x, q.y);
+        lens = m.array.nearest(q.x, q.y);
     }
 
-    if (m.array.microlens == MicrolensType::ThinLens && m.lens && !m.lens->forms_image())
-        return through_pinhole_main(m, p, lens, check_apertures, out);
-
-    const Vec2 c_local = lens_centre(m.array.grid, m.array.pitch_mm, lens);
-    Vec3 leave;      // where the ray leaves the array
-    Vec3 direction;  // after the microlens, optics frame, any length
-    if (m.array.microlens == MicrolensType::Pinhole) {
-        leave = to_optics(m, Vec3{c_local.x, c_local.y, 0});
-        direction = leave - p;
-        if (!(dot(direction, m.array.pose.normal) > 0))
-            return false;  // the sensor point is not behind the array
-    } else {
-        // A point of the lens cell; refraction in the array's own frame, with the direction
-        // normalised to unit local z: w' = w - (h - c) / f.
-        const Vec2 offset = sample_cell_uniform(m.array.grid, m.array.pitch_mm, lens_u, lens_v);
-        leave = to_optics(m, Vec3{c_local.x + offset.x, c_local.y + offset.y, 0});
-        const Vec3 w = mul_transposed(m.array.pose.rotation, leave - p);
-        if (!(w.z > 0))
-            return false;
-        const double f = microlens_focal(m, lens);
-        const Vec3 refracted{w.x / w.z - offset.x / f, w.y / w.z - offset.y / f, 1};
-        direction = mul(m.array.pose.rotation, refracted);
+    if (m.lens && !m.lens->forms_image()) {
+        // A pinhole main lens at the origin: the one ray from p through the microlens that passes it
+        // (none through a pinhole microlens: refused at parse time).
+        const Vec3 pinhole{0, 0, 0};
+        const ArrayRay ray = m.array.microlens->ray_through(m.array, p, lens, pinhole, check_apertures);
+        return ray.passed && finish(ray.origin, ray.direction, out);
     }
+
+    // Where the ray leaves the array, and its direction after the microlens (optics frame).
+    const ArrayRay ray = m.array.microlens->sample_ray(m.array, p, lens, lens_u, lens_v);
+    if (!ray.passed)
+        return false;  // the sensor point is not behind the array
+    const Vec3& leave = ray.origin;
+    const Vec3& direction = ray.direction;
 
     if (!m.lens)
         return weigh(m, finish(leave, direction, out), p, leave, m.array.pose.normal, out);
-    if (!m.lens->forms_image())
-        return false;  // pinhole + pinhole: refused at parse time, no ray passes both points
 
     // A real lens behind an array parallel to the sensor: a ray that crosses the exit pupil's plane
     // outside the pupil-bounds disc of the point where it leaves the array cannot pass the lens
@@ -198,8 +155,8 @@ bool lens_reaches_pixel(const PlenopticCamera& m, LensIndex lens, Vec3 p)
     const double mx = (c.x - e.x) * (1 + k) - (p.x - e.x) * k;
     const double my = (c.y - e.y) * (1 + k) - (p.y - e.y) * k;
     double spread = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]) * k;
-    if (m.array.microlens == MicrolensType::ThinLens)
-        spread += m.array.cell_circumradius_mm * std::fabs(1 + k - main_distance / microlens_focal(m, lens));
+    if (m.array.microlens->forms_image())
+        spread += m.array.cell_circumradius_mm * std::fabs(1 + k - main_distance / m.array.focal_length_mm(lens));
     if (m.array.pose.tilted)
         spread *= 1.25 + 4 * m.array.pose.tilt_sine;
     if (m.pupil_bounds) {
@@ -233,18 +190,14 @@ Vec2 Sensor::principal_point_px() const
     return Vec2{p.u, p.v};
 }
 
-Vec3 lens_centre_mm(const PlenopticCamera& m, LensIndex lens)
-{
-    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
-    return to_optics(m, Vec3{c.x, c.y, 0});
-}
+Vec3 lens_centre_mm(const PlenopticCamera& m, LensIndex lens) { return m.array.centre_mm(lens); }
 
 OwnLens own_lens(const PlenopticCamera& m, Vec3 p)
 {
     Vec2 q;
     if (!project_to_array(m, p, &q))
         return OwnLens{LensIndex{0, 0}, false};
-    return OwnLens{nearest_lens(m.array.grid, m.array.pitch_mm, q.x, q.y), true};
+    return OwnLens{m.array.nearest(q.x, q.y), true};
 }
 
 OpticsRay generate_ray(const PlenopticCamera& m, int i, int j, const CameraSample& sample, const LensIndex* lens)

@@ -11,14 +11,6 @@
 namespace plenoptic {
 namespace detail {
 
-inline Vec3 to_local(const PlenopticCamera& m, Vec3 q) { return mul_transposed(m.array.pose.rotation, q - m.array.pose.centre_mm); }
-inline Vec3 to_optics(const PlenopticCamera& m, Vec3 local) { return m.array.pose.centre_mm + mul(m.array.pose.rotation, local); }
-
-inline double microlens_focal(const PlenopticCamera& m, LensIndex lens)
-{
-    return m.array.focal_mm[lens_type(lens, m.array.lens_type_count)];
-}
-
 // Intersection of the line (main-lens centre -> p), or the vertical line through p when there is
 // no main lens, with the array plane; array-local coordinates. False when they do not meet.
 bool project_to_array(const PlenopticCamera& m, Vec3 p, Vec2* local);

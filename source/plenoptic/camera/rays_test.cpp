@@ -264,14 +264,14 @@ Vec3 trace_back(const PlenopticCamera& m, const CameraParams& params, const Opti
     const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
     Vec3 w = test::reference_unrotate(deg, back);
     w = (1 / -w.z) * w;  // unit travel along -z_local
-    if (m.array.microlens == MicrolensType::ThinLens) {
+    if (params.array.lens == MicrolensType::ThinLens) {
         // Type rule written out here: skew k = k - floor(l/2), type = (k_s - l) mod 3.
         int type = 0;
-        if (m.array.lens_type_count == 3) {
+        if (params.array.focal_length_count == 3) {
             const long long l = lens.l, ks = lens.k - (l >= 0 ? l / 2 : -((-l + 1) / 2));
             type = int((((ks - l) % 3) + 3) % 3);
         }
-        const double f = m.array.focal_mm[type];
+        const double f = params.array.focal_lengths_mm[type];
         // Undo the microlens: sensor-side slope = scene-side slope - (h - c)/f for this direction.
         w = Vec3{w.x - (h_local.x - c.x) / f, w.y - (h_local.y - c.y) / f, -1};
     } else if (std::hypot(h_local.x - c.x, h_local.y - c.y) > 1e-9) {

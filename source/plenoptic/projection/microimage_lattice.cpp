@@ -6,18 +6,15 @@
 #include <cmath>
 
 #include "plenoptic/camera/rays.h"
-#include "plenoptic/camera/rays_internal.h"
 
 namespace plenoptic {
 
 namespace {
 
-using detail::to_optics;
-
 // Pixel coordinates (centre convention) of an array-local point projected onto the sensor.
 bool local_to_px(const PlenopticCamera& m, Vec2 local, Vec2* px)
 {
-    const Vec3 c = to_optics(m, Vec3{local.x, local.y, 0});
+    const Vec3 c = m.array.to_optics(Vec3{local.x, local.y, 0});
     double x = c.x, y = c.y;
     if (m.lens) {
         // The central projection from the exit pupil's centre e onto the sensor plane.
@@ -120,7 +117,7 @@ void fit_lftoolbox(const PlenopticCamera& m, MicroimageLattice* lattice)
 MicroimageCentre microimage_centre_px(const PlenopticCamera& m, LensIndex lens)
 {
     Vec2 px;
-    if (m.array.grid == GridType::None || !local_to_px(m, lens_centre(m.array.grid, m.array.pitch_mm, lens), &px))
+    if (m.array.grid == GridType::None || !local_to_px(m, m.array.centre_local(lens), &px))
         return MicroimageCentre{0, 0, false};
     return MicroimageCentre{px.x, px.y, true};
 }

@@ -19,17 +19,10 @@ namespace detail {
 
 bool sensor_hit_through_lens(const PlenopticCamera& m, LensIndex lens, Vec3 h, Vec3 towards_sensor, Vec3* hit)
 {
-    Vec3 direction = towards_sensor;
-    if (m.array.microlens == MicrolensType::ThinLens) {
-        const Vec3 w = mul_transposed(m.array.pose.rotation, towards_sensor);
-        if (!(w.z < 0))
-            return false;
-        const Vec3 h_local = to_local(m, h);
-        const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
-        const double f = microlens_focal(m, lens);
-        const Vec3 out_local{w.x / -w.z - (h_local.x - c.x) / f, w.y / -w.z - (h_local.y - c.y) / f, -1};
-        direction = mul(m.array.pose.rotation, out_local);
-    }
+    const ArrayRay bent = m.array.microlens->towards_sensor(m.array, lens, h, towards_sensor);
+    if (!bent.passed)
+        return false;
+    const Vec3 direction = bent.direction;
     if (!(direction.z < 0))
         return false;
     const double travel = (m.sensor.z_mm - h.z) / direction.z;
@@ -61,11 +54,11 @@ std::vector<Vec2> picture_polygon(const PlenopticCamera& m)
 std::vector<Vec2> microimage_cell(const PlenopticCamera& m, LensIndex lens)
 {
     Vec2 cell[6];
-    const int count = cell_polygon(m.array.grid, m.array.pitch_mm, cell);
-    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
+    const int count = m.array.cell_corners(cell);
+    const Vec2 c = m.array.centre_local(lens);
     std::vector<Vec2> out;
     for (int i = 0; i < count; ++i) {
-        const Vec3 q = to_optics(m, Vec3{c.x + cell[i].x, c.y + cell[i].y, 0});
+        const Vec3 q = m.array.to_optics(Vec3{c.x + cell[i].x, c.y + cell[i].y, 0});
         double s = 1;
         if (m.lens) {
             if (!(q.z < 0))
@@ -97,10 +90,7 @@ void add_point_hit(const PlenopticCamera& m, LensIndex lens, Vec3 s, double frac
 
 namespace {
 
-using detail::microlens_focal;
 using detail::project_to_array;
-using detail::to_local;
-using detail::to_optics;
 using detail::add_point_hit;
 using detail::delivered_point;
 using detail::microimage_cell;
@@ -201,7 +191,7 @@ void for_each_lens_in_box(const PlenopticCamera& m, Box box, Visit visit)
 {
     if (!box.valid || !(box.x0 <= box.x1) || !(box.y0 <= box.y1))
         return;
-    const double row = row_spacing(m.array.grid, m.array.pitch_mm);
+    const double row = m.array.row_spacing_mm();
     const double rows = std::floor(box.y1 / row) - std::ceil(box.y0 / row) + 1;
     const double columns = (box.x1 - box.x0) / m.array.pitch_mm + 2;
     if (!(rows * columns <= double(kMaxForwardLenses)))
@@ -242,24 +232,25 @@ double distance_to_origin(const Vec2* corner, int count)
 }
 
 // Whether some ray from the object (thin-lens image `image`) through the main aperture passes
-// through the lens's cell (its centre only, for pinholes): the cell, projected from the image
-// point onto the main-lens plane, must meet the aperture disc.
+// through the lens where it lets light through (its cell; a pinhole's centre only): that part,
+// projected from the image point onto the main-lens plane, must meet the aperture disc.
 bool lens_sees(const PlenopticCamera& m, Homogeneous image, LensIndex lens)
 {
     const Vec3 pupil = m.lens->exit_pupil_centre();
-    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
+    const Vec2 c = m.array.centre_local(lens);
+    const bool whole_cell = m.array.microlens->forms_image();
     Vec2 local[6];
     int count = 1;
     local[0] = Vec2{0, 0};
-    if (m.array.microlens == MicrolensType::ThinLens)
-        count = cell_polygon(m.array.grid, m.array.pitch_mm, local);
+    if (whole_cell)
+        count = m.array.cell_corners(local);
     Vec2 projected[6];
     double first_sign = 0;
     for (int i = 0; i < count; ++i) {
-        const Vec3 corner = to_optics(m, Vec3{c.x + local[i].x, c.y + local[i].y, 0});
+        const Vec3 corner = m.array.to_optics(Vec3{c.x + local[i].x, c.y + local[i].y, 0});
         Homogeneous hit;
         if (!line_meets_plane(image, corner, Vec3{0, 0, 1}, pupil, &hit))
-            return m.array.microlens == MicrolensType::ThinLens;  // projection unbounded: keep (conservative)
+            return whole_cell;  // projection unbounded: keep (conservative)
         const double sign = hit.w > 0 ? 1 : -1;
         if (i == 0)
             first_sign = sign;
@@ -294,7 +285,7 @@ bool cone_footprint(const PlenopticCamera& m, Homogeneous image, Vec2 footprint[
             first_sign = sign;
         else if (sign != first_sign)
             return false;
-        const Vec3 local = to_local(m, (1 / hit.w) * hit.xyz);
+        const Vec3 local = m.array.to_local((1 / hit.w) * hit.xyz);
         footprint[i] = Vec2{local.x, local.y};
     }
     return true;
@@ -379,7 +370,7 @@ double delivered_area(const PlenopticCamera& m, LensIndex lens, const std::vecto
         const Vec3 c = lens_centre_mm(m, lens);
         if (c.z < 0) {
             const double scale = m.sensor.z_mm / c.z;
-            const double radius = scale * (rings > 0 ? rings * row_spacing(m.array.grid, m.array.pitch_mm) : m.array.cell_inradius_mm);
+            const double radius = scale * (rings > 0 ? rings * m.array.row_spacing_mm() : m.array.cell_inradius_mm);
             bool covered = true;
             for (const Vec2& q : inside)
                 covered = covered && length(q - Vec2{c.x * scale, c.y * scale}) <= radius * (1 - 1e-9);
@@ -465,7 +456,7 @@ bool cell_spot_may_reach_picture(const PlenopticCamera& m, LensIndex lens, Homog
 {
     Box spot{false, 0, 0, 0, 0};
     for (const Vec2& q : corners) {
-        const Vec3 h = to_optics(m, Vec3{q.x, q.y, 0});
+        const Vec3 h = m.array.to_optics(Vec3{q.x, q.y, 0});
         Vec3 towards = image.w == 0 ? image.xyz : (1 / image.w) * image.xyz - h;
         if (dot(towards, m.array.pose.normal) > 0)
             towards = -towards;
@@ -501,7 +492,7 @@ void project_through_thin_main(const PlenopticCamera& m, Vec3 point, std::vector
         if (i == 0)
             first_sign = sign;
         bounded = sign == first_sign;
-        const Vec3 local = to_local(m, (1 / hit.w) * hit.xyz);
+        const Vec3 local = m.array.to_local((1 / hit.w) * hit.xyz);
         include(&footprint, Vec2{local.x, local.y});
     }
     if (!bounded)
@@ -527,9 +518,9 @@ void project_through_thin_main(const PlenopticCamera& m, Vec3 point, std::vector
         if (image.w == 0)
             return;
         const Vec3 h = (1 / image.w) * image.xyz;
-        const Vec3 h_local = to_local(m, h);
-        const LensIndex lens = nearest_lens(m.array.grid, m.array.pitch_mm, h_local.x, h_local.y);
-        if (m.array.microlens == MicrolensType::Pinhole) {
+        const Vec3 h_local = m.array.to_local(h);
+        const LensIndex lens = m.array.nearest(h_local.x, h_local.y);
+        if (!m.array.microlens->forms_image()) {
             if (length(h - lens_centre_mm(m, lens)) > 1e-9 * m.array.pitch_mm)
                 return;  // a pinhole passes light only at its centre
             Vec3 hit;
@@ -560,10 +551,10 @@ void project_through_thin_main(const PlenopticCamera& m, Vec3 point, std::vector
     // whose footprints are small, need the partial cells. The fraction is the part of the point's
     // light through the main aperture that arrives in that image.
     Vec2 cone[kFootprintSides];
-    const bool thin_microlenses = m.array.microlens == MicrolensType::ThinLens;
+    const bool thin_microlenses = m.array.microlens->forms_image();
     const bool use_footprint = thin_microlenses && cone_footprint(m, image, cone);
     Vec2 cell[6];
-    const int cell_count = thin_microlenses ? cell_polygon(m.array.grid, m.array.pitch_mm, cell) : 0;
+    const int cell_count = thin_microlenses ? m.array.cell_corners(cell) : 0;
     const std::vector<Vec2> cone_polygon(cone, cone + (use_footprint ? kFootprintSides : 0));
     Vec2 unused;
     const double cone_area = use_footprint ? area_centroid(cone_polygon, &unused) : 0;
@@ -573,7 +564,7 @@ void project_through_thin_main(const PlenopticCamera& m, Vec3 point, std::vector
         if (!lens_sees(m, image, lens))
             return;
         if (use_footprint && cone_area > 0) {
-            const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
+            const Vec2 c = m.array.centre_local(lens);
             std::vector<Vec2> corners(cell_count);
             for (int i = 0; i < cell_count; ++i)
                 corners[i] = c + cell[i];
@@ -592,7 +583,7 @@ void project_through_thin_main(const PlenopticCamera& m, Vec3 point, std::vector
             // X' - h, towards the sensor).
             std::vector<Vec2> spot;
             for (const Vec2& q : part) {
-                const Vec3 h = to_optics(m, Vec3{q.x, q.y, 0});
+                const Vec3 h = m.array.to_optics(Vec3{q.x, q.y, 0});
                 Vec3 towards = image.w == 0 ? image.xyz : (1 / image.w) * image.xyz - h;
                 if (dot(towards, m.array.pose.normal) > 0)
                     towards = -towards;
@@ -617,8 +608,8 @@ void project_through_thin_main(const PlenopticCamera& m, Vec3 point, std::vector
 
 void project_through_pinhole_main(const PlenopticCamera& m, Vec3 point, std::vector<PixelHit>* hits)
 {
-    if (m.array.microlens == MicrolensType::Pinhole)
-        return;
+    if (!m.array.microlens->forms_image())
+        return;  // a pinhole's only ray through the main pinhole misses the point but by chance
     // The single ray: point -> pinhole -> array.
     const Vec3 towards_sensor = -point;
     const double along = dot(m.array.pose.normal, towards_sensor);
@@ -626,8 +617,8 @@ void project_through_pinhole_main(const PlenopticCamera& m, Vec3 point, std::vec
     if (!(t > 0) || !std::isfinite(t))
         return;
     const Vec3 h = t * towards_sensor;
-    const Vec3 h_local = to_local(m, h);
-    const LensIndex lens = nearest_lens(m.array.grid, m.array.pitch_mm, h_local.x, h_local.y);
+    const Vec3 h_local = m.array.to_local(h);
+    const LensIndex lens = m.array.nearest(h_local.x, h_local.y);
     Vec3 hit;
     if (sensor_hit_through_lens(m, lens, h, towards_sensor, &hit))
         add_point_hit(m, lens, hit, 1.0, hits);
@@ -635,7 +626,7 @@ void project_through_pinhole_main(const PlenopticCamera& m, Vec3 point, std::vec
 
 void project_without_main(const PlenopticCamera& m, Vec3 point, std::vector<PixelHit>* hits)
 {
-    const Vec3 local = to_local(m, point);
+    const Vec3 local = m.array.to_local(point);
     if (!(local.z > 0))
         return;  // behind the array
     Box box = sensor_box(m);

@@ -16,8 +16,9 @@ namespace plenoptic {
 namespace detail {
 
 // Sensor hit of a ray arriving at array point h (optics frame) with direction `towards_sensor`,
-// refracted by `lens` (the same rule w' = w - (h - c)/f with w normalised to unit travel along the
-// normal); pinholes pass it unchanged. False when it does not reach the sensor plane.
+// passed by `lens` as its kind passes light (Microlens::towards_sensor: a thin lens refracts it by
+// the rule of ray generation, a pinhole lets it through unchanged). False when it does not reach
+// the sensor plane.
 bool sensor_hit_through_lens(const PlenopticCamera& m, LensIndex lens, Vec3 h, Vec3 towards_sensor, Vec3* hit);
 
 // Lenses whose microimage cells may receive light through a lens: the renderer gives a sensor

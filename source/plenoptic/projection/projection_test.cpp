@@ -55,7 +55,7 @@ TEST(Optics, FocusedOnTheArrayImagesToTheCentreOfTheOnAxisMicroimage)
 // arrays use the untilted footprint with a margin of a pitch: an over-approximation.
 bool partly_covered(const PlenopticCamera& m, Vec3 x, LensIndex lens)
 {
-    if (test::lens_kind(m) != "thin_lens" || m.array.microlens != MicrolensType::ThinLens)
+    if (test::lens_kind(m) != "thin_lens" || m.spec.array.lens != MicrolensType::ThinLens)
         return false;
     const double F = m.focal_length_mm(), D = m.distance_mm;
     const double b = F * x.z / (x.z - F);             // image distance behind the main lens
@@ -176,7 +176,7 @@ void check_forward_is_centroid(const char* name, const CameraParams& params, dou
             const double hx = mx - wx * D, hy = my - wy * D;
             const LensIndex lens = test::brute_force_nearest(m.array.grid, m.array.pitch_mm, hx, hy);
             const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
-            const double f = m.array.focal_mm[lens_type(lens, m.array.lens_type_count)];
+            const double f = m.array.focal_length_mm(lens);
             const double bx = wx + (hx - c.x) / f, by = wy + (hy - c.y) / f;
             const double sxm = hx - bx * d, sym = hy - by * d;
             const double u = W / 2.0 - 0.5 - sxm / sx, v = H / 2.0 - 0.5 + sym / sy;

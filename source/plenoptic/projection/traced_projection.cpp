@@ -20,7 +20,6 @@ namespace {
 using detail::add_point_hit;
 using detail::delivered_point;
 using detail::sensor_hit_through_lens;
-using detail::to_local;
 
 // A square of the window's plane: centre (x, y), half side.
 struct Square {
@@ -82,7 +81,7 @@ Coarse coarse_pass(const PlenopticCamera& m, Vec3 point, double window_z, Square
             out.window.include(disc.x + dx, disc.y + dy);
             Vec3 h;
             if (m.array.grid != GridType::None && array_hit(m, ray, &h)) {
-                const Vec3 local = to_local(m, h);
+                const Vec3 local = m.array.to_local(h);
                 out.array.include(local.x, local.y);
             }
         }
@@ -104,13 +103,13 @@ typedef std::pair<std::int64_t, std::int64_t> RowKey;  // (l, k): row order
 // (apertures ignored while iterating, so that a lens near the edge of the light converges).
 bool ray_through_centre(const PlenopticCamera& m, Vec3 point, double window_z, LensIndex lens, double step, double* x, double* y)
 {
-    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
+    const Vec2 c = m.array.centre_local(lens);
     auto miss = [&](double px, double py, Vec2* out) {
         const ImageRay ray = trace_through(m, point, window_z, px, py, false);
         Vec3 h;
         if (!ray.passed || !array_hit(m, ray, &h))
             return false;
-        const Vec3 local = to_local(m, h);
+        const Vec3 local = m.array.to_local(h);
         *out = Vec2{local.x - c.x, local.y - c.y};
         return true;
     };
@@ -182,13 +181,13 @@ Ray sample(const PlenopticCamera& m, Vec3 point, double window_z, double wx, dou
     Vec3 h;
     if (!array_hit(m, ray, &h))
         return out;
-    const Vec3 local = to_local(m, h);
-    const LensIndex lens = nearest_lens(m.array.grid, m.array.pitch_mm, local.x, local.y);
-    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
+    const Vec3 local = m.array.to_local(h);
+    const LensIndex lens = m.array.nearest(local.x, local.y);
+    const Vec2 c = m.array.centre_local(lens);
     out.lens = RowKey(lens.l, lens.k);
     out.nearest2 = (local.x - c.x) * (local.x - c.x) + (local.y - c.y) * (local.y - c.y);
     Vec3 sensor;
-    if (m.array.microlens == MicrolensType::Pinhole || !sensor_hit_through_lens(m, lens, h, ray.dir, &sensor) ||
+    if (!m.array.microlens->forms_image() || !sensor_hit_through_lens(m, lens, h, ray.dir, &sensor) ||
         !delivered_point(m, lens, Vec2{sensor.x, sensor.y}))
         return out;
     out.kind = Ray::Delivered;
@@ -294,13 +293,15 @@ std::vector<PixelHit> forward_project_traced(const PlenopticCamera& m, Vec3 poin
         for (int i = 0; i <= n; ++i)
             (*row)[i] = sample(m, point, window.z, x0 + i * step_x, y0 + j * step_y);
     };
+    // Pinholes pass light only at their centres: each needs only the ray nearest it.
+    const bool pinholes = m.array.present() && !m.array.microlens->forms_image();
     std::vector<Ray> below, above;
     node_row(0, &below);
     for (int j = 0; j < n; ++j) {
         node_row(j + 1, &above);
         for (int i = 0; i < n; ++i) {
             const Ray* corner[4] = {&below[i], &below[i + 1], &above[i], &above[i + 1]};
-            if (m.array.microlens == MicrolensType::Pinhole && m.array.grid != GridType::None) {
+            if (pinholes) {
                 light.nearest(*corner[0]);  // pinholes need only the ray nearest each lens centre
                 continue;
             }
@@ -318,7 +319,7 @@ std::vector<PixelHit> forward_project_traced(const PlenopticCamera& m, Vec3 poin
                                      y0 + (j + (b + 0.5) / sub) * step_y),
                               1.0 / (sub * sub));
         }
-        if (m.array.microlens == MicrolensType::Pinhole && m.array.grid != GridType::None)
+        if (pinholes)
             for (int i = 0; i < n; ++i)
                 light.nearest(above[i]);
         below.swap(above);
@@ -339,7 +340,7 @@ std::vector<PixelHit> forward_project_traced(const PlenopticCamera& m, Vec3 poin
     for (const auto& entry : light.lenses) {
         const LensIndex lens{entry.first.second, entry.first.first};
         const LensLight& acc = entry.second;
-        if (m.array.microlens == MicrolensType::Pinhole) {
+        if (pinholes) {
             double wx = acc.wx, wy = acc.wy;
             if (!ray_through_centre(m, point, window.z, lens, std::max(step_x, step_y), &wx, &wy))
                 continue;

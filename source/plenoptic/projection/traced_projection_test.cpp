@@ -100,7 +100,7 @@ TEST(TracedProjection, ThroughAThinLensAgreesWithTheClosedForm)
     for (const Case& c : thin_lens_cases()) {
         const PlenopticCamera m = make_camera(c.params);
         ASSERT_EQ(test::lens_kind(m), "thin_lens");
-        const bool pinholes = m.array.microlens == MicrolensType::Pinhole && m.array.grid != GridType::None;
+        const bool pinholes = c.params.array.given && c.params.array.lens == MicrolensType::Pinhole;
         size_t images = 0;
         double worst_px = 0, worst_fraction = 0;
         for (const auto& p : points) {

@@ -34,7 +34,7 @@ std::string check_diffraction(const DiffractionParams& diffraction, const Camera
 {
     if (!diffraction.given)
         return "";
-    if (params.array.given && params.array.lens == MicrolensType::Pinhole)
+    if (params.array.given && !make_microlens(params.array)->forms_image())
         return "diffraction needs apertures with a size: pinhole microlenses have none (a point diffracts light "
                "everywhere); give the array focal_length";
     if (!params.array.given && is_pinhole(params.main))
@@ -48,8 +48,8 @@ Diffraction diffraction_of(const PlenopticCamera& m, const DiffractionParams& pa
     if (!params.given)
         return out;
     if (m.array.grid != GridType::None) {
-        if (m.array.microlens != MicrolensType::ThinLens)
-            return out;
+        if (!m.array.microlens->forms_image())
+            return out;  // a pinhole has no aperture with a size
         out.aperture = "microlens";
         out.aperture_diameter_mm = 2 * m.array.cell_inradius_mm;
         out.distance_mm = effective_array_distance_mm(m);

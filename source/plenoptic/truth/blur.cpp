@@ -37,7 +37,7 @@ double blur_radius_px(const PlenopticCamera& m, Vec3 point, LensIndex lens)
 {
     if (m.array.grid == GridType::None)
         return main_lens_blur_px(m, point);
-    if (m.array.microlens == MicrolensType::Pinhole || (m.lens && !m.lens->forms_image()))
+    if (!m.array.microlens->forms_image() || (m.lens && !m.lens->forms_image()))
         return 0;
     const Vec3 c = lens_centre_mm(m, lens);
     double inverse_a = 0;  // 1/a; 0 for an image at infinity
@@ -49,7 +49,7 @@ double blur_radius_px(const PlenopticCamera& m, Vec3 point, LensIndex lens)
         // a = n . (X / w - c) = (n . X - w n . c) / w, so 1/a = w / (n . X - w n . c).
         inverse_a = image.w / (dot(m.array.pose.normal, image.xyz) - image.w * dot(m.array.pose.normal, c));
     }
-    const double f = m.array.focal_mm[lens_type(lens, m.array.lens_type_count)];
+    const double f = m.array.focal_length_mm(lens);
     const double d = c.z - m.sensor.z_mm;
     const double r = 0.5 * m.array.pitch_mm * d * (1 / f - inverse_a - 1 / d);
     return std::isfinite(r) ? r / m.sensor.pixel_size_mm[0] : kNaN;

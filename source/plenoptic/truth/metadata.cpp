@@ -103,10 +103,10 @@ Json microlens_array(const PlenopticCamera& m, const CameraParams& params)
         return nullptr;
     Json json = Json::object();
     json["grid"] = m.array.grid == GridType::Hexagonal ? "hexagonal" : "rectangular";
-    json["lens"] = m.array.microlens == MicrolensType::ThinLens ? "thin_lens" : "pinhole";
+    json["lens"] = m.array.microlens->kind_name();
     json["pitch_mm"] = json_number(m.array.pitch_mm);
-    json["focal_lengths_mm"] =
-        json_numbers(m.array.focal_mm, m.array.microlens == MicrolensType::ThinLens ? m.array.lens_type_count : 0);
+    const std::vector<double> focal_lengths = m.array.microlens->focal_lengths_mm();
+    json["focal_lengths_mm"] = json_numbers(focal_lengths.data(), int(focal_lengths.size()));
     json["distance_mm"] = json_number(m.array.distance_mm);
     json["rotate_deg"] = json_numbers(params.array.rotate_deg, 3);
     json["translate_mm"] = json_numbers(params.array.translate_mm, 3);
@@ -125,7 +125,7 @@ Json lattice_json(const PlenopticCamera& m, const MicroimageLattice& lattice)
                              ? "skew indices (k, l): hexagonal centres in the array are k*(p,0) + l*(p/2, p*sqrt(3)/2)"
                              : "skew indices (k, l): rectangular centres in the array are k*(p,0) + l*(0,p)";
     json["exact"] = lattice.exact;
-    const int types = m.array.microlens == MicrolensType::ThinLens ? m.array.lens_type_count : 1;
+    const int types = m.array.lens_type_count;
     json["lens_types"] = types;
     json["lens_type_rule"] = types == 3 ? "type(k, l) = (k - l) mod 3, focal_lengths_mm[type]" : "type(k, l) = 0";
     // Diameter of the main lens's exit pupil imaged through a lens centre (the f-number-matched disc).

@@ -22,7 +22,6 @@ namespace plenoptic {
 namespace {
 
 using detail::project_to_array;
-using detail::to_optics;
 
 const int kCoarseSearch = 24;   // grid points a side when the start point is dark
 const int kMaxDoublings = 8;    // of the bracket, when a boundary lies beyond it
@@ -157,11 +156,11 @@ bool project_to_sensor_px(const PlenopticCamera& m, Vec3 q, Vec2* px)
 double microimage_cell_area_px(const PlenopticCamera& m, LensIndex lens)
 {
     Vec2 corners[6];
-    const int count = cell_polygon(m.array.grid, m.array.pitch_mm, corners);
-    const Vec2 c = lens_centre(m.array.grid, m.array.pitch_mm, lens);
+    const int count = m.array.cell_corners(corners);
+    const Vec2 c = m.array.centre_local(lens);
     Vec2 px[6];
     for (int i = 0; i < count; ++i)
-        if (!project_to_sensor_px(m, to_optics(m, Vec3{c.x + corners[i].x, c.y + corners[i].y, 0}), &px[i]))
+        if (!project_to_sensor_px(m, m.array.to_optics(Vec3{c.x + corners[i].x, c.y + corners[i].y, 0}), &px[i]))
             return 0;
     double twice = 0;
     for (int i = 0; i < count; ++i)
@@ -186,10 +185,10 @@ Guess guess_region(const PlenopticCamera& m, LensIndex lens, double lens_u, doub
 {
     const double pixel = std::min(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]);
     const double behind = effective_array_distance_mm(m);
-    const Vec2 c_local = lens_centre(m.array.grid, m.array.pitch_mm, lens);
-    const bool thin = m.array.microlens == MicrolensType::ThinLens;
-    const Vec2 offset = thin ? sample_cell_uniform(m.array.grid, m.array.pitch_mm, lens_u, lens_v) : Vec2{0, 0};
-    const Vec3 h = to_optics(m, Vec3{c_local.x + offset.x, c_local.y + offset.y, 0});
+    const Vec2 c_local = m.array.centre_local(lens);
+    const bool thin = m.array.microlens->forms_image();  // light through the whole cell, bent by f
+    const Vec2 offset = thin ? m.array.cell_point(lens_u, lens_v) : Vec2{0, 0};
+    const Vec3 h = m.array.to_optics(Vec3{c_local.x + offset.x, c_local.y + offset.y, 0});
     PupilDisc disc{m.lens->exit_pupil_centre(), m.lens->exit_pupil_radius()};
     if (m.pupil_bounds)
         disc = m.pupil_bounds->disc_for(h);
@@ -205,7 +204,7 @@ Guess guess_region(const PlenopticCamera& m, LensIndex lens, double lens_u, doub
         return Guess{false, 0, 0, 0};
     double wx = (disc.centre.x - h.x) / along, wy = (disc.centre.y - h.y) / along;
     if (thin) {
-        const double f = detail::microlens_focal(m, lens);
+        const double f = m.array.focal_length_mm(lens);
         const Vec3 shift = mul(m.array.pose.rotation, Vec3{offset.x / f, offset.y / f, 0});
         wx += shift.x;
         wy += shift.y;
@@ -285,7 +284,7 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         }
     }
 
-    const bool thin = m.array.microlens == MicrolensType::ThinLens;
+    const bool thin = m.array.microlens->forms_image();  // a pinhole has one aperture point
     const int n = thin ? std::max(1, options.aperture_points) : 1;
     auto measure = [&](std::size_t index) {
         MicroimageTruth& truth = out[index];

@@ -14,11 +14,11 @@ namespace plenoptic {
 
 bool is_focused_camera(const PlenopticCamera& m)
 {
-    if (m.array.grid == GridType::None || m.array.microlens != MicrolensType::ThinLens || !m.lens || !m.lens->forms_image())
+    if (!m.array.present() || !m.array.microlens->forms_image() || !m.lens || !m.lens->forms_image())
         return false;
     const double d = effective_array_distance_mm(m);
     for (int t = 0; t < m.array.lens_type_count; ++t)
-        if (std::fabs(m.array.focal_mm[t] - d) > 1e-9 * d)
+        if (std::fabs(m.array.microlens->focal_length_mm(t) - d) > 1e-9 * d)
             return true;
     return false;
 }

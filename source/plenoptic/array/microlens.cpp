@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The two kinds of microlens: pinholes and ideal thin lenses.
+
+#include "plenoptic/array/microlens.h"
+
+#include <cmath>
+#include <limits>
+
+#include "plenoptic/array/microlens_array.h"
+
+namespace plenoptic {
+
+std::vector<double> Microlens::focal_lengths_mm() const
+{
+    std::vector<double> out;
+    if (forms_image())
+        for (int t = 0; t < type_count(); ++t)
+            out.push_back(focal_length_mm(t));
+    return out;
+}
+
+namespace {
+
+ArrayRay no_ray() { return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false}; }
+
+// A pinhole at each lens centre: every ray through it goes straight on.
+class PinholeMicrolens : public Microlens {
+public:
+    const char* kind_name() const override { return "pinhole"; }
+    bool forms_image() const override { return false; }
+    double focal_length_mm(int) const override { return std::numeric_limits<double>::quiet_NaN(); }
+
+    ArrayRay sample_ray(const MicrolensArray& array, const Vec3& p, LensIndex lens, double, double) const override
+    {
+        const Vec2 c = array.centre_local(lens);
+        const Vec3 leave = array.to_optics(Vec3{c.x, c.y, 0});
+        const Vec3 direction = leave - p;
+        if (!(dot(direction, array.pose.normal) > 0))
+            return no_ray();  // the sensor point is not behind the array
+        return ArrayRay{leave, direction, true};
+    }
+
+    ArrayRay ray_through(const MicrolensArray&, const Vec3&, LensIndex, Vec3, bool) const override { return no_ray(); }
+
+    ArrayRay towards_sensor(const MicrolensArray&, LensIndex, Vec3 h, Vec3 direction) const override
+    {
+        return ArrayRay{h, direction, true};
+    }
+};
+
+// Ideal thin lenses, refracting in the array's own frame: with the direction normalised to unit
+// component along the normal, w' = w - (h - c) / f for a ray meeting the lens at h.
+class ThinMicrolens : public Microlens {
+public:
+    ThinMicrolens(const double* focal_mm, int type_count) : type_count_(type_count)
+    {
+        for (int t = 0; t < 3; ++t)
+            focal_mm_[t] = focal_mm[t < type_count ? t : 0];
+    }
+
+    const char* kind_name() const override { return "thin_lens"; }
+    bool forms_image() const override { return true; }
+    int type_count() const override { return type_count_; }
+    double focal_length_mm(int type) const override { return focal_mm_[type]; }
+
+    ArrayRay sample_ray(const MicrolensArray& array, const Vec3& p, LensIndex lens, double u, double v) const override
+    {
+        // A point of the lens cell; refraction in the array's own frame.
+        const double f = focal(array, lens);
+        const Vec2 c = array.centre_local(lens);
+        const Vec2 offset = array.cell_point(u, v);
+        const Vec3 leave = array.to_optics(Vec3{c.x + offset.x, c.y + offset.y, 0});
+        const Vec3 w = mul_transposed(array.pose.rotation, leave - p);
+        if (!(w.z > 0))
+            return no_ray();
+        const Vec3 refracted{w.x / w.z - offset.x / f, w.y / w.z - offset.y / f, 1};
+        return ArrayRay{leave, mul(array.pose.rotation, refracted), true};
+    }
+
+    // The lens images the target O to the homogeneous point I = (o, 1 - o_z/f) (lens-relative
+    // coordinates); every ray from p aimed at I leaves the lens through O. No division by
+    // (1 + D/d - D/f), so near-degenerate set-ups only block rays.
+    ArrayRay ray_through(const MicrolensArray& array, const Vec3& p, LensIndex lens, Vec3 target, bool check_cell) const override
+    {
+        const Vec2 c = array.centre_local(lens);
+        const double f = focal(array, lens);
+        const Vec3 o = array.to_local(target);
+        const Vec3 s = array.to_local(p);
+        if (!(o.z > 0) || !(s.z < 0))
+            return no_ray();
+        const Vec3 o_rel{o.x - c.x, o.y - c.y, o.z};
+        const Vec3 p_rel{s.x - c.x, s.y - c.y, s.z};
+        const double w = 1 - o_rel.z / f;
+        Vec3 along = o_rel - w * p_rel;  // direction of the line p -> I
+        if (along.z < 0)
+            along = -along;
+        if (!(along.z > 0))
+            return no_ray();
+        const double t = -p_rel.z / along.z;
+        const double hx = p_rel.x + t * along.x;
+        const double hy = p_rel.y + t * along.y;
+        if (check_cell && array.nearest(c.x + hx, c.y + hy) != lens)
+            return no_ray();
+        const Vec3 local_out{along.x / along.z - hx / f, along.y / along.z - hy / f, 1};
+        return ArrayRay{target, mul(array.pose.rotation, local_out), true};
+    }
+
+    ArrayRay towards_sensor(const MicrolensArray& array, LensIndex lens, Vec3 h, Vec3 direction) const override
+    {
+        const Vec3 w = mul_transposed(array.pose.rotation, direction);
+        if (!(w.z < 0))
+            return no_ray();
+        const Vec3 h_local = array.to_local(h);
+        const Vec2 c = array.centre_local(lens);
+        const double f = focal(array, lens);
+        const Vec3 out_local{w.x / -w.z - (h_local.x - c.x) / f, w.y / -w.z - (h_local.y - c.y) / f, -1};
+        return ArrayRay{h, mul(array.pose.rotation, out_local), true};
+    }
+
+private:
+    double focal(const MicrolensArray& array, LensIndex lens) const { return focal_mm_[array.type_of(lens)]; }
+
+    int type_count_;
+    double focal_mm_[3];
+};
+
+} // namespace
+
+std::shared_ptr<const Microlens> make_pinhole_microlens() { return std::make_shared<PinholeMicrolens>(); }
+
+std::shared_ptr<const Microlens> make_thin_microlens(const double* focal_mm, int type_count)
+{
+    return std::make_shared<ThinMicrolens>(focal_mm, type_count);
+}
+
+} // namespace plenoptic

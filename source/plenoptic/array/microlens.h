@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The microlenses of an array: one interface for every kind of microlens, with one implementation
+// per kind, each answering for itself (what it is called, whether it forms an image, its focal
+// lengths, how it passes a ray). Nothing outside this folder asks which kind the lenses are; it asks
+// the lens. The array (array/microlens_array.h) places the lenses and says which lens type each is.
+
+#ifndef PLENOPTIC_MICROLENS_H
+#define PLENOPTIC_MICROLENS_H
+
+#include <memory>
+#include <vector>
+
+#include "plenoptic/core/lattice.h"
+#include "plenoptic/core/vec.h"
+
+namespace plenoptic {
+
+struct MicrolensArray;
+
+// A ray leaving a microlens: where it leaves (optics frame, mm) and its direction (any length).
+// passed false: there is no such ray (the other fields are then meaningless).
+struct ArrayRay {
+    Vec3 origin;
+    Vec3 direction;
+    bool passed;
+};
+
+// The lenses of one array, all of one kind. Lens types (multi-focus arrays have 3) differ only in
+// their first-order data; the array says which type a lens is (MicrolensArray::type_of). Rays are
+// passed in the array's own frame (its pose, MicrolensArray::to_local); every method takes the
+// array for its lattice and pose.
+class Microlens {
+public:
+    virtual ~Microlens() {}
+
+    // What the metadata calls this kind of lens (microlens_array.lens: "pinhole", "thin_lens").
+    virtual const char* kind_name() const = 0;
+    // A pinhole forms no image: light passes it only at its centre, undeviated; it has no focal
+    // length, nothing blurs through it, and it has no area to be lit through or to diffract.
+    // A lens that forms one passes light anywhere in its lattice cell.
+    virtual bool forms_image() const = 0;
+    // How many lens types the array's lenses come in (1, or 3 for a multi-focus array).
+    virtual int type_count() const { return 1; }
+    // The paraxial focal length of lens type `type` (0 <= type < type_count()); only for lenses that
+    // form an image (a pinhole has none: NaN).
+    virtual double focal_length_mm(int type) const = 0;
+    // The focal length of each lens type, as the metadata lists them; empty for a pinhole.
+    std::vector<double> focal_lengths_mm() const;
+
+    // The ray from sensor point p (optics frame) through lens `lens` for the aperture sample (u, v)
+    // in [0, 1)^2, as it leaves the array towards the scene: through the pinhole's centre, or
+    // through the point of the lens's cell the sample picks (uniform over the cell, (0.5, 0.5) the
+    // centre), bent by the lens. Not passed when p is not behind the array. Per sample: no
+    // allocation, no search, no trigonometry.
+    virtual ArrayRay sample_ray(const MicrolensArray& array, const Vec3& p, LensIndex lens, double u, double v) const = 0;
+
+    // The ray from sensor point p through lens `lens` that leaves the lens heading for `target` (a
+    // point in front of the array: a pinhole main lens), returned from `target` on. Not passed when
+    // there is none (a pinhole's only ray from p misses any given point but by chance), when p or
+    // the target is on the wrong side of the array, or, with check_cell, when the ray crosses the
+    // lens plane outside the lens's cell.
+    virtual ArrayRay ray_through(const MicrolensArray& array, const Vec3& p, LensIndex lens, Vec3 target,
+                                 bool check_cell) const = 0;
+
+    // Light arriving from the scene at point h of lens `lens`'s plane, travelling along `direction`
+    // (optics frame, any length): the ray leaving the lens towards the sensor, from h. Not passed
+    // when the light does not head towards the sensor side.
+    virtual ArrayRay towards_sensor(const MicrolensArray& array, LensIndex lens, Vec3 h, Vec3 direction) const = 0;
+};
+
+// Pinholes.
+std::shared_ptr<const Microlens> make_pinhole_microlens();
+// Ideal thin lenses of focal lengths focal_mm[0 .. type_count - 1] (type_count 1 or 3): a ray
+// meeting a lens at offset h from its centre, its direction normalised to unit component along the
+// lens normal, leaves with w' = w - h / f, in either direction of travel.
+std::shared_ptr<const Microlens> make_thin_microlens(const double* focal_mm, int type_count);
+
+} // namespace plenoptic
+
+#endif

@@ -1,0 +1,87 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The microlens array: its pose and its construction.
+
+#include "plenoptic/array/microlens_array.h"
+
+#include <cmath>
+#include <utility>
+
+namespace plenoptic {
+
+namespace {
+
+// sin and cos of an angle in degrees, exact at multiples of 90 degrees so that an unrotated or
+// quarter-turned array stays exactly axis-aligned.
+void sin_cos_degrees(double degrees, double* s, double* c)
+{
+    const double reduced = std::fmod(degrees, 360.0);  // exact
+    const double quarter = reduced / 90.0;
+    if (quarter == std::floor(quarter)) {
+        static const double sines[4] = {0, 1, 0, -1};
+        const int q = int(((long long)quarter % 4 + 4) % 4);
+        *s = sines[q];
+        *c = sines[(q + 1) % 4];
+        return;
+    }
+    const double radians = reduced * (kPi / 180.0);
+    *s = std::sin(radians);
+    *c = std::cos(radians);
+}
+
+} // namespace
+
+Mat3 rotation_from_degrees(const double degrees[3])
+{
+    double sx, cx, sy, cy, sz, cz;
+    sin_cos_degrees(degrees[0], &sx, &cx);
+    sin_cos_degrees(degrees[1], &sy, &cy);
+    sin_cos_degrees(degrees[2], &sz, &cz);
+    // Column-vector forms of POV-Ray's row-vector matrices (its [1][2] = sin x is our [2][1]).
+    const Mat3 rx = {{{1, 0, 0}, {0, cx, -sx}, {0, sx, cx}}};
+    const Mat3 ry = {{{cy, 0, sy}, {0, 1, 0}, {-sy, 0, cy}}};
+    const Mat3 rz = {{{cz, -sz, 0}, {sz, cz, 0}, {0, 0, 1}}};
+    return mul(rz, mul(ry, rx));
+}
+
+ArrayPose make_array_pose(const double rotate_deg[3], Vec3 centre_mm)
+{
+    ArrayPose pose;
+    pose.rotation = rotation_from_degrees(rotate_deg);
+    pose.centre_mm = centre_mm;
+    pose.normal = mul(pose.rotation, Vec3{0, 0, 1});
+    pose.tilted = !(pose.rotation.m[0][2] == 0 && pose.rotation.m[1][2] == 0);
+    pose.tilt_sine = std::hypot(pose.normal.x, pose.normal.y);
+    return pose;
+}
+
+MicrolensArray no_microlens_array(double plane_z)
+{
+    const double no_rotation[3] = {0, 0, 0};
+    MicrolensArray array;
+    array.grid = GridType::None;
+    array.pitch_mm = 0;
+    array.microlens = nullptr;
+    array.lens_type_count = 1;
+    array.distance_mm = 0;
+    array.pose = make_array_pose(no_rotation, Vec3{0, 0, plane_z});
+    array.cell_inradius_mm = 0;
+    array.cell_circumradius_mm = 0;
+    return array;
+}
+
+MicrolensArray make_microlens_array(GridType grid, double pitch_mm, std::shared_ptr<const Microlens> microlens,
+                                    double distance_mm, const ArrayPose& pose)
+{
+    MicrolensArray array;
+    array.grid = grid;
+    array.pitch_mm = pitch_mm;
+    array.lens_type_count = microlens->type_count();
+    array.microlens = std::move(microlens);
+    array.distance_mm = distance_mm;
+    array.pose = pose;
+    array.cell_inradius_mm = cell_inradius(grid, pitch_mm);
+    array.cell_circumradius_mm = cell_circumradius(grid, pitch_mm);
+    return array;
+}
+
+} // namespace plenoptic

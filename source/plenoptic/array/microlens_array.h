@@ -1,0 +1,86 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// The microlens array as the camera holds it: its lattice (rectangular or hexagonal, core/lattice.h),
+// its pose in the optics frame, its lenses (one kind, array/microlens.h) and which lens type each
+// lens is. It answers the questions its users used to work out from its fields: where a lens is,
+// which lens a point belongs to, a lens's type and focal length, the array's own frame.
+
+#ifndef PLENOPTIC_MICROLENS_ARRAY_H
+#define PLENOPTIC_MICROLENS_ARRAY_H
+
+#include <memory>
+
+#include "plenoptic/array/microlens.h"
+#include "plenoptic/core/lattice.h"
+#include "plenoptic/core/vec.h"
+
+namespace plenoptic {
+
+// Pose of the microlens array in the optics frame: q_optics = centre_mm + rotation * q_local.
+struct ArrayPose {
+    Mat3 rotation;   // array-local -> optics frame, Rz * Ry * Rx
+    Vec3 centre_mm;  // where the array's lens (0, 0) sits
+    Vec3 normal;     // rotation * (0, 0, 1): towards the scene
+    bool tilted;     // rotated about x or y: the array plane is not parallel to the sensor
+    double tilt_sine;// sine of the angle between the array's normal and the optical axis
+};
+
+// Rotation about x, then y, then z, in degrees: v -> Rz * Ry * Rx * v, with the same
+// matrices as POV-Ray's Compute_Rotation_Transform (which applies them to row vectors).
+// Multiples of 90 degrees are exact.
+Mat3 rotation_from_degrees(const double degrees[3]);
+
+// The pose rotated by `rotate_deg` (about x, then y, then z) with lens (0, 0) at centre_mm.
+ArrayPose make_array_pose(const double rotate_deg[3], Vec3 centre_mm);
+
+// The array. present() false: the camera has none; grid is then None, every number 0, microlens
+// nullptr, and the pose unrotated at the plane where an array would be (z = -D; 0 without a main
+// lens), so that distances measured to it stay defined. The methods below that concern lenses are
+// for a present array only.
+struct MicrolensArray {
+    GridType grid;
+    double pitch_mm;
+    std::shared_ptr<const Microlens> microlens;  // the lenses' kind and first-order data
+    int lens_type_count;         // microlens->type_count(): 1, or 3 for multi-focus arrays
+    double distance_mm;          // d, to the sensor; 0 without array
+    ArrayPose pose;
+    double cell_inradius_mm;     // of a lens's lattice cell
+    double cell_circumradius_mm;
+
+    bool present() const { return grid != GridType::None; }
+
+    // The array's own frame (lens (0, 0) at the origin, the lenses in its plane z = 0) and back.
+    Vec3 to_local(Vec3 optics) const { return mul_transposed(pose.rotation, optics - pose.centre_mm); }
+    Vec3 to_optics(Vec3 local) const { return pose.centre_mm + mul(pose.rotation, local); }
+
+    // Lens centres: array-local (in its plane), and in the optics frame.
+    Vec2 centre_local(LensIndex lens) const { return lens_centre(grid, pitch_mm, lens); }
+    Vec3 centre_mm(LensIndex lens) const
+    {
+        const Vec2 c = centre_local(lens);
+        return to_optics(Vec3{c.x, c.y, 0});
+    }
+    // The lens whose cell contains the array-local point (x, y) (core/lattice.h: nearest_lens).
+    LensIndex nearest(double x, double y) const { return nearest_lens(grid, pitch_mm, x, y); }
+    // Which lens type a lens is (0 .. lens_type_count - 1), and its focal length (lenses that form
+    // an image only).
+    int type_of(LensIndex lens) const { return lens_type_count == 1 ? 0 : lens_type(lens, lens_type_count); }
+    double focal_length_mm(LensIndex lens) const { return microlens->focal_length_mm(type_of(lens)); }
+
+    // A lens's cell, relative to its centre: the point for the sample (u, v) in [0, 1)^2 (uniform,
+    // (0.5, 0.5) the centre), and its corners counter-clockwise (returns 4 or 6).
+    Vec2 cell_point(double u, double v) const { return sample_cell_uniform(grid, pitch_mm, u, v); }
+    int cell_corners(Vec2 corners[6]) const { return cell_polygon(grid, pitch_mm, corners); }
+    // Distance between rows of lenses: p, or p sqrt(3)/2.
+    double row_spacing_mm() const { return row_spacing(grid, pitch_mm); }
+};
+
+// No array: see MicrolensArray; plane_z is where an array would be.
+MicrolensArray no_microlens_array(double plane_z);
+// An array of `microlens` lenses on a `grid` lattice of pitch pitch_mm, d = distance_mm in front of
+// the sensor, posed by `pose`.
+MicrolensArray make_microlens_array(GridType grid, double pitch_mm, std::shared_ptr<const Microlens> microlens,
+                                    double distance_mm, const ArrayPose& pose);
+
+} // namespace plenoptic
+
+#endif
