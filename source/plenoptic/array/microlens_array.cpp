@@ -3,6 +3,8 @@
 
 #include "plenoptic/array/microlens_array.h"
 
+#include "plenoptic/core/json.h"
+
 #include <cmath>
 #include <utility>
 
@@ -82,6 +84,20 @@ MicrolensArray make_microlens_array(GridType grid, double pitch_mm, std::shared_
     array.cell_inradius_mm = cell_inradius(grid, pitch_mm);
     array.cell_circumradius_mm = cell_circumradius(grid, pitch_mm);
     return array;
+}
+
+MetadataJson MicrolensArray::metadata(const double rotate_deg[3], const double translate_mm[3]) const
+{
+    MetadataJson json = MetadataJson::object();
+    json["grid"] = grid == GridType::Hexagonal ? "hexagonal" : "rectangular";
+    json["lens"] = microlens->kind_name();
+    json["pitch_mm"] = json_number(pitch_mm);
+    const std::vector<double> focal_lengths = microlens->focal_lengths_mm();
+    json["focal_lengths_mm"] = json_numbers(focal_lengths.data(), int(focal_lengths.size()));
+    json["distance_mm"] = json_number(distance_mm);
+    json["rotate_deg"] = json_numbers(rotate_deg, 3);
+    json["translate_mm"] = json_numbers(translate_mm, 3);
+    return json;
 }
 
 } // namespace plenoptic

@@ -9,6 +9,8 @@
 
 #include <memory>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "plenoptic/array/microlens.h"
 #include "plenoptic/core/lattice.h"
 #include "plenoptic/core/vec.h"
@@ -72,6 +74,10 @@ struct MicrolensArray {
     int cell_corners(Vec2 corners[6]) const { return cell_polygon(grid, pitch_mm, corners); }
     // Distance between rows of lenses: p, or p sqrt(3)/2.
     double row_spacing_mm() const { return row_spacing(grid, pitch_mm); }
+
+    // The metadata's microlens_array section (present arrays only): grid, lens kind, pitch, the
+    // focal lengths, d, and the pose as the scene gave it (degrees and mm, from the spec).
+    nlohmann::ordered_json metadata(const double rotate_deg[3], const double translate_mm[3]) const;
 };
 
 // No array: see MicrolensArray; plane_z is where an array would be.

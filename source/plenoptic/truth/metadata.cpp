@@ -97,22 +97,6 @@ Json main_lens(const PlenopticCamera& m)
     return json;
 }
 
-Json microlens_array(const PlenopticCamera& m, const CameraParams& params)
-{
-    if (m.array.grid == GridType::None)
-        return nullptr;
-    Json json = Json::object();
-    json["grid"] = m.array.grid == GridType::Hexagonal ? "hexagonal" : "rectangular";
-    json["lens"] = m.array.microlens->kind_name();
-    json["pitch_mm"] = json_number(m.array.pitch_mm);
-    const std::vector<double> focal_lengths = m.array.microlens->focal_lengths_mm();
-    json["focal_lengths_mm"] = json_numbers(focal_lengths.data(), int(focal_lengths.size()));
-    json["distance_mm"] = json_number(m.array.distance_mm);
-    json["rotate_deg"] = json_numbers(params.array.rotate_deg, 3);
-    json["translate_mm"] = json_numbers(params.array.translate_mm, 3);
-    return json;
-}
-
 Json lattice_json(const PlenopticCamera& m, const MicroimageLattice& lattice)
 {
     if (!lattice.valid)
@@ -235,7 +219,8 @@ std::string metadata_json(const PlenopticCamera& m, const CameraParams& params, 
     json["camera_frame"] = camera_frame;
 
     json["main_lens"] = main_lens(m);
-    json["microlens_array"] = microlens_array(m, params);
+    json["microlens_array"] =
+        m.array.present() ? m.array.metadata(params.array.rotate_deg, params.array.translate_mm) : Json(nullptr);
 
     json["sensor"] = m.sensor.metadata(reference_projected_solid_angle_sr(m), params.sensor.chain, files.raw);
     json["samples"] = m.sampling.metadata();
