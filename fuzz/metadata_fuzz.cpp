@@ -96,11 +96,12 @@ void expect_same_camera(const RenderMetadata& a, const RenderMetadata& b)
         FUZZ_ASSERT(same_double(m.sensor.pixel_size_mm[i], n.sensor.pixel_size_mm[i]) &&
                         same_double(m.sensor.offset_mm[i], n.sensor.offset_mm[i]),
                     "sensor [%d] differs after a round trip", i);
-    for (int i = 0; i < 3; ++i)
-        FUZZ_ASSERT(same_double(a.frame.location[i], b.frame.location[i]) &&
-                        same_double(a.frame.right[i], b.frame.right[i]) && same_double(a.frame.up[i], b.frame.up[i]) &&
-                        same_double(a.frame.direction[i], b.frame.direction[i]),
-                    "camera frame [%d] differs after a round trip", i);
+    const auto same_vector = [](Vec3 p, Vec3 q) {
+        return same_double(p.x, q.x) && same_double(p.y, q.y) && same_double(p.z, q.z);
+    };
+    FUZZ_ASSERT(same_vector(a.frame.location, b.frame.location) && same_vector(a.frame.right, b.frame.right) &&
+                    same_vector(a.frame.up, b.frame.up) && same_vector(a.frame.direction, b.frame.direction),
+                "camera frame differs after a round trip");
     FUZZ_ASSERT(a.depth_map == b.depth_map, "depth_map '%s' -> '%s'", a.depth_map.c_str(), b.depth_map.c_str());
 }
 
@@ -142,7 +143,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     if (m.array.grid == GridType::None || span_mm <= 64 * m.array.pitch_mm) {
         const double points[3][3] = {{0, 0, 1}, {0.1, -0.05, 2}, {-3, 2, 50}};
         for (const auto& point : points) {
-            for (const PixelHit& hit : project_world_point(metadata, point)) {
+            for (const PixelHit& hit : project_world_point(metadata, Vec3{point[0], point[1], point[2]})) {
                 FUZZ_ASSERT(std::isfinite(hit.u) && std::isfinite(hit.v), "projection hit (%g, %g)", hit.u, hit.v);
                 FUZZ_ASSERT(hit.u >= -0.5 && hit.u < metadata.width - 0.5 && hit.v >= -0.5 &&
                                 hit.v < metadata.height - 0.5,

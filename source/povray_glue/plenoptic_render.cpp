@@ -27,12 +27,12 @@ std::shared_ptr<plenoptic::Render> Plenoptic_Start_Render(
     // The optics frame's origin: the scene's location is a real lens's front vertex, the frame's
     // origin its rear vertex, the lens's length behind it.
     const double behind_units = camera.Plenoptic->model.lens_length_mm() / camera.Plenoptic->model.mm_per_unit;
-    for (int i = 0; i < 3; i++) {
-        frame.location[i] = camera.Location[i] - behind_units * direction[i];
-        frame.right[i] = right[i];
-        frame.up[i] = up[i];
-        frame.direction[i] = direction[i];
-    }
+    frame.location = plenoptic::Vec3{camera.Location[X] - behind_units * direction[X],
+                                     camera.Location[Y] - behind_units * direction[Y],
+                                     camera.Location[Z] - behind_units * direction[Z]};
+    frame.right = plenoptic::Vec3{right[X], right[Y], right[Z]};
+    frame.up = plenoptic::Vec3{up[X], up[Y], up[Z]};
+    frame.direction = plenoptic::Vec3{direction[X], direction[Y], direction[Z]};
     // The blocks as POV-Ray's ViewData::GetNextRectangle cuts them from the render area.
     plenoptic::RenderArea traced;
     traced.area = plenoptic::PixelRect{int(area.left), int(area.top), int(area.right), int(area.bottom)};

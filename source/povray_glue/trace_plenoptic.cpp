@@ -27,12 +27,12 @@ void To_Scene(const plenoptic::Render& render, const plenoptic::OpticsRay& in, R
 {
 	const plenoptic::CameraFrame& frame = render.frame();
 	const double units_per_mm = 1.0 / render.model().mm_per_unit;
-	for (int i = 0; i < 3; i++)
-	{
-		out.Origin[i] = frame.location[i] + (in.origin_mm.x * frame.right[i] + in.origin_mm.y * frame.up[i] +
-		                                     in.origin_mm.z * frame.direction[i]) * units_per_mm;
-		out.Direction[i] = in.dir.x * frame.right[i] + in.dir.y * frame.up[i] + in.dir.z * frame.direction[i];
-	}
+	// In the optics frame's world axes: location + (o.x right + o.y up + o.z direction) / mm_per_unit.
+	const plenoptic::Vec3 along = in.origin_mm.x * frame.right + in.origin_mm.y * frame.up + in.origin_mm.z * frame.direction;
+	const plenoptic::Vec3 origin = frame.location + units_per_mm * along;
+	const plenoptic::Vec3 direction = in.dir.x * frame.right + in.dir.y * frame.up + in.dir.z * frame.direction;
+	Make_Vector(out.Origin, origin.x, origin.y, origin.z);
+	Make_Vector(out.Direction, direction.x, direction.y, direction.z);
 	if (!render.frame_orthonormal())
 		VNormalizeEq(out.Direction);
 }

@@ -418,13 +418,16 @@ void read_frame(const Json& root, CameraFrame* frame)
 {
     const std::string parent = "camera_frame";
     const Json& f = object_member(root, "", parent);
-    numbers(f, parent, "location", 3, false, frame->location);
-    numbers(f, parent, "right", 3, false, frame->right);
-    numbers(f, parent, "up", 3, false, frame->up);
-    numbers(f, parent, "direction", 3, false, frame->direction);
-    const Vec3 r{frame->right[0], frame->right[1], frame->right[2]};
-    const Vec3 u{frame->up[0], frame->up[1], frame->up[2]};
-    const Vec3 d{frame->direction[0], frame->direction[1], frame->direction[2]};
+    double axes[4][3];
+    numbers(f, parent, "location", 3, false, axes[0]);
+    numbers(f, parent, "right", 3, false, axes[1]);
+    numbers(f, parent, "up", 3, false, axes[2]);
+    numbers(f, parent, "direction", 3, false, axes[3]);
+    frame->location = Vec3{axes[0][0], axes[0][1], axes[0][2]};
+    frame->right = Vec3{axes[1][0], axes[1][1], axes[1][2]};
+    frame->up = Vec3{axes[2][0], axes[2][1], axes[2][2]};
+    frame->direction = Vec3{axes[3][0], axes[3][1], axes[3][2]};
+    const Vec3 r = frame->right, u = frame->up, d = frame->direction;
     const double volume = dot(r, cross(u, d));
     if (!(std::fabs(volume) > 1e-9 * length(r) * length(u) * length(d)) || !std::isfinite(volume))
         throw FieldError("field 'camera_frame': right, up and direction are linearly dependent "
@@ -548,32 +551,28 @@ MetadataReading read_metadata_file(const std::string& path)
     return parse_metadata(text.str());
 }
 
-bool world_to_optics_mm(const RenderMetadata& md, const double world[3], double optics_mm[3])
+OpticsPoint world_to_optics_mm(const RenderMetadata& md, Vec3 world)
 {
     const CameraFrame& f = md.frame;
-    const Vec3 r{f.right[0], f.right[1], f.right[2]};
-    const Vec3 u{f.up[0], f.up[1], f.up[2]};
-    const Vec3 d{f.direction[0], f.direction[1], f.direction[2]};
-    const Vec3 w{world[0] - f.location[0], world[1] - f.location[1], world[2] - f.location[2]};
+    const Vec3 r = f.right, u = f.up, d = f.direction;
+    const Vec3 w = world - f.location;
     // Cramer's rule for x r + y u + z d = w.
     const double det = dot(r, cross(u, d));
     if (!(det != 0) || !std::isfinite(det))
-        return false;
+        return OpticsPoint{Vec3{0, 0, 0}, false};
     const double x = dot(w, cross(u, d)) / det;
     const double y = dot(r, cross(w, d)) / det;
     const double z = dot(r, cross(u, w)) / det;
-    optics_mm[0] = x * md.model.mm_per_unit;
-    optics_mm[1] = y * md.model.mm_per_unit;
-    optics_mm[2] = z * md.model.mm_per_unit;
-    return std::isfinite(optics_mm[0]) && std::isfinite(optics_mm[1]) && std::isfinite(optics_mm[2]);
+    const Vec3 optics{x * md.model.mm_per_unit, y * md.model.mm_per_unit, z * md.model.mm_per_unit};
+    return OpticsPoint{optics, is_finite(optics)};
 }
 
-std::vector<PixelHit> project_world_point(const RenderMetadata& md, const double world[3])
+std::vector<PixelHit> project_world_point(const RenderMetadata& md, Vec3 world)
 {
-    double optics[3];
-    if (!world_to_optics_mm(md, world, optics))
+    const OpticsPoint optics = world_to_optics_mm(md, world);
+    if (!optics.valid)
         return std::vector<PixelHit>();
-    return md.model.project(Vec3{optics[0], optics[1], optics[2]});
+    return md.model.project(optics.mm);
 }
 
 } // namespace plenoptic

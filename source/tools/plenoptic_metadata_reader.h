@@ -45,12 +45,16 @@ MetadataReading parse_metadata(const std::string& text);
 MetadataReading read_metadata_file(const std::string& path);
 
 // World point (scene units) -> optics frame (mm): solves location + (x right + y up + z direction)
-// / mm_per_unit = world. False when the frame is singular or the result is not finite.
-bool world_to_optics_mm(const RenderMetadata& metadata, const double world[3], double optics_mm[3]);
+// / mm_per_unit = world. Not valid when the frame is singular or the result is not finite.
+struct OpticsPoint {
+    Vec3 mm;
+    bool valid;
+};
+OpticsPoint world_to_optics_mm(const RenderMetadata& metadata, Vec3 world);
 
 // Every pixel position (docs/metadata.md's centre convention) where the world point images, one
 // per microlens that sees it; lens indices in row form ((0, 0) without an array).
-std::vector<PixelHit> project_world_point(const RenderMetadata& metadata, const double world[3]);
+std::vector<PixelHit> project_world_point(const RenderMetadata& metadata, Vec3 world);
 
 } // namespace plenoptic
 

@@ -89,7 +89,7 @@ TEST(MetadataReader, ReadsWhatTheWriterWrites)
     EXPECT_EQ(metadata.width, 320);
     EXPECT_EQ(metadata.height, 240);
     EXPECT_EQ(metadata.depth_map, "scene.depth.exr");
-    EXPECT_EQ(metadata.frame.location[2], -0.3);
+    EXPECT_EQ(metadata.frame.location.z, -0.3);
     // Shortest round-trip numbers: every value reads back bit for bit.
     EXPECT_EQ(metadata.model.distance_mm, m.distance_mm);
     EXPECT_EQ(metadata.model.array.pitch_mm, 0.15);

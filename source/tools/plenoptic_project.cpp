@@ -113,16 +113,15 @@ int main(int argc, char** argv)
             return fail("coordinate '" + words[i] + "' (point " + std::to_string(i / 3) + ") is not a finite number");
 
     for (size_t p = 0; p < values.size() / 3; ++p) {
-        const std::vector<plenoptic::PixelHit> hits = plenoptic::project_world_point(metadata, &values[3 * p]);
-        double optics[3] = {0, 0, 0};
-        if (with_blur && !hits.empty())
-            plenoptic::world_to_optics_mm(metadata, &values[3 * p], optics);
+        const plenoptic::Vec3 world{values[3 * p], values[3 * p + 1], values[3 * p + 2]};
+        const std::vector<plenoptic::PixelHit> hits = plenoptic::project_world_point(metadata, world);
+        const plenoptic::Vec3 optics = plenoptic::world_to_optics_mm(metadata, world).mm;
         for (const plenoptic::PixelHit& hit : hits) {
             std::printf("%zu %lld %lld %.6f %.6f", p, (long long)hit.lens.k, (long long)hit.lens.l, hit.u, hit.v);
             if (with_fraction)
                 std::printf(" %.6g", hit.fraction);
             if (with_blur)
-                std::printf(" %.6f", plenoptic::blur_radius_px(metadata.model, plenoptic::Vec3{optics[0], optics[1], optics[2]}, hit.lens));
+                std::printf(" %.6f", plenoptic::blur_radius_px(metadata.model, optics, hit.lens));
             std::printf("\n");
         }
     }

@@ -29,4 +29,10 @@ MetadataJson json_numbers(const double* values, int count)
     return array;
 }
 
+MetadataJson json_numbers(Vec3 v)
+{
+    const double values[3] = {v.x, v.y, v.z};
+    return json_numbers(values, 3);
+}
+
 } // namespace plenoptic

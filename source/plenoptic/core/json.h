@@ -7,6 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "plenoptic/core/vec.h"
+
 namespace plenoptic {
 
 using MetadataJson = nlohmann::ordered_json;
@@ -20,6 +22,8 @@ MetadataJson json_number(double value);
 MetadataJson json_number_or_null(bool present, double value);
 // An array of `count` json_numbers.
 MetadataJson json_numbers(const double* values, int count);
+// A vector as the array [x, y, z] of json_numbers.
+MetadataJson json_numbers(Vec3 v);
 
 } // namespace plenoptic
 

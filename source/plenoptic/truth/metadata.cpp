@@ -212,10 +212,10 @@ std::string metadata_json(const PlenopticCamera& m, const CameraParams& params, 
     json["mm_per_unit"] = json_number(m.mm_per_unit);
 
     Json camera_frame = Json::object();
-    camera_frame["location"] = json_numbers(frame.location, 3);
-    camera_frame["right"] = json_numbers(frame.right, 3);
-    camera_frame["up"] = json_numbers(frame.up, 3);
-    camera_frame["direction"] = json_numbers(frame.direction, 3);
+    camera_frame["location"] = json_numbers(frame.location);
+    camera_frame["right"] = json_numbers(frame.right);
+    camera_frame["up"] = json_numbers(frame.up);
+    camera_frame["direction"] = json_numbers(frame.direction);
     json["camera_frame"] = camera_frame;
 
     json["main_lens"] = main_lens(m);

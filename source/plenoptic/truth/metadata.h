@@ -14,10 +14,10 @@ namespace plenoptic {
 
 // Where the optics frame sits in the scene (scene units; the three axes unit length).
 struct CameraFrame {
-    double location[3];   // main-lens centre (array centre when there is no main lens)
-    double right[3];      // +x of the optics frame
-    double up[3];         // +y
-    double direction[3];  // +z, towards the scene
+    Vec3 location;   // main-lens centre (array centre when there is no main lens)
+    Vec3 right;      // +x of the optics frame
+    Vec3 up;         // +y
+    Vec3 direction;  // +z, towards the scene
 };
 
 // The JSON of docs/metadata.md for a W x H render (written with nlohmann-json, members in the

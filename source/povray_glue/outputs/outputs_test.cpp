@@ -40,14 +40,7 @@ std::shared_ptr<CameraSetup> setup_of(const CameraParams& params)
 
 CameraFrame test_frame()
 {
-    CameraFrame frame;
-    for (int i = 0; i < 3; ++i) {
-        frame.location[i] = 0;
-        frame.right[i] = i == 0 ? 1 : 0;
-        frame.up[i] = i == 1 ? 1 : 0;
-        frame.direction[i] = i == 2 ? 1 : 0;
-    }
-    return frame;
+    return CameraFrame{Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}};
 }
 
 RenderArea whole(int W, int H) { return RenderArea{PixelRect{0, 0, W - 1, H - 1}, {}}; }

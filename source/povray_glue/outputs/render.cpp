@@ -13,11 +13,10 @@ namespace {
 
 bool is_orthonormal(const CameraFrame& frame)
 {
-    const double* axes[3] = {frame.right, frame.up, frame.direction};
+    const Vec3 axes[3] = {frame.right, frame.up, frame.direction};
     for (int a = 0; a < 3; ++a)
         for (int b = a; b < 3; ++b) {
-            const double dot = axes[a][0] * axes[b][0] + axes[a][1] * axes[b][1] + axes[a][2] * axes[b][2];
-            if (std::fabs(dot - (a == b ? 1.0 : 0.0)) > 1e-12)
+            if (std::fabs(dot(axes[a], axes[b]) - (a == b ? 1.0 : 0.0)) > 1e-12)
                 return false;
         }
     return true;
