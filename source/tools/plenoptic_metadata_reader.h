@@ -20,7 +20,7 @@ struct RenderMetadata {
     int height = 0;
     CameraParams params;  // rebuilt from the resolved values (D as distance_mm)
     PlenopticCamera model;
-    CameraFrame frame;    // world frame of the optics frame, scene units
+    CameraFrame frame = CameraFrame();  // world frame of the optics frame, scene units
     std::string depth_map;// file name of the depth EXR, empty when none
 };
 

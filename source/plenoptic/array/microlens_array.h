@@ -19,11 +19,11 @@ namespace plenoptic {
 
 // Pose of the microlens array in the optics frame: q_optics = centre_mm + rotation * q_local.
 struct ArrayPose {
-    Mat3 rotation;   // array-local -> optics frame, Rz * Ry * Rx
-    Vec3 centre_mm;  // where the array's lens (0, 0) sits
-    Vec3 normal;     // rotation * (0, 0, 1): towards the scene
-    bool tilted;     // rotated about x or y: the array plane is not parallel to the sensor
-    double tilt_sine;// sine of the angle between the array's normal and the optical axis
+    Mat3 rotation = Mat3();  // array-local -> optics frame, Rz * Ry * Rx
+    Vec3 centre_mm = Vec3();  // where the array's lens (0, 0) sits
+    Vec3 normal = Vec3();  // rotation * (0, 0, 1): towards the scene
+    bool tilted = false;  // rotated about x or y: the array plane is not parallel to the sensor
+    double tilt_sine = 0;  // sine of the angle between the array's normal and the optical axis
 };
 
 // Rotation about x, then y, then z, in degrees: v -> Rz * Ry * Rx * v, with the same
@@ -39,14 +39,14 @@ ArrayPose make_array_pose(const double rotate_deg[3], Vec3 centre_mm);
 // lens), so that distances measured to it stay defined. The methods below that concern lenses are
 // for a present array only.
 struct MicrolensArray {
-    GridType grid;
-    double pitch_mm;
+    GridType grid = GridType::None;
+    double pitch_mm = 0;
     std::shared_ptr<const Microlens> microlens;  // the lenses' kind and first-order data
-    int lens_type_count;         // microlens->type_count(): 1, or 3 for multi-focus arrays
-    double distance_mm;          // d, to the sensor; 0 without array
+    int lens_type_count = 0;  // microlens->type_count(): 1, or 3 for multi-focus arrays
+    double distance_mm = 0;  // d, to the sensor; 0 without array
     ArrayPose pose;
-    double cell_inradius_mm;     // of a lens's lattice cell
-    double cell_circumradius_mm;
+    double cell_inradius_mm = 0;  // of a lens's lattice cell
+    double cell_circumradius_mm = 0;
 
     bool present() const { return grid != GridType::None; }
 

@@ -38,9 +38,9 @@ struct Film {
 
 // Overlapping microimages: modelled only when the camera's geometry makes overlap possible.
 struct Overlap {
-    bool modelled;
-    int rings;                   // rings of neighbours a pixel may receive light through
-    bool rings_capped;           // the bound asked for more than kMaxOverlapRings
+    bool modelled = false;
+    int rings = 0;  // rings of neighbours a pixel may receive light through
+    bool rings_capped = false;  // the bound asked for more than kMaxOverlapRings
 };
 
 // A point of the picture in the centre convention used by the metadata (pixel (i, j)'s centre is
@@ -52,15 +52,15 @@ struct PixelPoint {
 
 // The sensor: its picture (film), its plane and pixel grid, and what a pixel measures.
 struct Sensor {
-    Film film;                   // the picture's size in pixels (0 x 0 until with_film)
-    double z_mm;                 // -(D + d); -D without array; -d without main lens
-    double pixel_size_mm[2];
-    double offset_mm[2];
+    Film film = Film{0, 0};  // the picture's size in pixels (0 x 0 until with_film)
+    double z_mm = 0;  // -(D + d); -D without array; -d without main lens
+    double pixel_size_mm[2] = {0, 0};
+    double offset_mm[2] = {0, 0};
     // What a pixel measures (camera/radiometry.h); under Irradiance each passing sample's colour
     // is weighted by irradiance_weight with K = irradiance_k_mm2 (0 under Flat).
-    Radiometry radiometry;
-    double irradiance_k_mm2;
-    double angular_exponent;     // angular_response n: each sample also weighs cos^n(incidence)
+    Radiometry radiometry = Radiometry::Flat;
+    double irradiance_k_mm2 = 0;
+    double angular_exponent = 0;  // angular_response n: each sample also weighs cos^n(incidence)
 
     // Point on the sensor (optics frame, mm) at continuous pixel coordinates (pu, pv), where pixel
     // (i, j) spans [i, i+1) x [j, j+1); (i + 0.5, j + 0.5) is its centre:
@@ -79,11 +79,11 @@ struct Sensor {
 
 // How many samples a pixel takes (fixed, or adaptive between a minimum and a maximum).
 struct Sampling {
-    bool adaptive;
-    int samples_min;             // == samples_max when not adaptive
-    int samples_max;
-    double confidence;
-    double variance;
+    bool adaptive = false;
+    int samples_min = 0;  // == samples_max when not adaptive
+    int samples_max = 0;
+    double confidence = 0;
+    double variance = 0;
     std::vector<double> thresholds; // adaptive stop thresholds, index n-1 for n samples
     // The metadata's samples section.
     MetadataJson metadata() const;
@@ -103,14 +103,14 @@ struct PixelHit;
 // there is no main lens), +z towards the scene, +x right, +y up; millimetres throughout.
 struct PlenopticCamera {
     CameraParams spec;           // the checked parameters the camera was made from
-    double mm_per_unit;
+    double mm_per_unit = 0;
 
     // The main lens (it answers for its kind: lens/main_lens.h); nullptr without one. D is where
     // this camera holds it: from its rear vertex (its plane) to the array, or to the sensor.
     std::shared_ptr<const MainLens> lens;
-    double distance_mm;          // D; 0 without main lens
-    bool has_focus_distance;     // D came from focus_distance
-    double focus_distance_units; // as given; 0 when D was given directly
+    double distance_mm = 0;  // D; 0 without main lens
+    bool has_focus_distance = false;  // D came from focus_distance
+    double focus_distance_units = 0;  // as given; 0 when D was given directly
     // Where light passes a traced real lens, for points of the sensor (no array) or of the array
     // plane: what ray generation samples, and what the overlap bound reaches. nullptr otherwise.
     // The lens makes it for the plane this camera puts behind it.
