@@ -49,6 +49,20 @@ void add_prescription_metadata(MetadataJson& section, const Prescription& lens, 
         row["thickness_mm"] = json_number(s.thickness_mm);
         row["ior"] = json_number(s.ior);
         row["aperture_mm"] = json_number(s.aperture_mm);
+        // A dispersing medium's glass (absent for one that does not disperse).
+        if (s.glass.abbe != 0)
+            row["abbe_number"] = json_number(s.glass.abbe);
+        if (s.glass.sellmeier) {
+            MetadataJson sellmeier = MetadataJson::object();
+            MetadataJson b = MetadataJson::array(), c = MetadataJson::array();
+            for (int i = 0; i < 3; ++i) {
+                b.push_back(json_number(s.glass.sellmeier_b[i]));
+                c.push_back(json_number(s.glass.sellmeier_c_um2[i]));
+            }
+            sellmeier["b"] = b;
+            sellmeier["c_um2"] = c;
+            row["sellmeier"] = sellmeier;
+        }
         surfaces.push_back(row);
     }
     MetadataJson prescription = MetadataJson::object();
@@ -79,6 +93,20 @@ void add_prescription_metadata(MetadataJson& section, const Prescription& lens, 
     // limits the axial beam), and the widest stop that still limits it (null: no rim ever does).
     paraxial["limiting_surface"] = p.aperture_surface;
     paraxial["largest_stop_diameter_mm"] = json_number(p.largest_stop_mm);
+    // A dispersing lens's focus at the F, d and C lines (infinity focus), and its longitudinal colour.
+    const ChromaticFocus colour = chromatic_focus(lens);
+    if (colour.valid) {
+        MetadataJson lines = MetadataJson::object();
+        for (const LineFocus& line : colour.lines) {
+            MetadataJson at = MetadataJson::object();
+            at["wavelength_nm"] = json_number(line.wavelength_nm);
+            at["effective_focal_length_mm"] = json_number(line.efl_mm);
+            at["back_focal_distance_mm"] = json_number(line.bfd_mm);
+            lines[line.line] = at;
+        }
+        paraxial["lines"] = lines;
+        paraxial["longitudinal_colour_mm"] = json_number(colour.longitudinal_colour_mm);
+    }
     section["paraxial"] = paraxial;
 }
 

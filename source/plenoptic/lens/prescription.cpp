@@ -340,22 +340,25 @@ ParsedPrescription parse_lens_file(const std::string& file_text)
             tokens.push_back(token);
         if (tokens.empty())
             continue;
-        if (tokens.size() != 4) {
+        if (tokens.size() != 4 && tokens.size() != 5) {
             std::ostringstream msg;
             msg << "a lens file row has four numbers (radius, thickness, index of refraction, aperture "
-                   "diameter, in mm); this one has "
+                   "diameter, in mm) and optionally a fifth (the Abbe number V_d; 0: no dispersion); this one has "
                 << tokens.size();
             parsed.error = PrescriptionError{msg.str(), number};
             return parsed;
         }
-        double v[4];
-        for (int k = 0; k < 4; ++k)
+        double v[5] = {0, 0, 0, 0, 0};
+        for (size_t k = 0; k < tokens.size(); ++k)
             if (!parse_number(tokens[k], &v[k])) {
                 parsed.error = PrescriptionError{"'" + tokens[k] + "' is not a finite number", number};
                 return parsed;
             }
         const bool stop = v[0] == 0;
-        parsed.prescription.surfaces.push_back(LensSurface{stop ? 0.0 : flat_radius(v[0]), v[1], v[2], v[3], stop, number});
+        Glass glass;
+        glass.abbe = v[4];
+        parsed.prescription.surfaces.push_back(
+            LensSurface{stop ? 0.0 : flat_radius(v[0]), v[1], v[2], v[3], stop, number, glass});
     }
     if (parsed.prescription.surfaces.empty()) {
         const std::string what = file_text.empty()
@@ -407,6 +410,10 @@ PrescriptionError check_prescription(const Prescription& lens)
                 return PrescriptionError{msg.str(), s.line};
             }
             first_stop = int(i);
+            if (s.glass.dispersive())
+                return PrescriptionError{name + ": the stop does not refract; it takes no Abbe number or Sellmeier "
+                                                "coefficients (0 in a lens file's fifth column)",
+                                         s.line};
             const double before = i == 0 ? 1.0 : medium_after(lens, int(i) - 1);
             if (s.ior != 0 && s.ior != before)
                 return PrescriptionError{name + ": the stop does not refract; its index must be 0 or that of the "
@@ -416,6 +423,16 @@ PrescriptionError check_prescription(const Prescription& lens)
         }
         if (!(s.ior >= 1))
             return PrescriptionError{name + ": the index of refraction must be >= 1", s.line};
+        if (s.glass.dispersive()) {
+            if (s.ior == 1)
+                return PrescriptionError{name + ": the medium after it is air (index 1), which does not disperse; it "
+                                                "takes no Abbe number or Sellmeier coefficients (0 in a lens file's "
+                                                "fifth column)",
+                                         s.line};
+            const std::string glass = check_glass(s.ior, s.glass);
+            if (!glass.empty())
+                return PrescriptionError{name + ": " + glass, s.line};
+        }
         if (s.radius_mm != 0 && s.aperture_mm > 2 * std::fabs(s.radius_mm))
             return PrescriptionError{name + ": the aperture diameter exceeds the surface's sphere (diameter 2 |radius|)",
                                      s.line};
@@ -565,6 +582,46 @@ Traced TracingLens::trace_from_object(const LensRay& in) const
 
 Traced trace_from_image(const Prescription& lens, const LensRay& in) { return TracingLens(lens).trace_from_image(in); }
 Traced trace_from_object(const Prescription& lens, const LensRay& in) { return TracingLens(lens).trace_from_object(in); }
+
+bool dispersive(const Prescription& lens)
+{
+    for (const LensSurface& s : lens.surfaces)
+        if (s.glass.dispersive())
+            return true;
+    return false;
+}
+
+Prescription prescription_at_wavelength(const Prescription& lens, double wavelength_nm)
+{
+    Prescription at = lens;
+    for (LensSurface& s : at.surfaces)
+        if (s.glass.dispersive()) {
+            s.ior = s.index_at(wavelength_nm);
+            s.glass = Glass();
+        }
+    return at;
+}
+
+ChromaticFocus chromatic_focus(const Prescription& lens)
+{
+    ChromaticFocus focus;
+    if (!dispersive(lens))
+        return focus;
+    const char* names[3] = {"F", "d", "C"};
+    const double wavelengths[3] = {kLineFNm, kLineDNm, kLineCNm};
+    for (int k = 0; k < 3; ++k) {
+        const Prescription at = prescription_at_wavelength(lens, wavelengths[k]);
+        const int count = int(at.surfaces.size());
+        const Mat2 S = system_matrix(at, 0, count - 1);
+        if (S.c == 0)
+            return focus;
+        const double efl = -1 / S.c;
+        focus.lines[k] = LineFocus{names[k], wavelengths[k], efl, S.a * efl};
+    }
+    focus.longitudinal_colour_mm = focus.lines[0].bfd_mm - focus.lines[2].bfd_mm;
+    focus.valid = std::isfinite(focus.longitudinal_colour_mm);
+    return focus;
+}
 
 double stop_diameter_for_f_number(const Prescription& lens, double f_number)
 {

@@ -17,17 +17,29 @@
 #include <vector>
 
 #include "plenoptic/core/vec.h"
+#include "plenoptic/lens/glass.h"
 
 namespace plenoptic {
 
 // One row of a prescription.
 struct LensSurface {
-    double radius_mm;     // curvature radius; 0 for a flat surface (and for the stop)
-    double thickness_mm;  // axial distance to the next surface (after the last: to nothing, unused)
-    double ior;           // refractive index of the medium after the surface (1 for air)
-    double aperture_mm;   // clear aperture diameter
-    bool stop;            // the aperture stop (a flat, non-refracting opening)
-    int line;             // where it was written (file or scene line, 0 when unknown)
+    double radius_mm = 0;     // curvature radius; 0 for a flat surface (and for the stop)
+    double thickness_mm = 0;  // axial distance to the next surface (after the last: to nothing, unused)
+    double ior = 1;           // refractive index of the medium after the surface at the d line (1 for air)
+    double aperture_mm = 0;   // clear aperture diameter
+    bool stop = false;        // the aperture stop (a flat, non-refracting opening)
+    int line = 0;             // where it was written (file or scene line, 0 when unknown)
+    Glass glass;              // how the medium after the surface disperses (default: it does not)
+
+    LensSurface() = default;
+    LensSurface(double radius, double thickness, double index, double aperture, bool is_stop, int at,
+                const Glass& medium = Glass())
+        : radius_mm(radius), thickness_mm(thickness), ior(index), aperture_mm(aperture), stop(is_stop), line(at),
+          glass(medium) {}
+
+    // The index of the medium after the surface at a wavelength (nm): ior at every wavelength when
+    // it does not disperse.
+    double index_at(double wavelength_nm) const { return plenoptic::index_at(ior, glass, wavelength_nm); }
 };
 
 // The surfaces, object side first.
@@ -61,8 +73,9 @@ const double kPrescriptionMaxLengthMm = 1e12;
 double flat_radius(double radius_mm);
 
 // Reads pbrt's RealisticCamera lens file format: one surface per row, object side first, four
-// numbers: curvature radius, thickness, index of refraction (of the medium after the surface),
-// aperture diameter, in mm. A row with radius 0 is the aperture stop (pbrt writes its index as 0
+// numbers: curvature radius, thickness, index of refraction (of the medium after the surface, at
+// the d line), aperture diameter, in mm; and optionally a fifth, the medium's Abbe number V_d
+// (0: no dispersion; glass.h). A row with radius 0 is the aperture stop (pbrt writes its index as 0
 // or 1: the stop does not refract either way); a refracting row with a radius beyond
 // +-kPrescriptionMaxLengthMm is flat (flat_radius). `#` starts a comment; blank lines are skipped,
 // and so is a leading UTF-8 byte-order mark. The prescription is checked (check_prescription)
@@ -75,8 +88,31 @@ ParsedPrescription parse_lens_file(const std::string& text);
 // a length beyond kPrescriptionMaxLengthMm (a radius there must have been made flat by the parser);
 // two consecutive rows that cross inside the smaller of their clear apertures; a lens that
 // has a negative effective focal length (a diverging lens, or a relay with an intermediate image:
-// not supported as a main lens).
+// not supported as a main lens); a glass check_glass refuses, or a dispersing medium on the stop or
+// on a row of index 1 (air, which the models leave at index 1 and Sellmeier terms would not).
 PrescriptionError check_prescription(const Prescription& lens);
+
+// Whether any medium of the lens disperses.
+bool dispersive(const Prescription& lens);
+
+// The lens at a wavelength (nm): each medium at its index there (LensSurface::index_at) and no
+// glass model left; the lens itself when it does not disperse. Tracing or a paraxial trace at a
+// wavelength is that of this prescription.
+Prescription prescription_at_wavelength(const Prescription& lens, double wavelength_nm);
+
+// The paraxial focal data at the F, d and C lines (glass.h) of a dispersing lens, infinity focus.
+struct LineFocus {
+    const char* line;      // "F", "d", "C"
+    double wavelength_nm;
+    double efl_mm;         // effective focal length
+    double bfd_mm;         // back focal distance: rear vertex -> rear focal point
+};
+struct ChromaticFocus {
+    bool valid = false;            // false for a lens that does not disperse or is afocal at a line
+    LineFocus lines[3] = {};       // F, d, C
+    double longitudinal_colour_mm = 0;  // back focus at F minus back focus at C (negative: F focuses nearer)
+};
+ChromaticFocus chromatic_focus(const Prescription& lens);
 
 // The iris's turn reduced by its symmetry: degrees modulo 360 / blades (360 without an iris),
 // in [0, 360 / blades). A rotation of 1e300 degrees is as valid as any and must not swamp the
