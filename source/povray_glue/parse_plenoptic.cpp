@@ -134,6 +134,7 @@ class PlenopticParser
 		void Parse_Lens_File(KeywordRead& read);
 		void Parse_Samples(const Keyword& keyword, KeywordRead& read);
 		void Parse_F_Numbers(const Keyword& keyword, KeywordRead& read);
+		void Parse_Vector6(const Keyword& keyword, KeywordRead& read);
 		void Parse_Camera_Modifier();
 		void Parse_Placement();
 		void Close_Block(KeywordBlock block, const BlockState& state);
@@ -317,6 +318,9 @@ void PlenopticParser::Parse_Keyword(const Keyword& keyword, BlockState& state)
 		case KeywordValue::FNumbers:
 			Parse_F_Numbers(keyword, read);
 			break;
+		case KeywordValue::Vector6:
+			Parse_Vector6(keyword, read);
+			break;
 		case KeywordValue::Block:
 			// The store starts the block; its keywords follow in braces.
 			keyword.store(*setup, read);
@@ -466,6 +470,37 @@ void PlenopticParser::Parse_F_Numbers(const Keyword& keyword, KeywordRead& read)
 	plenoptic::WhiteImageRequest listed;
 	listed.f_numbers = values;
 	Check_At(plenoptic::repeated_white_f_number(listed), position, column);
+	read.list = values;
+}
+
+// sellmeier <B1, B2, B3, C1, C2, C3>: six floats in angle brackets (POV-Ray's vectors hold at
+// most five), each finite.
+void PlenopticParser::Parse_Vector6(const Keyword& keyword, KeywordRead& read)
+{
+	const FilePos position = Token.Token_File_Pos;
+	const int column = Token.Token_Col_No;
+	const std::string six = std::string(keyword.value_label()) + " takes six numbers in angle brackets, " +
+	                        (keyword.listed != NULL ? keyword.listed : keyword.word);
+	p.Get_Token();
+	if (Token.Token_Id != LEFT_ANGLE_TOKEN)
+		Check_At(six, position, column);
+	std::vector<DBL> values;
+	for (;;)
+	{
+		values.push_back(p.Parse_Float());
+		p.Parse_Comma();
+		p.Get_Token();
+		if (Token.Token_Id == RIGHT_ANGLE_TOKEN)
+			break;
+		p.Unget_Token();
+		if (values.size() >= 6)
+			break;
+	}
+	if (values.size() != 6 || Token.Token_Id != RIGHT_ANGLE_TOKEN)
+		Check_At(six + "; found " + (values.size() == 6 ? std::string("more") : std::to_string(values.size())), position,
+		         column);
+	for (size_t k = 0; k < values.size(); k++)
+		Check_At(plenoptic::check_finite(keyword.value_label(), values[k]), position, column);
 	read.list = values;
 }
 

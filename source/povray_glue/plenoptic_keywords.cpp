@@ -10,6 +10,7 @@
 #include <cstring>
 
 #include "plenoptic/camera/radiometry.h"
+#include "plenoptic/lens/glass.h"
 #include "plenoptic/sensor/diffraction.h"
 #include "plenoptic/sensor/sensor_chain.h"
 
@@ -31,6 +32,11 @@ std::string Check_Variance(const char *, double value) { return check_variance(v
 std::string Check_Blades(const char *, double value) { return check_blades(value); }
 std::string Check_Wavelength(const char *, double value) { return check_wavelength(value); }
 std::string Check_Angular_Exponent(const char *, double value) { return check_angular_exponent(value); }
+std::string Check_Abbe(const char *label, double value)
+{
+    const std::string message = check_abbe(value);
+    return message.empty() ? message : std::string(label) + ": " + message;
+}
 std::string Check_White_F_Number(const char *, double value)
 {
     const std::string message = check_f_number(value);
@@ -219,6 +225,17 @@ std::vector<Keyword> make_table()
         Keyword("aperture", B::Surface, V::Number, "", "the clear aperture's diameter (mm)",
                 [](CameraSetup& s, R r) { row(s).aperture_mm = r.values[0]; })
             .reserved_word().labelled("surface aperture").checked(check_positive_length).needed_in_block(),
+        // The medium's dispersion (lens/glass.h); checked with the whole glass at prescription's }.
+        Keyword("abbe", B::Surface, V::Number, "0: no dispersion", "the Abbe number V_d of the medium after the surface",
+                [](CameraSetup& s, R r) { row(s).glass.abbe = r.values[0]; })
+            .labelled("surface abbe").checked(Check_Abbe),
+        Keyword("sellmeier", B::Surface, V::Vector6, "none", "the medium's Sellmeier coefficients B1, B2, B3, C1, C2, C3 (C in µm²)",
+                [](CameraSetup& s, R r) {
+                    row(s).glass.sellmeier = true;
+                    std::copy(r.list.begin(), r.list.begin() + 3, row(s).glass.sellmeier_b);
+                    std::copy(r.list.begin() + 3, r.list.begin() + 6, row(s).glass.sellmeier_c_um2);
+                })
+            .labelled("surface sellmeier").listed_as("sellmeier <B1, B2, B3, C1, C2, C3>"),
 
         // ---- stop { } ----
         Keyword("thickness", B::Stop, V::Number, "", "the axial distance to the next row (mm)",
@@ -263,6 +280,9 @@ std::vector<Keyword> make_table()
         Keyword("translate", B::MicrolensArray, V::Vector3, "<0, 0, 0>", "pose error: shift after the rotation (mm)",
                 [](CameraSetup& s, R r) { std::copy(r.values, r.values + 3, array(s).translate_mm); })
             .reserved_word().labelled("microlens_array translate").checked(check_translation).in_group(G::ArrayTranslate),
+        Keyword("abbe", B::MicrolensArray, V::Number, "0: no dispersion", "the microlenses' Abbe number V_d",
+                [](CameraSetup& s, R r) { array(s).abbe = r.values[0]; })
+            .labelled("microlens_array abbe").checked(Check_Abbe),
 
         // ---- sensor { }: any read-out keyword (bayer to seed) makes the render write the raw ----
         Keyword("pixel_size", B::Sensor, V::Vector2, "0.01", "the pixel pitch, horizontal and vertical (mm)",
@@ -418,6 +438,7 @@ const char *keyword_value_name(KeywordValue value)
         case V::Number: return "number";
         case V::Vector2: return "vector2";
         case V::Vector3: return "vector3";
+        case V::Vector6: return "vector6";
         case V::OnOff: return "on/off";
         case V::Word: return "word";
         case V::String: return "string";

@@ -40,6 +40,7 @@ enum class KeywordValue {
     Number,    // a float expression
     Vector2,   // <a, b> (a float gives both)
     Vector3,   // <a, b, c>
+    Vector6,   // <a, b, c, d, e, f>: six numbers in angle brackets (read into the list)
     OnOff,     // an optional float, 0 off and anything else (or none, or a keyword next) on; then
                // the modifiers of the block the row opens
     Word,      // one of the row's words, read by its text (not a string, not an identifier's value)
@@ -56,7 +57,7 @@ enum class KeywordGroup { None, MainLensKind, LensSource, Distortion, Grid, Micr
 struct KeywordRead {
     double values[3] = {0, 0, 0};  // Number: [0]; Vector2, Vector3: the components; OnOff: 1 on, 0 off;
                                    // Word: the index of the word; Samples: N (or MIN, MAX)
-    std::vector<double> list;      // FNumbers: the values
+    std::vector<double> list;      // FNumbers, Vector6: the values
     std::string text;              // String: the string
     Prescription prescription;     // String: the surfaces of the lens file it names
     long line = 0;                 // where the keyword is written
@@ -83,6 +84,7 @@ struct Keyword {
     const char *doc;           // one line
     KeywordStore store;
     KeywordCheck check = nullptr;              // Number, Vector, Samples, FNumbers: each value, after the finite check
+                                               // (Vector6: finite only)
     const char *label = nullptr;               // how value errors name the keyword; nullptr: the word
     const char *listed = nullptr;              // how the block's "allowed" list names it; nullptr: the word
     bool reserved = false;                     // one of POV-Ray's reserved words (recognised by its token);

@@ -261,6 +261,17 @@ void read_prescription(const Json& v, const std::string& parent, MainLensParams*
         surface.ior = finite_number(member(s, row, "ior"), row + ".ior");
         surface.aperture_mm = positive_number(member(s, row, "aperture_mm"), row + ".aperture_mm");
         surface.line = 0;
+        // The medium's glass: absent when it does not disperse (the camera checks it with the lens).
+        if (s.contains("abbe_number"))
+            surface.glass.abbe = finite_number(s["abbe_number"], row + ".abbe_number");
+        if (s.contains("sellmeier")) {
+            const Json& sellmeier = s["sellmeier"];
+            if (!sellmeier.is_object())
+                refuse(row + ".sellmeier", "an object {\"b\": [B1, B2, B3], \"c_um2\": [C1, C2, C3]}", sellmeier);
+            surface.glass.sellmeier = true;
+            numbers(sellmeier, row + ".sellmeier", "b", 3, false, surface.glass.sellmeier_b);
+            numbers(sellmeier, row + ".sellmeier", "c_um2", 3, false, surface.glass.sellmeier_c_um2);
+        }
         m->prescription.surfaces.push_back(surface);
     }
     const Json& blades = member(v, parent, "blades");
@@ -412,6 +423,9 @@ void read_array(const Json& root, CameraParams* params)
     a.distance_mm = positive_number(member(v, parent, "distance_mm"), parent + ".distance_mm");
     numbers(v, parent, "rotate_deg", 3, false, a.rotate_deg);
     numbers(v, parent, "translate_mm", 3, false, a.translate_mm);
+    // The microlenses' Abbe number: absent when they do not disperse.
+    if (v.contains("abbe_number"))
+        a.abbe = finite_number(v["abbe_number"], parent + ".abbe_number");
 }
 
 void read_frame(const Json& root, CameraFrame* frame)

@@ -12,7 +12,7 @@ in backticks, the second its block). This test reads both and fails with the row
    undocumented), or a documented keyword is not the parser's in that block, or a keyword has
    two rows in one block;
 2. the value column says a different kind of value than the parser reads (flag, block, on/off,
-   word, string, a 2- or 3-vector, a list, one number, N or MIN, MAX), or a block's or on/off
+   word, string, a 2-, 3- or 6-vector, a list, one number, N or MIN, MAX), or a block's or on/off
    keyword's value names other keywords or modifiers than the block the parser reads after it;
 3. the default column says another default than the table (compared after dropping backticks
    and parenthesised remarks).
@@ -104,7 +104,8 @@ def documented_kind(cell: str) -> str:
 
 
 # The table's value kinds and the kind of the specification's value cell each must have.
-KINDS = {"flag": "flag", "number": "number", "vector2": "vector2", "vector3": "vector3", "on/off": "on/off",
+KINDS = {"flag": "flag", "number": "number", "vector2": "vector2", "vector3": "vector3", "vector6": "vector6",
+         "on/off": "on/off",
          "word": "word", "string": "string", "block": "block", "samples": "numbers", "f_numbers": "list"}
 
 

@@ -364,6 +364,28 @@ REAL_LENS_CASES = [
     ("surfaces that cross", camera(main=main_with("prescription {", STOP, "  surface { radius 30 thickness 0.5 ior 1.5 aperture 20 }  " + MARK,
                                                   S2, "}", "focus_distance 2")),
      ["surface 2", "surface 3", "cross", "meet 3.8649", "smaller clear aperture"], "glass cannot pass through glass"),
+    # Dispersion (docs/real-lenses.md, "Dispersion"): refused at the row's line, naming the value and the range.
+    ("surface abbe out of range", camera(main=main_with("prescription {", STOP, "  surface { radius 30 thickness 5 ior 1.5 aperture 20 abbe 2 }  " + MARK,
+                                                        S2, "}", "focus_distance 2")),
+     ["surface abbe", "V_d 2", "5 to 150"], "an index or a slip in the Abbe number's place"),
+    ("abbe on air", camera(main=main_with("prescription {", STOP, S1, "  surface { radius -30 thickness 0 ior 1 aperture 20 abbe 30 }  " + MARK,
+                                          "}", "focus_distance 2")),
+     ["surface 3", "air (index 1)", "does not disperse"], "air's index stays 1"),
+    ("sellmeier with five numbers", camera(main=main_with("prescription {", STOP, "  surface { radius 30 thickness 5 ior 1.5168 aperture 20 "
+                                                          "sellmeier <1.04, 0.23, 1.01, 0.006, 0.02> }  " + MARK, S2, "}", "focus_distance 2")),
+     ["surface sellmeier", "six numbers", "found 5"], "B1..B3 and C1..C3"),
+    ("sellmeier resonance in the visible", camera(main=main_with("prescription {", STOP, "  surface { radius 30 thickness 5 ior 1.5168 aperture 20 "
+                                                                 "sellmeier <1.03961212, 0.231792344, 1.01046945, 0.00600069867, 0.25, 103.560653> }  " + MARK,
+                                                                 S2, "}", "focus_distance 2")),
+     ["surface 2", "C2 = 0.25", "resonance at 500 nm", "380 to 720"], "a pole of the index where the render traces"),
+    ("sellmeier and abbe", camera(main=main_with("prescription {", STOP, "  surface { radius 30 thickness 5 ior 1.5168 aperture 20 abbe 64 "
+                                                 "sellmeier <1.03961212, 0.231792344, 1.01046945, 0.00600069867, 0.0200179144, 103.560653> }  " + MARK,
+                                                 S2, "}", "focus_distance 2")),
+     ["surface 2", "not both"], "one model per medium"),
+    ("microlens abbe on pinholes", camera(array=array_with("hexagonal", "pitch 0.08", "pinhole", "abbe 40", "distance 0.32", close=BRACE)),
+     ["microlens_array abbe 40", "pinhole"], "a pinhole has no glass"),
+    ("microlens abbe out of range", camera(array=array_with(*HEX, "abbe 200  " + MARK)),
+     ["microlens_array abbe", "200", "5 to 150"], "an Abbe number no glass has"),
 ]
 
 GROUPS = {"camera": CASES, "placement": PLACEMENT_CASES, "real_lens": REAL_LENS_CASES}

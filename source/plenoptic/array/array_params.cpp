@@ -21,8 +21,10 @@ MicrolensArray make_microlens_array(const ArrayParams& params, double array_z)
     if (!params.given || params.grid == GridType::None)
         return no_microlens_array(array_z);
     const Vec3 centre{params.translate_mm[0], params.translate_mm[1], array_z + params.translate_mm[2]};
-    return make_microlens_array(params.grid, params.pitch_mm, make_microlens(params), params.distance_mm,
-                                make_array_pose(params.rotate_deg, centre));
+    MicrolensArray array = make_microlens_array(params.grid, params.pitch_mm, make_microlens(params), params.distance_mm,
+                                                make_array_pose(params.rotate_deg, centre));
+    array.abbe = params.abbe;
+    return array;
 }
 
 } // namespace plenoptic

@@ -27,6 +27,7 @@ struct ArrayParams {
     double distance_mm = 0;                 // d: array -> sensor
     double rotate_deg[3] = {0, 0, 0};       // about x, then y, then z (POV-Ray's order)
     double translate_mm[3] = {0, 0, 0};     // camera frame, after the rotation
+    double abbe = 0;                        // the microlenses' Abbe number V_d; 0: no dispersion
 };
 
 // The lenses of a checked specification, of their kind.

@@ -97,6 +97,8 @@ MetadataJson MicrolensArray::metadata(const double rotate_deg[3], const double t
     json["distance_mm"] = json_number(distance_mm);
     json["rotate_deg"] = json_numbers(rotate_deg, 3);
     json["translate_mm"] = json_numbers(translate_mm, 3);
+    if (abbe != 0)
+        json["abbe_number"] = json_number(abbe);
     return json;
 }
 

@@ -47,6 +47,10 @@ struct MicrolensArray {
     ArrayPose pose;
     double cell_inradius_mm = 0;  // of a lens's lattice cell
     double cell_circumradius_mm = 0;
+    // The microlenses' glass: their Abbe number V_d (0: they do not disperse). At a wavelength a
+    // microlens's power scales with (n(lambda) - 1) / (n_d - 1) of the two-term model (lens/glass.h),
+    // which V_d alone fixes. Stored and written to the metadata; traced with spectral sampling.
+    double abbe = 0;
 
     bool present() const { return grid != GridType::None; }
 

@@ -8,6 +8,7 @@
 #include <cstdlib>
 
 #include "plenoptic/camera/plenoptic_camera.h"
+#include "plenoptic/lens/glass.h"
 
 namespace plenoptic {
 
@@ -391,6 +392,14 @@ std::string check_array(const ArrayParams& array)
                                         array.focal_lengths_mm[i]);
         if (!message.empty())
             return message;
+    }
+    if (array.abbe != 0) {
+        if (array.lens == MicrolensType::Pinhole)
+            return "microlens_array abbe " + format_number(array.abbe) +
+                   ": a pinhole has no glass to disperse; abbe goes with focal_length or focal_lengths";
+        message = check_abbe(array.abbe);
+        if (!message.empty())
+            return "microlens_array abbe: " + message;
     }
     if (!array.has_distance)
         return "microlens_array needs distance (d: microlens array to sensor, mm)";

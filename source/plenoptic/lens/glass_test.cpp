@@ -15,6 +15,8 @@
 #include <cstdio>
 #include <string>
 
+#include "plenoptic/array/array_params.h"
+#include "plenoptic/camera/params.h"
 #include "plenoptic/core/json.h"
 #include "plenoptic/lens/glass.h"
 #include "plenoptic/lens/main_lens.h"
@@ -274,6 +276,40 @@ TEST(Glass, MetadataOfADispersingLens)
     trimmed["paraxial"].erase("longitudinal_colour_mm");
     trimmed["prescription"]["surfaces"][1].erase("abbe_number");
     EXPECT_EQ(trimmed, without);
+}
+
+// Dispersing microlenses: their Abbe number is checked with the array and written to its metadata.
+TEST(Glass, MicrolensAbbeNumber)
+{
+    ArrayParams a;
+    a.given = true;
+    a.grid = GridType::Hexagonal;
+    a.has_pitch = true;
+    a.pitch_mm = 0.1;
+    a.has_lens = true;
+    a.lens = MicrolensType::ThinLens;
+    a.focal_length_count = 1;
+    a.focal_lengths_mm[0] = 0.4;
+    a.has_distance = true;
+    a.distance_mm = 0.4;
+    EXPECT_EQ(check_array(a), "");
+    const MicrolensArray plain = make_microlens_array(a, -50);
+    EXPECT_FALSE(plain.metadata(a.rotate_deg, a.translate_mm).contains("abbe_number"));
+    a.abbe = 58;
+    EXPECT_EQ(check_array(a), "");
+    const MicrolensArray glass = make_microlens_array(a, -50);
+    EXPECT_EQ(glass.abbe, 58);
+    MetadataJson written = glass.metadata(a.rotate_deg, a.translate_mm);
+    EXPECT_EQ(written["abbe_number"], 58);
+    written.erase("abbe_number");
+    EXPECT_EQ(written, plain.metadata(a.rotate_deg, a.translate_mm));
+    a.abbe = 200;
+    EXPECT_NE(check_array(a).find("microlens_array abbe: the Abbe number V_d 200 is outside 5 to 150"), std::string::npos)
+        << check_array(a);
+    a.abbe = 40;
+    a.lens = MicrolensType::Pinhole;
+    a.focal_length_count = 0;
+    EXPECT_NE(check_array(a).find("a pinhole has no glass"), std::string::npos) << check_array(a);
 }
 
 } // namespace
