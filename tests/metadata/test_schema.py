@@ -280,3 +280,44 @@ def test_golden_references_match_schema():
             problems.append("golden reference %s: %s" % (os.path.basename(ref), e))
     assert not problems, "\n".join(problems)
     assert len(references) > 0, "%d golden references match the schema" % len(references)
+
+
+# A dispersing real lens and dispersing microlenses (docs/real-lenses.md, "Dispersion"): an N-BK7
+# singlet (SCHOTT: n_d 1.51680, V_d 64.17) behind a stop, its Abbe number inline.
+DISPERSIVE = ("main_lens { prescription { stop { thickness 2 aperture 8 }"
+              " surface { radius 30 thickness 5 ior 1.5168 aperture 20 abbe 64.17 }"
+              " surface { radius -30 thickness 0 ior 1 aperture 20 } } focus_distance 2 }"
+              " microlens_array { hexagonal pitch 0.15 focal_length 0.6 distance 0.6 abbe 58 } samples 2")
+
+
+def test_dispersive_lens_metadata(args):
+    """The glass and the focus at the F, d and C lines are written, match the schema, and the
+    schema refuses them broken."""
+    doc = pt.load_metadata(render(args, "dispersive", DISPERSIVE))
+    surfaces = doc["main_lens"]["prescription"]["surfaces"]
+    assert [s.get("abbe_number") for s in surfaces] == [None, 64.17, None]
+    assert doc["microlens_array"]["abbe_number"] == 58
+    lines = doc["main_lens"]["paraxial"]["lines"]
+    assert list(lines) == ["F", "d", "C"]
+    assert [lines[k]["wavelength_nm"] for k in "FdC"] == [486.1327, 587.5618, 656.2725]
+    # An undercorrected singlet: blue focuses nearer, by about f / V_d.
+    f = doc["main_lens"]["paraxial"]["effective_focal_length_mm"]
+    colour = doc["main_lens"]["paraxial"]["longitudinal_colour_mm"]
+    assert colour == lines["F"]["back_focal_distance_mm"] - lines["C"]["back_focal_distance_mm"]
+    assert -1.2 * f / 64.17 < colour < -0.8 * f / 64.17, (colour, f)
+    assert lines["F"]["effective_focal_length_mm"] < lines["d"]["effective_focal_length_mm"] < lines["C"]["effective_focal_length_mm"]
+
+    def broken(edit):
+        d = copy.deepcopy(doc)
+        edit(d)
+        return d
+    for label, bad in [
+        ("Abbe number 2", broken(lambda d: d["main_lens"]["prescription"]["surfaces"][1].update(abbe_number=2))),
+        ("a line missing", broken(lambda d: d["main_lens"]["paraxial"]["lines"].pop("C"))),
+        ("a line without its wavelength", broken(lambda d: d["main_lens"]["paraxial"]["lines"]["F"].pop("wavelength_nm"))),
+        ("sellmeier with two terms", broken(lambda d: d["main_lens"]["prescription"]["surfaces"][1].update(
+            sellmeier={"b": [1, 0.2], "c_um2": [0.006, 0.02, 103]}))),
+        ("microlens Abbe number 500", broken(lambda d: d["microlens_array"].update(abbe_number=500))),
+    ]:
+        with pytest.raises(pt.MetadataError):
+            pt.validate(bad, label)
