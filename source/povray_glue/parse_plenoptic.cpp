@@ -131,7 +131,9 @@ class PlenopticParser
 		void Parse_Keyword(const Keyword& keyword, BlockState& state);
 		void Parse_Modifiers(KeywordBlock block);
 		void Parse_Word(const Keyword& keyword, KeywordRead& read);
+		std::string Read_Named_File(const char *keyword, const char *kind, bool lenses_folder, std::string *file);
 		void Parse_Lens_File(KeywordRead& read);
+		void Parse_Response_File(KeywordRead& read);
 		void Parse_Samples(const Keyword& keyword, KeywordRead& read);
 		void Parse_F_Numbers(const Keyword& keyword, KeywordRead& read);
 		void Parse_Vector6(const Keyword& keyword, KeywordRead& read);
@@ -312,6 +314,9 @@ void PlenopticParser::Parse_Keyword(const Keyword& keyword, BlockState& state)
 		case KeywordValue::String:
 			Parse_Lens_File(read);
 			break;
+		case KeywordValue::ResponseFile:
+			Parse_Response_File(read);
+			break;
 		case KeywordValue::Samples:
 			Parse_Samples(keyword, read);
 			break;
@@ -331,7 +336,7 @@ void PlenopticParser::Parse_Keyword(const Keyword& keyword, BlockState& state)
 			return;
 	}
 	keyword.store(*setup, read);
-	if (keyword.value == KeywordValue::OnOff && keyword.opens != KeywordBlock::None)
+	if (keyword.opens != KeywordBlock::None)
 		Parse_Modifiers(keyword.opens);
 }
 
@@ -368,46 +373,81 @@ void PlenopticParser::Parse_Word(const Keyword& keyword, KeywordRead& read)
 	read.values[0] = found;
 }
 
-// lens_file "name": pbrt's lens-file format (lens/prescription.h), found as POV-Ray finds a
-// file the scene reads (beside the scene, then the library paths), and else in the lenses/
-// folder installed with the program. Errors name the file and its row.
-void PlenopticParser::Parse_Lens_File(KeywordRead& read)
+// The text of the file a keyword names (the string that follows it), found as POV-Ray finds a file
+// the scene reads (beside the scene, then the library paths) and, with lenses_folder, in the
+// lenses/ folder installed with the program. *file is the name as written. Refused (naming the
+// keyword, the file and `kind`, what the file should be): an empty name, a file not found, a
+// directory, a file larger than kMaxLensFileBytes.
+std::string PlenopticParser::Read_Named_File(const char *keyword, const char *kind, bool lenses_folder, std::string *file)
 {
 	const FilePos position = Token.Token_File_Pos;
 	const int column = Token.Token_Col_No;
 	char *name = p.Parse_C_String(true);
-	const std::string file(name);
+	*file = name;
 	POV_FREE(name);
-	if (file.empty())
-		Check_At("lens_file \"\" names no file: give the name of a lens file (pbrt's format, one row per surface)",
-		         position, column);
+	const std::string quoted = std::string(keyword) + " \"" + *file + "\"";
+	if (file->empty())
+		Check_At(std::string(keyword) + " \"\" names no file: give the name of " + kind, position, column);
 	UCS2String found;
-	IStream *stream = Locate_File(&p, p.sceneData, ASCIItoUCS2String(file.c_str()), POV_File_Text_User, found, false);
+	IStream *stream = Locate_File(&p, p.sceneData, ASCIItoUCS2String(file->c_str()), POV_File_Text_User, found, false);
+	if (stream == NULL && lenses_folder)
+		stream = Locate_File(&p, p.sceneData, ASCIItoUCS2String(("lenses/" + *file).c_str()), POV_File_Text_User, found, false);
 	if (stream == NULL)
-		stream = Locate_File(&p, p.sceneData, ASCIItoUCS2String(("lenses/" + file).c_str()), POV_File_Text_User, found, false);
-	if (stream == NULL)
-		Check_At("lens_file \"" + file + "\" was not found beside the scene, in the library paths (+L) or in "
-		         "the lenses folder installed with the program", position, column);
+		Check_At(quoted + " was not found beside the scene" +
+		         (lenses_folder ? ", in the library paths (+L) or in the lenses folder installed with the program"
+		                        : " or in the library paths (+L)"), position, column);
 	// A directory opens, and reads as no bytes: say what it is rather than "no surface".
 	struct stat status;
 	const std::string path = UCS2toASCIIString(found);
 	if (stat(path.c_str(), &status) == 0 && S_ISDIR(status.st_mode))
 	{
 		delete stream;
-		Check_At("lens_file \"" + file + "\" names a directory (" + path + "), not a lens file", position, column);
+		Check_At(quoted + " names a directory (" + path + "), not " + kind, position, column);
 	}
 	std::string text;
 	for (int c = stream->Read_Byte(); c != EOF && text.size() <= kMaxLensFileBytes; c = stream->Read_Byte())
 		text.push_back((char)c);
 	delete stream;
 	if (text.size() > kMaxLensFileBytes)
-		Check_At("lens_file \"" + file + "\" is larger than " + std::to_string(kMaxLensFileBytes) +
-		         " bytes: not a lens file", position, column);
+		Check_At(quoted + " is larger than " + std::to_string(kMaxLensFileBytes) + " bytes: not " + kind, position, column);
+	return text;
+}
+
+// lens_file "name": pbrt's lens-file format (lens/prescription.h), found as Read_Named_File says.
+// Errors name the file and its row.
+void PlenopticParser::Parse_Lens_File(KeywordRead& read)
+{
+	const FilePos position = Token.Token_File_Pos;
+	const int column = Token.Token_Col_No;
+	std::string file;
+	const std::string text = Read_Named_File("lens_file", "a lens file (pbrt's format, one row per surface)", true, &file);
 	const plenoptic::ParsedPrescription parsed = plenoptic::parse_lens_file(text);
 	if (parsed.error.any())
 		Check_At("lens_file \"" + file + "\"" + (parsed.error.line > 0 ? ", line " + std::to_string(parsed.error.line) : std::string()) +
 		         ": " + parsed.error.message, position, column);
 	read.prescription.surfaces = parsed.prescription.surfaces;
+	read.text = file;
+}
+
+// spectral response_file "name": the sensor's tabulated sensitivities (sensor/spectral_response.h:
+// wavelength_nm, r, g, b per row), found beside the scene or in the library paths. Errors name the
+// file and its row.
+void PlenopticParser::Parse_Response_File(KeywordRead& read)
+{
+	const FilePos position = Token.Token_File_Pos;
+	const int column = Token.Token_Col_No;
+	std::string file;
+	const std::string text = Read_Named_File("response_file", "a spectral response table (wavelength_nm, r, g, b per row)",
+	                                         false, &file);
+	std::string error;
+	int line = 0;
+	read.response = plenoptic::parse_response_table(text, &error, &line);
+	if (error.empty())
+		error = plenoptic::check_response(read.response);
+	if (!error.empty())
+		Check_At("spectral response_file \"" + file + "\"" + (line > 0 ? ", line " + std::to_string(line) : std::string()) +
+		         ": " + error, position, column);
+	read.response.file = file;
 	read.text = file;
 }
 

@@ -32,6 +32,22 @@ std::string Check_Variance(const char *, double value) { return check_variance(v
 std::string Check_Blades(const char *, double value) { return check_blades(value); }
 std::string Check_Wavelength(const char *, double value) { return check_wavelength(value); }
 std::string Check_Angular_Exponent(const char *, double value) { return check_angular_exponent(value); }
+std::string Check_Spectral_Bands(const char *, double value) { return check_spectral_bands(value); }
+std::string Check_Response_Centre(const char *label, double value)
+{
+    if (!(value >= kMinWavelengthNm && value <= kMaxWavelengthNm))
+        return std::string(label) + " are in nanometres, from " + format_number(kMinWavelengthNm) + " to " +
+               format_number(kMaxWavelengthNm) + ", got " + format_number(value);
+    return "";
+}
+std::string Check_Response_Width(const char *label, double value)
+{
+    if (!(value >= kMinResponseWidthNm && value <= kMaxResponseWidthNm))
+        return std::string(label) + " are full widths at half maximum in nanometres, from " +
+               format_number(kMinResponseWidthNm) + " to " + format_number(kMaxResponseWidthNm) + ", got " +
+               format_number(value);
+    return "";
+}
 std::string Check_Abbe(const char *label, double value)
 {
     const std::string message = check_abbe(value);
@@ -122,6 +138,14 @@ std::vector<Keyword> make_table()
                 })
             .opening(B::Diffraction),
 
+        Keyword("spectral", B::Camera, V::Number, "off",
+                "trace each sample at one of N wavelength bands (380 to 720 nm), weighed by the sensor's response",
+                [](CameraSetup& s, R r) {
+                    s.params.spectral = SpectralParams();
+                    s.params.spectral.bands = (int)r.values[0];
+                })
+            .checked(Check_Spectral_Bands).opening(B::Spectral),
+
         // ---- white_image's modifiers ----
         Keyword("f_numbers", B::WhiteImage, V::FNumbers, "the camera's own aperture: one file, <image stem>.white.png",
                 "one white image per f-number, the main lens set to it",
@@ -140,6 +164,25 @@ std::vector<Keyword> make_table()
         Keyword("wavelengths", B::Diffraction, V::Vector3, "<610, 550, 465>", "the wavelength of each colour channel (nm)",
                 [](CameraSetup& s, R r) { std::copy(r.values, r.values + 3, s.params.diffraction.wavelengths_nm); })
             .labelled("diffraction wavelengths").checked(Check_Wavelength),
+
+        // ---- spectral's modifiers ----
+        Keyword("response_centres", B::Spectral, V::Vector3, "<610, 550, 465>",
+                "the centres of the sensor's Gaussian sensitivities, R, G, B (nm)",
+                [](CameraSetup& s, R r) {
+                    std::copy(r.values, r.values + 3, s.params.spectral.response.centre_nm);
+                    s.params.spectral.gaussian_written = true;
+                })
+            .labelled("spectral response_centres").checked(Check_Response_Centre),
+        Keyword("response_widths", B::Spectral, V::Vector3, "<90, 90, 90>",
+                "their full widths at half maximum, R, G, B (nm)",
+                [](CameraSetup& s, R r) {
+                    std::copy(r.values, r.values + 3, s.params.spectral.response.fwhm_nm);
+                    s.params.spectral.gaussian_written = true;
+                })
+            .labelled("spectral response_widths").checked(Check_Response_Width),
+        Keyword("response_file", B::Spectral, V::ResponseFile, "Gaussian sensitivities",
+                "the sensor's sensitivities tabulated: wavelength_nm, r, g, b per row",
+                [](CameraSetup& s, R r) { s.params.spectral.response = r.response; }),
 
         // ---- main_lens { } ----
         Keyword("thin_lens", B::MainLens, V::Flag, "", "an ideal thin lens",
@@ -348,6 +391,7 @@ const KeywordBlockInfo kBlocks[] = {
     {B::Sensor, "sensor", "sensor", nullptr, 0},
     {B::WhiteImage, "white_image", "white_image", nullptr, 0},
     {B::Diffraction, "diffraction", "diffraction", nullptr, 1},
+    {B::Spectral, "spectral", "spectral", nullptr, 2},
 };
 
 } // namespace
@@ -442,6 +486,7 @@ const char *keyword_value_name(KeywordValue value)
         case V::OnOff: return "on/off";
         case V::Word: return "word";
         case V::String: return "string";
+        case V::ResponseFile: return "string";
         case V::Block: return "block";
         case V::Samples: return "samples";
         case V::FNumbers: return "f_numbers";

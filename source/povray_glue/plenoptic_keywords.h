@@ -21,7 +21,7 @@ namespace plenoptic {
 
 // Where a keyword is written: the blocks of the specification's tables.
 enum class KeywordBlock {
-    None,            // (a Block or OnOff row that opens no block)
+    None,            // (a row that opens no block)
     Camera,          // directly inside camera { plenoptic ... }
     MainLens,        // main_lens { }
     Distortion,      // main_lens { distortion { } }
@@ -31,7 +31,8 @@ enum class KeywordBlock {
     MicrolensArray,  // microlens_array { }
     Sensor,          // sensor { }
     WhiteImage,      // the modifiers read right after the camera's white_image
-    Diffraction      // the modifiers read right after the camera's diffraction
+    Diffraction,     // the modifiers read right after the camera's diffraction
+    Spectral         // the modifiers read right after the camera's spectral N
 };
 
 // How the parser reads what follows the keyword.
@@ -45,6 +46,7 @@ enum class KeywordValue {
                // the modifiers of the block the row opens
     Word,      // one of the row's words, read by its text (not a string, not an identifier's value)
     String,    // a string: the name of a lens file, read into the main lens's prescription
+    ResponseFile,  // a string: the name of a spectral response table, read into `response`
     Block,     // { } holding the keywords of the block the row opens
     Samples,   // N, or MIN, MAX
     FNumbers   // N, or <N1, ..., Nk>
@@ -60,6 +62,7 @@ struct KeywordRead {
     std::vector<double> list;      // FNumbers, Vector6: the values
     std::string text;              // String: the string
     Prescription prescription;     // String: the surfaces of the lens file it names
+    SpectralResponse response;     // ResponseFile: the table it names
     long line = 0;                 // where the keyword is written
     long column = 0;
     long long offset = 0;
@@ -91,7 +94,7 @@ struct Keyword {
                                                // else a word only here, recognised by its text
     KeywordGroup group = KeywordGroup::None;
     bool needed = false;                       // the block is refused at its } without it (checked by the parser)
-    KeywordBlock opens = KeywordBlock::None;   // Block: the block inside; OnOff: the block of its modifiers
+    KeywordBlock opens = KeywordBlock::None;   // Block: the block inside; another kind: the block of its modifiers
     KeywordWordAt word_at = nullptr;           // Word: the words allowed
 
     // Setters for the table's rows.

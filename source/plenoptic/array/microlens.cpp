@@ -62,6 +62,13 @@ public:
     bool forms_image() const override { return true; }
     int type_count() const override { return type_count_; }
     double focal_length_mm(int type) const override { return focal_mm_[type]; }
+    std::shared_ptr<const Microlens> with_power_scaled(double factor) const override
+    {
+        double focal[3];
+        for (int t = 0; t < 3; ++t)
+            focal[t] = focal_mm_[t] / factor;
+        return std::make_shared<ThinMicrolens>(focal, type_count_);
+    }
 
     ArrayRay sample_ray(const MicrolensArray& array, const Vec3& p, LensIndex lens, double u, double v) const override
     {

@@ -47,6 +47,14 @@ public:
     // The focal length of each lens type, as the metadata lists them; empty for a pinhole.
     std::vector<double> focal_lengths_mm() const;
 
+    // The same lenses with every power multiplied by `factor` (their glass at another wavelength:
+    // MicrolensArray::at_wavelength); nullptr for lenses without power (a pinhole).
+    virtual std::shared_ptr<const Microlens> with_power_scaled(double factor) const
+    {
+        (void)factor;
+        return nullptr;
+    }
+
     // The ray from sensor point p (optics frame) through lens `lens` for the aperture sample (u, v)
     // in [0, 1)^2, as it leaves the array towards the scene: through the pinhole's centre, or
     // through the point of the lens's cell the sample picks (uniform over the cell, (0.5, 0.5) the

@@ -3,6 +3,8 @@
 
 #include "plenoptic/array/microlens_array.h"
 
+#include "plenoptic/lens/glass.h"
+
 #include "plenoptic/core/json.h"
 
 #include <cmath>
@@ -84,6 +86,17 @@ MicrolensArray make_microlens_array(GridType grid, double pitch_mm, std::shared_
     array.cell_inradius_mm = cell_inradius(grid, pitch_mm);
     array.cell_circumradius_mm = cell_circumradius(grid, pitch_mm);
     return array;
+}
+
+MicrolensArray MicrolensArray::at_wavelength(double wavelength_nm) const
+{
+    MicrolensArray out = *this;
+    if (abbe == 0 || !microlens)
+        return out;
+    std::shared_ptr<const Microlens> scaled = microlens->with_power_scaled(two_term_power_ratio(abbe, wavelength_nm));
+    if (scaled)
+        out.microlens = std::move(scaled);
+    return out;
 }
 
 MetadataJson MicrolensArray::metadata(const double rotate_deg[3], const double translate_mm[3]) const

@@ -49,7 +49,7 @@ struct MicrolensArray {
     double cell_circumradius_mm = 0;
     // The microlenses' glass: their Abbe number V_d (0: they do not disperse). At a wavelength a
     // microlens's power scales with (n(lambda) - 1) / (n_d - 1) of the two-term model (lens/glass.h),
-    // which V_d alone fixes. Stored and written to the metadata; traced with spectral sampling.
+    // which V_d alone fixes (at_wavelength).
     double abbe = 0;
 
     bool present() const { return grid != GridType::None; }
@@ -78,6 +78,10 @@ struct MicrolensArray {
     int cell_corners(Vec2 corners[6]) const { return cell_polygon(grid, pitch_mm, corners); }
     // Distance between rows of lenses: p, or p sqrt(3)/2.
     double row_spacing_mm() const { return row_spacing(grid, pitch_mm); }
+
+    // The same array at a wavelength (nm): each lens's power scaled by two_term_power_ratio(abbe)
+    // (lens/glass.h); the array itself when its lenses do not disperse or have no power.
+    MicrolensArray at_wavelength(double wavelength_nm) const;
 
     // The metadata's microlens_array section (present arrays only): grid, lens kind, pitch, the
     // focal lengths, d, and the pose as the scene gave it (degrees and mm, from the spec).

@@ -468,6 +468,18 @@ std::string check_sampling(const SamplingParams& sampling)
     return check_variance(sampling.variance);
 }
 
+std::string check_spectral(const SpectralParams& spectral)
+{
+    if (!spectral.given())
+        return "";
+    std::string message = check_spectral_bands(spectral.bands);
+    if (!message.empty())
+        return message;
+    if (spectral.response.tabulated && spectral.gaussian_written)
+        return "spectral takes response_file or response_centres / response_widths (Gaussian sensitivities), not both";
+    return check_response(spectral.response);
+}
+
 std::string check_camera(const CameraParams& camera)
 {
     std::string message;
@@ -480,6 +492,8 @@ std::string check_camera(const CameraParams& camera)
     if (!(message = check_sensor(camera.sensor)).empty())
         return message;
     if (!(message = check_sampling(camera.sampling)).empty())
+        return message;
+    if (!(message = check_spectral(camera.spectral)).empty())
         return message;
 
     if (camera.sensor.angular_exponent > 0 && camera.radiometry != Radiometry::Irradiance)

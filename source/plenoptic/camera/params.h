@@ -9,6 +9,7 @@
 #include "plenoptic/array/array_params.h"
 #include "plenoptic/core/format.h"
 #include "plenoptic/core/lattice.h"
+#include "plenoptic/camera/spectral_bands.h"
 #include "plenoptic/lens/main_lens_params.h"
 #include "plenoptic/sensor/sensor_chain.h"
 
@@ -80,6 +81,7 @@ struct CameraParams {
     ArrayParams array;
     SensorParams sensor;
     SamplingParams sampling;
+    SpectralParams spectral;  // `spectral N` (camera/spectral_bands.h); bands 0: off
 };
 
 // The camera's parameters with the main lens at f-number N (aperture from N, as `f_number N`).
@@ -120,6 +122,8 @@ std::string format_rounded(double value, bool round_up);
 std::string check_array(const ArrayParams& array);
 std::string check_sensor(const SensorParams& sensor);
 std::string check_sampling(const SamplingParams& sampling);
+// spectral N with its response (camera/spectral_bands.h): "" when off or usable.
+std::string check_spectral(const SpectralParams& spectral);
 // The whole camera, run when the camera's closing brace is read. Runs the block checks again
 // (cheap), then the checks that need several blocks at once.
 std::string check_camera(const CameraParams& camera);

@@ -85,22 +85,33 @@ inline void estimate(const SampleSums* sums, int lenses, double value[4], double
 // of one Halton sequence is not such a pattern: with L = 2, the even points have their base-2
 // coordinate, the aperture's u, all in one half of [0, 1).) With one lens this is exactly
 // make_sample(i, j, n, count).
-inline CameraSample lens_sample(int i, int j, int n, int count, int lenses, int* slot)
+inline CameraSample lens_sample(int i, int j, int n, int count, int lenses, int* slot, int stream = 0)
 {
     *slot = n % lenses;
     // `count`, not the lens's share of it: only a 1-sample pixel is sampled at its centre, and a
     // lens that gets one sample of several gets a random point (point 0 of its rotated stream).
-    return make_sample(i, j, n / lenses, count, *slot);
+    return make_sample(i, j, n / lenses, count, stream + *slot);
 }
+
+// The samples one call of shade_samples takes: between min and max (fixed: min == max), from
+// sample stream `stream` (make_sample; lens slot s of overlap modelling uses stream + s); `pixel_count`
+// is the pixel's whole sample count, which decides whether the pixel is a 1-sample pixel (its centre
+// and chief ray) or sampled over its area: a spectral band that gets 1 of a pixel's 16 samples
+// takes a random point of the pixel and the aperture, as every other sample does.
+struct SampleBudget {
+    int min, max;
+    int pixel_count;
+    int stream;
+};
 
 // How many of samples from .. to-1 of pixel (i, j) pass the apertures through the pixel's own
 // lenses (geometry only); *first is the first of them (-1 if none).
-inline int passing_samples(const PlenopticCamera& model, int i, int j, int from, int to, int* first)
+inline int passing_samples(const PlenopticCamera& model, int i, int j, int from, int to, int* first, int stream = 0)
 {
     int passing = 0;
     *first = -1;
     for (int n = from; n < to; ++n) {
-        const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, n, to));
+        const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, n, to, stream));
         if (ray.passed) {
             ++passing;
             if (*first < 0)
@@ -116,14 +127,15 @@ inline int passing_samples(const PlenopticCamera& model, int i, int j, int from,
 // `sum` holds the sums of the `passed` traced colours of samples 0 .. n-1. With none passed but
 // some probe passing, that probe's sample is traced so the pixel is not black where light lands.
 template <class TraceFn>
-Rgbt vignetted_value(const PlenopticCamera& model, int i, int j, int n, int passed, double sum[4], TraceFn& trace)
+Rgbt vignetted_value(const PlenopticCamera& model, int i, int j, int n, int passed, double sum[4], TraceFn& trace,
+                     int stream)
 {
     const int probes = n * kVignettingProbesPerSample;
     int first_untraced;
     // Samples 0 .. n-1 were generated already: only the points after them are new.
-    const int passing = passed + passing_samples(model, i, j, n, probes, &first_untraced);
+    const int passing = passed + passing_samples(model, i, j, n, probes, &first_untraced, stream);
     if (passed == 0 && first_untraced >= 0) {
-        const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, first_untraced, probes));
+        const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, first_untraced, probes, stream));
         const Rgbt c = detail::traced(trace, ray);
         sum[0] = c.r;
         sum[1] = c.g;
@@ -160,7 +172,8 @@ inline double mean_lit_area(const PlenopticCamera& model, int i, int j)
 // vignetting costs look-ups, not traces. With none passed, the first passing point of
 // kVignettingProbesPerSample n points of its sample sequence is traced for the colour.
 template <class TraceFn>
-Rgbt lit_area_value(const PlenopticCamera& model, int i, int j, int n, int passed, const double plain[4], TraceFn& trace)
+Rgbt lit_area_value(const PlenopticCamera& model, int i, int j, int n, int passed, const double plain[4], TraceFn& trace,
+                    int stream)
 {
     const double lit = mean_lit_area(model, i, j);
     if (!(lit > 0))
@@ -171,13 +184,162 @@ Rgbt lit_area_value(const PlenopticCamera& model, int i, int j, int n, int passe
     }
     const int points = n * kVignettingProbesPerSample;
     for (int k = n; k < points; ++k) {
-        const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, k, points));
+        const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, k, points, stream));
         if (ray.passed) {
             const Rgbt c = trace(ray);
             return Rgbt{c.r * lit, c.g * lit, c.b * lit, c.t * lit};
         }
     }
     return Rgbt{0, 0, 0, 0};
+}
+
+// shade_pixel's work for one camera and one budget of samples (see shade_pixel below).
+template <class TraceFn>
+Rgbt shade_samples(const PlenopticCamera& model, int i, int j, TraceFn& trace, const SampleBudget& budget)
+{
+    const int count = std::max(1, budget.max);
+    const int stream = budget.stream;
+    if (!model.sampling.adaptive && !model.overlap.modelled) {
+        // Fixed count through the own lens: the plain mean, without the variance bookkeeping
+        // (the common case, and the one whose cost is compared with the stock cameras).
+        const bool lit_area = model.lit_area && budget.pixel_count > 1;
+        double sum[4] = {0, 0, 0, 0};
+        int passed = 0;
+        for (int n = 0; n < count; ++n) {
+            const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, n, budget.pixel_count, stream));
+            if (ray.passed) {
+                // With a lit-area table the colours are summed without the ray weight: the
+                // pixel's lit area scales their mean (detail::lit_area_value).
+                const Rgbt c = lit_area ? trace(ray) : detail::traced(trace, ray);
+                sum[0] += c.r;
+                sum[1] += c.g;
+                sum[2] += c.b;
+                sum[3] += c.t;
+                ++passed;
+            }
+        }
+        if (lit_area)
+            return lit_area_value(model, i, j, count, passed, sum, trace, stream);
+        if (budget.pixel_count > 1 && passed < count)
+            return vignetted_value(model, i, j, count, passed, sum, trace, stream);
+        return Rgbt{sum[0] / count, sum[1] / count, sum[2] / count, sum[3] / count};
+    }
+
+    LensIndex lenses[kMaxOverlapLenses];
+    int lens_count = 1;
+    if (model.overlap.modelled) {
+        lens_count = overlap_lenses(model, i, j, lenses, kMaxOverlapLenses);
+        if (lens_count == 0)
+            return Rgbt{0, 0, 0, 0};
+    }
+    SampleSums sums[kMaxOverlapLenses];
+    for (int s = 0; s < lens_count; ++s)
+        sums[s] = SampleSums{{0, 0, 0, 0}, {0, 0, 0, 0}, 0};
+
+    int batch = model.sampling.adaptive ? std::max(1, budget.min) : count;
+    double value[4], variance[4];
+    int n = 0;
+    int passed = 0;  // samples that passed the apertures so far
+    double plain[4] = {0, 0, 0, 0};  // their colours without the ray weight (for lit_area_value)
+    for (;;) {
+        const int stop = std::min(count, n + batch);
+        for (; n < stop; ++n) {
+            int slot = 0;
+            const CameraSample sample = lens_sample(i, j, n, budget.pixel_count, lens_count, &slot, stream);
+            const OpticsRay ray = generate_ray(model, i, j, sample, model.overlap.modelled ? &lenses[slot] : nullptr);
+            Rgbt colour{0, 0, 0, 0};
+            if (ray.passed) {
+                const Rgbt raw = trace(ray);
+                colour = Rgbt{raw.r * ray.weight, raw.g * ray.weight, raw.b * ray.weight, raw.t * ray.weight};
+                plain[0] += raw.r;
+                plain[1] += raw.g;
+                plain[2] += raw.b;
+                plain[3] += raw.t;
+                ++passed;
+            }
+            add_sample(&sums[slot], colour);
+        }
+        if (!model.sampling.adaptive || n >= count)
+            break;
+        batch = 4;
+        // While every sample so far was blocked, the zero variance says nothing: a pixel at the
+        // rim of a microimage can have its lit part missed by the first samples. Blocked samples
+        // cost no scene ray, so go on until one passes (or samples_max says the pixel is dark).
+        if (passed == 0)
+            continue;
+        // The variance of the plain mean, blocked samples as zeros: the pass/block noise in it keeps
+        // rim pixels sampling (tried: leaving it out to the vignetting probes stopped them too early;
+        // on the benchmark's plenoptic 1.0 scene that took 1.6-2x the time for the same error).
+        estimate(sums, lens_count, value, variance);
+        const double threshold = model.sampling.thresholds[n - 1];
+        if (std::fabs(variance[0]) < threshold && std::fabs(variance[1]) < threshold &&
+            std::fabs(variance[2]) < threshold && std::fabs(variance[3]) < threshold)
+            break;
+    }
+    if (lens_count == 1 && budget.pixel_count > 1 && model.lit_area)
+        return lit_area_value(model, i, j, n, passed, plain, trace, stream);
+    if (lens_count == 1 && budget.pixel_count > 1 && passed < n)
+        return vignetted_value(model, i, j, n, passed, sums[0].sum, trace, stream);
+    estimate(sums, lens_count, value, variance);
+    const double t = lens_count > 1 ? std::min(1.0, std::max(0.0, value[3])) : value[3];
+    return Rgbt{value[0], value[1], value[2], t};
+}
+
+
+// Sample streams of spectral band b start at (b + 1) * kBandStreamStride, clear of the overlap
+// lens slots (0 .. kMaxOverlapLenses - 1) of stream 0 and of each other.
+const int kBandStreamStride = 1024;
+
+// Which band sample 0 of pixel (i, j) goes to (an integer hash of (i, j) modulo the bands): with
+// fewer samples than bands, neighbouring pixels see different bands.
+inline int band_offset(int i, int j, int bands)
+{
+    const unsigned h = unsigned(i) * 0x9E3779B1u ^ (unsigned(j) * 0x85EBCA77u + 0x165667B1u);
+    return int((h ^ (h >> 15)) % unsigned(bands));
+}
+
+// Spectral sampling (camera/spectral_bands.h): the pixel's samples shared among the bands, each
+// band's share traced through the camera at its wavelength by shade_samples, as a pixel of its own
+// (vignetting, lit area, overlap and adaptive stopping included) from a sample stream of its own.
+// Fixed count n over N bands: sample k goes to band (k + band_offset) mod N, so each band gets
+// n / N samples, give or take one. Adaptive: every band takes ceil(MIN / N) .. ceil(MAX / N)
+// samples and stops by the pixel's thresholds on its own (each band's variance below the
+// threshold keeps the weighted sum's below it: the weights are at most 1 and sum to 1). The value
+// of channel c is (N / S) sum_b w_c(b) v_b,c over the S bands that got samples: their weighted sum
+// when every band got some, and an unbiased estimate of it when fewer samples than bands leave some
+// out (each band is left out of as many pixels' sets as any other); t is the mean over them.
+template <class TraceFn>
+Rgbt spectral_pixel(const PlenopticCamera& model, int i, int j, TraceFn& trace)
+{
+    const SpectralCameras& spectral = *model.spectral;
+    const int bands = int(spectral.bands.size());
+    const int count = std::max(1, model.sampling.samples_max);
+    const int offset = band_offset(i, j, bands);
+    double sum[4] = {0, 0, 0, 0};
+    int sampled = 0;
+    for (int b = 0; b < bands; ++b) {
+        SampleBudget budget{0, 0, count, (b + 1) * kBandStreamStride};
+        if (model.sampling.adaptive) {
+            budget.min = std::max(1, (model.sampling.samples_min + bands - 1) / bands);
+            budget.max = std::max(1, (count + bands - 1) / bands);
+        } else {
+            const int first = ((b - offset) % bands + bands) % bands;  // the first sample k of band b
+            budget.min = budget.max = first < count ? (count - 1 - first) / bands + 1 : 0;
+        }
+        if (budget.max == 0)
+            continue;
+        const Rgbt v = shade_samples(spectral.cameras[size_t(b)], i, j, trace, budget);
+        const double* w = spectral.bands[size_t(b)].weight;
+        sum[0] += w[0] * v.r;
+        sum[1] += w[1] * v.g;
+        sum[2] += w[2] * v.b;
+        sum[3] += v.t;
+        ++sampled;
+    }
+    if (sampled == 0)
+        return Rgbt{0, 0, 0, 0};
+    const double scale = double(bands) / sampled;
+    return Rgbt{sum[0] * scale, sum[1] * scale, sum[2] * scale, sum[3] / sampled};
 }
 
 } // namespace detail
@@ -196,95 +358,16 @@ Rgbt lit_area_value(const PlenopticCamera& model, int i, int j, int n, int passe
 // With overlap modelling, sample n goes through the pixel's lens n mod L (L lenses from
 // overlap_lenses) as sample n / L of that lens's own sample stream (detail::lens_sample), and
 // the value is the sum over lenses of each lens's mean; t is clamped to [0, 1]. A pixel that no
-// lens reaches is black and opaque, never background.
+// lens reaches is black and opaque, never background. With spectral sampling, the samples are shared
+// among the wavelength bands (detail::spectral_pixel).
 template <class TraceFn>
 Rgbt shade_pixel(const PlenopticCamera& model, int i, int j, TraceFn trace)
 {
-    const int count = std::max(1, model.sampling.samples_max);
-    if (!model.sampling.adaptive && !model.overlap.modelled) {
-        // Fixed count through the own lens: the plain mean, without the variance bookkeeping
-        // (the common case, and the one whose cost is compared with the stock cameras).
-        const bool lit_area = model.lit_area && count > 1;
-        double sum[4] = {0, 0, 0, 0};
-        int passed = 0;
-        for (int n = 0; n < count; ++n) {
-            const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, n, count));
-            if (ray.passed) {
-                // With a lit-area table the colours are summed without the ray weight: the
-                // pixel's lit area scales their mean (detail::lit_area_value).
-                const Rgbt c = lit_area ? trace(ray) : detail::traced(trace, ray);
-                sum[0] += c.r;
-                sum[1] += c.g;
-                sum[2] += c.b;
-                sum[3] += c.t;
-                ++passed;
-            }
-        }
-        if (lit_area)
-            return detail::lit_area_value(model, i, j, count, passed, sum, trace);
-        if (count > 1 && passed < count)
-            return detail::vignetted_value(model, i, j, count, passed, sum, trace);
-        return Rgbt{sum[0] / count, sum[1] / count, sum[2] / count, sum[3] / count};
-    }
-
-    LensIndex lenses[kMaxOverlapLenses];
-    int lens_count = 1;
-    if (model.overlap.modelled) {
-        lens_count = overlap_lenses(model, i, j, lenses, kMaxOverlapLenses);
-        if (lens_count == 0)
-            return Rgbt{0, 0, 0, 0};
-    }
-    detail::SampleSums sums[kMaxOverlapLenses];
-    for (int s = 0; s < lens_count; ++s)
-        sums[s] = detail::SampleSums{{0, 0, 0, 0}, {0, 0, 0, 0}, 0};
-
-    int batch = model.sampling.adaptive ? std::max(1, model.sampling.samples_min) : count;
-    double value[4], variance[4];
-    int n = 0;
-    int passed = 0;  // samples that passed the apertures so far
-    double plain[4] = {0, 0, 0, 0};  // their colours without the ray weight (for lit_area_value)
-    for (;;) {
-        const int stop = std::min(count, n + batch);
-        for (; n < stop; ++n) {
-            int slot = 0;
-            const CameraSample sample = detail::lens_sample(i, j, n, count, lens_count, &slot);
-            const OpticsRay ray = generate_ray(model, i, j, sample, model.overlap.modelled ? &lenses[slot] : nullptr);
-            Rgbt colour{0, 0, 0, 0};
-            if (ray.passed) {
-                const Rgbt raw = trace(ray);
-                colour = Rgbt{raw.r * ray.weight, raw.g * ray.weight, raw.b * ray.weight, raw.t * ray.weight};
-                plain[0] += raw.r;
-                plain[1] += raw.g;
-                plain[2] += raw.b;
-                plain[3] += raw.t;
-                ++passed;
-            }
-            detail::add_sample(&sums[slot], colour);
-        }
-        if (!model.sampling.adaptive || n >= count)
-            break;
-        batch = 4;
-        // While every sample so far was blocked, the zero variance says nothing: a pixel at the
-        // rim of a microimage can have its lit part missed by the first samples. Blocked samples
-        // cost no scene ray, so go on until one passes (or samples_max says the pixel is dark).
-        if (passed == 0)
-            continue;
-        // The variance of the plain mean, blocked samples as zeros: the pass/block noise in it keeps
-        // rim pixels sampling (tried: leaving it out to the vignetting probes stopped them too early;
-        // on the benchmark's plenoptic 1.0 scene that took 1.6-2x the time for the same error).
-        detail::estimate(sums, lens_count, value, variance);
-        const double threshold = model.sampling.thresholds[n - 1];
-        if (std::fabs(variance[0]) < threshold && std::fabs(variance[1]) < threshold &&
-            std::fabs(variance[2]) < threshold && std::fabs(variance[3]) < threshold)
-            break;
-    }
-    if (lens_count == 1 && n > 1 && model.lit_area)
-        return detail::lit_area_value(model, i, j, n, passed, plain, trace);
-    if (lens_count == 1 && n > 1 && passed < n)
-        return detail::vignetted_value(model, i, j, n, passed, sums[0].sum, trace);
-    detail::estimate(sums, lens_count, value, variance);
-    const double t = lens_count > 1 ? std::min(1.0, std::max(0.0, value[3])) : value[3];
-    return Rgbt{value[0], value[1], value[2], t};
+    if (model.spectral)
+        return detail::spectral_pixel(model, i, j, trace);
+    const detail::SampleBudget budget{model.sampling.samples_min, model.sampling.samples_max,
+                                      std::max(1, model.sampling.samples_max), 0};
+    return detail::shade_samples(model, i, j, trace, budget);
 }
 
 // Whether any of the sample points shade_pixel looks at for pixel (i, j) passes the apertures

@@ -45,6 +45,45 @@ OverlapGeometry overlap_geometry(const PlenopticCamera& m)
     return g;
 }
 
+// The lens says where light from the array's plane (or the sensor's) passes it.
+void place_pupil_bounds(PlenopticCamera& m)
+{
+    m.pupil_bounds = nullptr;
+    m.lit_area = nullptr;
+    if (!m.lens)
+        return;
+    m.pupil_bounds = m.lens->pupil_bounds(m.array.grid == GridType::None ? m.sensor.z_mm : m.array.pose.centre_mm.z);
+    if (m.pupil_bounds && m.array.grid == GridType::None)
+        m.lit_area = m.lens->lit_area(*m.pupil_bounds, m.sensor.irradiance_k_mm2, m.sensor.angular_exponent);
+}
+
+// Overlap: a bound at the array centre says whether a neighbour's light can reach a microimage
+// cell at all, and how many rings of neighbours a pixel must consider.
+Overlap overlap_of(const PlenopticCamera& m)
+{
+    Overlap overlap;
+    if (m.array.grid == GridType::None || !m.lens)
+        return overlap;
+    const OverlapGeometry g = overlap_geometry(m);
+    const double reach = g.disc_mm + g.blur_mm;
+    if (!(reach > g.cell_mm))
+        return overlap;
+    overlap.modelled = true;
+    const double pixel_reach = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]);
+    const double lattice_reach = (reach + pixel_reach) / (1 + g.magnification) + m.array.cell_circumradius_mm;
+    // Ring r of the lattice is at least r times this far from the own lens.
+    const double ring_step = m.array.row_spacing_mm();
+    double rings = std::ceil(lattice_reach / ring_step) + (m.array.pose.tilted ? 1 : 0);
+    if (!(rings >= 1))
+        rings = 1;
+    if (!(rings <= kMaxOverlapRings)) {
+        rings = kMaxOverlapRings;
+        overlap.rings_capped = true;
+    }
+    overlap.rings = int(rings);
+    return overlap;
+}
+
 } // namespace
 
 double effective_main_distance_mm(const PlenopticCamera& model)
@@ -60,6 +99,12 @@ double effective_array_distance_mm(const PlenopticCamera& model)
 PlenopticCamera with_film(PlenopticCamera model, int width, int height)
 {
     model.sensor.film = Film{width, height};
+    if (model.spectral) {
+        std::shared_ptr<SpectralCameras> spectral = std::make_shared<SpectralCameras>(*model.spectral);
+        for (PlenopticCamera& camera : spectral->cameras)
+            camera.sensor.film = Film{width, height};
+        model.spectral = spectral;
+    }
     return model;
 }
 
@@ -142,42 +187,14 @@ PlenopticCamera make_camera(const CameraParams& params)
 
     m.sensor.irradiance_k_mm2 = irradiance_constant_mm2(m);
 
-    if (m.lens) {
-        // The lens says where light from the array's plane (or the sensor's) passes it.
-        m.pupil_bounds = m.lens->pupil_bounds(m.array.grid == GridType::None ? m.sensor.z_mm : m.array.pose.centre_mm.z);
-        if (m.pupil_bounds && m.array.grid == GridType::None)
-            m.lit_area = m.lens->lit_area(*m.pupil_bounds, m.sensor.irradiance_k_mm2, m.sensor.angular_exponent);
-    }
+    place_pupil_bounds(m);
 
     for (int a = 0; a < 2; ++a) {
         m.sensor.pixel_size_mm[a] = params.sensor.pixel_size_mm[a];
         m.sensor.offset_mm[a] = params.sensor.offset_mm[a];
     }
 
-    // Overlap: a bound at the array centre says whether a neighbour's light can reach a
-    // microimage cell at all, and how many rings of neighbours a pixel must consider.
-    m.overlap.modelled = false;
-    m.overlap.rings = 0;
-    m.overlap.rings_capped = false;
-    if (m.array.grid != GridType::None && m.lens) {
-        const OverlapGeometry g = overlap_geometry(m);
-        const double reach = g.disc_mm + g.blur_mm;
-        if (reach > g.cell_mm) {
-            m.overlap.modelled = true;
-            const double pixel_reach = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]);
-            const double lattice_reach = (reach + pixel_reach) / (1 + g.magnification) + m.array.cell_circumradius_mm;
-            // Ring r of the lattice is at least r times this far from the own lens.
-            const double ring_step = m.array.row_spacing_mm();
-            double rings = std::ceil(lattice_reach / ring_step) + (m.array.pose.tilted ? 1 : 0);
-            if (!(rings >= 1))
-                rings = 1;
-            if (!(rings <= kMaxOverlapRings)) {
-                rings = kMaxOverlapRings;
-                m.overlap.rings_capped = true;
-            }
-            m.overlap.rings = int(rings);
-        }
-    }
+    m.overlap = overlap_of(m);
 
     const SamplingParams& sampling = params.sampling;
     m.sampling.adaptive = sampling.adaptive;
@@ -188,6 +205,32 @@ PlenopticCamera make_camera(const CameraParams& params)
     m.sampling.variance = sampling.variance;
     if (m.sampling.adaptive)
         m.sampling.thresholds = adaptive_thresholds(m.sampling.samples_max, m.sampling.confidence, m.sampling.variance);
+
+    if (params.spectral.given()) {
+        std::shared_ptr<SpectralCameras> spectral = std::make_shared<SpectralCameras>();
+        spectral->bands = spectral_bands(params.spectral);
+        for (const SpectralBand& band : spectral->bands)
+            spectral->cameras.push_back(at_wavelength(m, band.wavelength_nm));
+        m.spectral = spectral;
+    }
+    return m;
+}
+
+PlenopticCamera at_wavelength(const PlenopticCamera& camera, double wavelength_nm)
+{
+    PlenopticCamera m = camera;
+    m.spectral = nullptr;
+    m.array = camera.array.at_wavelength(wavelength_nm);
+    std::shared_ptr<const MainLens> lens = camera.lens ? camera.lens->at_wavelength(wavelength_nm) : nullptr;
+    if (lens) {
+        m.lens = lens;
+        place_pupil_bounds(m);
+    }
+    // The overlap bound of this lens and array, and never fewer rings than the d line's.
+    const Overlap own = overlap_of(m);
+    m.overlap.modelled = own.modelled || camera.overlap.modelled;
+    m.overlap.rings = std::max(own.rings, camera.overlap.rings);
+    m.overlap.rings_capped = own.rings_capped || camera.overlap.rings_capped;
     return m;
 }
 

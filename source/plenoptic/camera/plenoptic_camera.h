@@ -13,6 +13,7 @@
 #include "plenoptic/lens/main_lens.h"
 #include "plenoptic/core/lattice.h"
 #include "plenoptic/camera/params.h"
+#include "plenoptic/camera/spectral_bands.h"
 #include "plenoptic/lens/lit_area.h"
 #include "plenoptic/lens/pupil_bounds.h"
 #include "plenoptic/core/vec.h"
@@ -92,6 +93,7 @@ struct Sampling {
 struct OpticsRay;
 struct CameraSample;
 struct PixelHit;
+struct SpectralCameras;
 
 // The plenoptic camera: a main lens, an optional microlens array, a sensor with its film, and the
 // sampling settings, each part holding its own data; everything precomputed once from checked
@@ -124,6 +126,11 @@ struct PlenopticCamera {
     Overlap overlap;
     Sensor sensor;
     Sampling sampling;
+    // Spectral sampling (`spectral N`, camera/spectral_bands.h): the bands and this camera at each
+    // band's wavelength, which traces that band's samples (camera/pixel.h); nullptr without it.
+    // This camera itself is the camera at the d line: chief rays, projection and the ground truth
+    // ask it.
+    std::shared_ptr<const SpectralCameras> spectral;
 
     // What the main lens says, 0 (or empty) without one: F (a real lens's effective focal
     // length), A (its diameter; a real lens's stop), the f-number (a real lens's: F / entrance-pupil
@@ -150,8 +157,22 @@ struct PlenopticCamera {
     bool receives_light(int i, int j) const;
 };
 
+// The cameras of spectral sampling.
+struct SpectralCameras {
+    std::vector<SpectralBand> bands;
+    std::vector<PlenopticCamera> cameras;  // cameras[b]: the camera at bands[b].wavelength_nm
+};
+
 // Builds the camera from parameters that passed check_camera. Pure: no image size, no state.
 PlenopticCamera make_camera(const CameraParams& params);
+
+// The same camera at a wavelength (nm): its main lens's glass and its microlenses' at their
+// indices there (MainLens::at_wavelength, MicrolensArray::at_wavelength), with the pupil bounds, the
+// lit-area table and the overlap bound that lens and array need; every position (D, d, the sensor),
+// the stop and the sampling as they are, since glass, not the camera's build, changes with the
+// wavelength. Without spectral cameras of its own. The camera itself (less them) when nothing in it
+// disperses.
+PlenopticCamera at_wavelength(const PlenopticCamera& camera, double wavelength_nm);
 
 // The same camera taking a picture of width x height pixels.
 PlenopticCamera with_film(PlenopticCamera model, int width, int height);

@@ -15,6 +15,13 @@ double two_term_index(double n_d, double abbe, double wavelength_nm)
     return n_d + (n_d - 1) / abbe * (523655.0 / (wavelength_nm * wavelength_nm) - 1.5168);
 }
 
+double two_term_power_ratio(double abbe, double wavelength_nm)
+{
+    if (abbe == 0)
+        return 1;
+    return 1 + (523655.0 / (wavelength_nm * wavelength_nm) - 1.5168) / abbe;
+}
+
 double sellmeier_index(const Glass& glass, double wavelength_nm)
 {
     const double l2 = (wavelength_nm * 1e-3) * (wavelength_nm * 1e-3);

@@ -48,6 +48,11 @@ struct Glass {
 // (to 2e-5 of it).
 double two_term_index(double n_d, double abbe, double wavelength_nm);
 
+// (n(lambda) - 1) / (n_d - 1) of the two-term model, 1 + (523655 / lambda^2 - 1.5168) / V_d: by
+// how much a thin element's power (which is proportional to n - 1) changes from the d line's; 1
+// for V_d = 0 (no dispersion). It does not depend on n_d.
+double two_term_power_ratio(double abbe, double wavelength_nm);
+
 // The Sellmeier formula n^2 = 1 + sum B_i lambda^2 / (lambda^2 - C_i), lambda in µm; NaN where
 // n^2 < 0.
 double sellmeier_index(const Glass& glass, double wavelength_nm);

@@ -25,6 +25,16 @@ bool inside_disc(double x, double y, double radius)
     return std::hypot(x, y) <= radius;
 }
 
+// The lens of a prescription at a wavelength (MainLens::at_wavelength): nullptr when no medium of it
+// disperses.
+std::shared_ptr<const MainLens> prescription_at(const Prescription& lens, double wavelength_nm, bool exact,
+                                                double image_distance_mm)
+{
+    if (!dispersive(lens))
+        return nullptr;
+    return make_prescription_lens(prescription_at_wavelength(lens, wavelength_nm), 0, exact, image_distance_mm);
+}
+
 // Whether the line from `origin` along `direction` passes through the origin, heading towards it
 // (to rounding).
 bool through_origin(Vec3 origin, Vec3 direction)
@@ -262,8 +272,8 @@ private:
 // inside the pupil.
 class ThickMainLens : public MainLens {
 public:
-    ThickMainLens(const Prescription& lens, const ParaxialData& p)
-        : lens_(lens), paraxial_(p), length_(p.rear_vertex_z), focal_(p.efl_mm),
+    ThickMainLens(const Prescription& lens, const ParaxialData& p, double image_distance_mm)
+        : lens_(lens), paraxial_(p), image_distance_mm_(image_distance_mm), length_(p.rear_vertex_z), focal_(p.efl_mm),
           front_h_(length_ - p.front_principal_z), rear_h_(length_ - p.rear_principal_z),
           pupil_z_(length_ - p.exit_pupil_z), radius_(0.5 * p.exit_pupil_mm) {}
     const char* kind_name() const override { return "thick_lens"; }
@@ -280,6 +290,11 @@ public:
     {
         add_prescription_metadata(section, lens_, paraxial_, placement);
     }
+    std::shared_ptr<const MainLens> at_wavelength(double wavelength_nm) const override
+    {
+        return prescription_at(lens_, wavelength_nm, false, image_distance_mm_);
+    }
+    double image_distance_mm() const { return image_distance_mm_; }
     bool front_window(FrontWindow* window) const override
     {
         *window = entrance_pupil();
@@ -343,6 +358,7 @@ public:
 private:
     Prescription lens_;
     ParaxialData paraxial_;
+    double image_distance_mm_;  // where the axial beam the pupils belong to converges (NaN: the stop's)
     double length_;  // front vertex at z = length_, rear vertex at 0
     double focal_, front_h_, rear_h_, pupil_z_, radius_;
 };
@@ -383,6 +399,10 @@ public:
     void add_metadata(MetadataJson& section, const LensPlacement& placement) const override
     {
         paraxial_.add_metadata(section, placement);  // the same surfaces and first-order data
+    }
+    std::shared_ptr<const MainLens> at_wavelength(double wavelength_nm) const override
+    {
+        return prescription_at(*prescription(), wavelength_nm, true, image_distance_mm_);
     }
     // The first surface: its vertex plane, clear radius and sag.
     bool front_window(FrontWindow* window) const override
@@ -454,7 +474,7 @@ std::shared_ptr<const MainLens> make_prescription_lens(const Prescription& lens,
     if (!p.valid)
         return nullptr;
     const double length = p.rear_vertex_z;  // front vertex at z_optics = length, rear at 0
-    const ThickMainLens thick(sized, p);
+    const ThickMainLens thick(sized, p, image_distance_mm);
     if (!exact)
         return std::make_shared<ThickMainLens>(thick);
     return std::make_shared<ExactMainLens>(sized, length, thick, image_distance_mm);

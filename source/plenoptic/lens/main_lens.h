@@ -145,6 +145,15 @@ public:
     // infinity is fine. A pinhole forms none: it returns the point itself with w = 1 (unused).
     virtual HomogeneousPoint paraxial_image(Vec3 point) const = 0;
 
+    // The same lens at a wavelength (nm): each dispersing medium at its index there (lens/glass.h),
+    // its stop, iris and placement unchanged (so the pupils are those of the same apertures). nullptr
+    // when the lens does not disperse: it is then the same lens at every wavelength.
+    virtual std::shared_ptr<const MainLens> at_wavelength(double wavelength_nm) const
+    {
+        (void)wavelength_nm;
+        return nullptr;
+    }
+
     // The kind's own members of the metadata's main_lens section (docs/metadata.md), added after
     // the members every lens writes (main_lens_metadata): a thin lens's distortion, a real lens's
     // prescription and paraxial data.

@@ -224,6 +224,8 @@ std::string metadata_json(const PlenopticCamera& m, const CameraParams& params, 
 
     json["sensor"] = m.sensor.metadata(reference_projected_solid_angle_sr(m), params.sensor.chain, files.raw);
     json["samples"] = m.sampling.metadata();
+    if (params.spectral.given())
+        json["spectral"] = spectral_metadata(params.spectral);  // only with `spectral`
     json["diffraction"] = diffraction_json(diffraction_of(m, params.diffraction), params.diffraction, m);
 
     const Vec2 principal = m.sensor.principal_point_px();
