@@ -11,6 +11,7 @@ import time
 from . import __doc__ as USAGE
 from .build import section_build
 from .dark import section_dark
+from .spectral import section_spectral
 from .dataset import section_dataset
 from .fullsize import section_fullsize
 from .lenses import section_lenses
@@ -49,7 +50,7 @@ def main():
         return 2
     runs = 1 if args.quick else args.runs
     sections = args.only or ["overhead", "lenses", "trade", "dark", "threads", "fullsize", "real_lens",
-                             "fullsize_real_lens", "realism", "dataset"]
+                             "fullsize_real_lens", "realism", "spectral", "dataset"]
     os.makedirs(args.out, exist_ok=True)
     work = tempfile.mkdtemp(prefix="plenoptic-bench-")
     b = Bench(os.path.abspath(args.povray), work, runs)
@@ -128,6 +129,12 @@ def main():
             section_realism(b, (64, 48) if args.quick else (1440, 960), runs, 24 if args.quick else 96, results)
             save()
             done("realism")
+        if "spectral" in sections:
+            section_spectral(b, (64, 48) if args.quick else (480, 320), 1 if args.quick else max(runs, 5),
+                             (48, 36) if args.quick else (240, 160), 256 if args.quick else 512,
+                             (64, 48) if args.quick else (966, 671), 32 if args.quick else 128, results)
+            save()
+            done("spectral")
         if "dataset" in sections:
             section_dataset(b, args.quick, runs, results)
             save()

@@ -61,6 +61,44 @@ def realism_report(L, results):
     L.append("")
 
 
+def spectral_report(L, results):
+    """Section spectral: its cost at equal samples, the samples for equal noise, a Lytro-class crop."""
+    r = results["spectral"]
+    L.append("## Spectral sampling (`--only spectral`)\n")
+    L.append("`spectral N` (docs/spectral.md) on the benchmark scene through a made-up 53 mm triplet whose glass"
+             " disperses (V_d 58, 30, 58) at f/5.6, with a plenoptic 1.0 array of dispersing microlenses (hexagonal,"
+             " 0.1 mm pitch, f = d = 0.56 mm, V_d 58), 10 um pixels, %dx%d, %d interleaved runs, POV-Ray's trace"
+             " time; CPU time is the whole process's (it includes the set-up of one camera per band).\n"
+             % (r["size"][0], r["size"][1], r["runs"]))
+    L.append("| variant | trace, s (median) | ratio | CPU, s | CPU ratio | peak RSS, MiB |\n|---|---|---|---|---|---|")
+    for row in r["rows"]:
+        L.append("| %s | %.2f | %.3fx | %.2f | %.3fx | %.0f |" % (row["variant"], row["median_trace_s"], row["ratio"],
+                                                               row["cpu_s"], row["cpu_ratio"], row["peak_rss_mib"]))
+    cg = r.get("callgrind")
+    if cg:
+        L.append("\nInstructions of the whole process (callgrind, one thread, %dx%d):\n" % (cg["size"], cg["size"]))
+        L.append("| variant | instructions | ratio |\n|---|---|---|")
+        for row in cg["rows"]:
+            L.append("| %s | %.4g | %.3fx |" % (row["variant"], row["total_ir"], row["total_ratio"]))
+    n = r["noise"]
+    L.append("\n**Noise against samples** (%dx%d): the RMSE of each render against a reference of %d samples of"
+             " its own kind (the dispersing lens's spectral picture is not the d line's):\n"
+             % (n["size"][0], n["size"][1], n["reference_samples"]))
+    L.append("| render | samples | RMSE |\n|---|---|---|")
+    for row in n["rows"]:
+        L.append("| %s | %d | %.5f |" % (row["variant"], row["samples"], row["rmse"]))
+    needed = n["spectral_samples_for_plain_16_noise"]
+    L.append("\nSamples `spectral 8` needs for the noise of 16 samples without it (log-log interpolation): %s.\n"
+             % ("%.0f" % needed if needed else "beyond the counts measured"))
+    c = r["lytro_crop"]
+    L.append("**Lytro-class crop through the dispersing lens** (%dx%d pixels of 1.4 um, hexagonal 20 um microlenses,"
+             " f/5.6 matched, 16 samples, one run each, the whole process):\n" % (c["size"][0], c["size"][1]))
+    L.append("| variant | wall, s | CPU, s | peak RSS, MiB |\n|---|---|---|---|")
+    for row in c["rows"]:
+        L.append("| %s | %.1f | %.1f | %.0f |" % (row["variant"], row["wall_s"], row["cpu_s"], row["peak_rss_mib"]))
+    L.append("")
+
+
 def real_lens_report(L, results):
     """Section real_lens (and fullsize_real_lens): pass fractions, cost against the thin and thick lens."""
     L.append("## Real main lens (`--only real_lens`, `--only fullsize_real_lens`)\n")
@@ -310,6 +348,8 @@ def write_report(results, path, plots, results_path):
         real_lens_report(L, results)
     if results.get("realism"):
         realism_report(L, results)
+    if results.get("spectral"):
+        spectral_report(L, results)
     if results.get("dataset"):
         dataset_report(L, results)
     analysis = os.path.join(ROOT, "benchmarks", "analysis.md")

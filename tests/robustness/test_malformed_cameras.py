@@ -243,6 +243,23 @@ CASES = [
      ["resolution", "sensor keyword", "allowed"], "unknown keywords are errors, never ignored"),
     ("sensor unterminated", camera(sensor=sensor_with("pixel_size 0.01", close=""), extra="  samples 2  " + MARK),
      ["samples", "sensor keyword"], "a missing brace is noticed at the next keyword"),
+    # ---- spectral sampling (docs/spectral.md)
+    ("spectral zero bands", camera(extra=SAMPLES + "\n  spectral 0 " + MARK),
+     ["spectral", "whole number", "1 to 64", "got 0"], "at least one band"),
+    ("spectral fractional bands", camera(extra=SAMPLES + "\n  spectral 2.5 " + MARK),
+     ["spectral", "whole number", "2.5"], "bands are counted"),
+    ("spectral too many bands", camera(extra=SAMPLES + "\n  spectral 65 " + MARK),
+     ["spectral", "1 to 64", "65"], "at most 64 bands"),
+    ("spectral response width too narrow", camera(extra=SAMPLES + "\n  spectral 8 response_widths <90, 0.5, 90> " + MARK),
+     ["spectral response_widths", "1 to 1000", "0.5"], "a Gaussian of a fraction of a nanometre is no colour filter"),
+    ("spectral response centre out of range", camera(extra=SAMPLES + "\n  spectral 8 response_centres <610, 50, 465> " + MARK),
+     ["spectral response_centres", "100 to 20000", "got 50"], "a wavelength in nm"),
+    ("spectral response far from the visible", camera(extra=SAMPLES + "\n  spectral 8 response_centres <610, 550, 5000> "
+                                                             "response_widths <90, 90, 20>", close=CAMERA_BRACE),
+     ["b channel responds to no wavelength", "380", "720"], "a channel that sees none of the traced light cannot be weighed"),
+    ("spectral response_file missing", camera(extra=SAMPLES + '\n  spectral 8 response_file "no_such_response.csv" ' + MARK),
+     ["response_file", "no_such_response.csv", "not found"], "the table must exist"),
+
     # ---- camera level: sampling, scale, unknown keywords, rules across blocks
     ("samples 0", camera(extra="  samples 0  " + MARK),
      ["samples", "whole number", "got 0"], "at least one ray per pixel"),
