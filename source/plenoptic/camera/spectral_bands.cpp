@@ -40,6 +40,19 @@ double channel_wavelength_nm(const std::vector<SpectralBand>& bands, int channel
     return weight > 0 ? sum / weight : 0;
 }
 
+void channel_wavelengths_nm(const SpectralParams& params, double out[3])
+{
+    if (params.given()) {
+        const std::vector<SpectralBand> bands = spectral_bands(params);
+        for (int c = 0; c < 3; ++c)
+            out[c] = channel_wavelength_nm(bands, c);
+        return;
+    }
+    const SpectralResponse response;
+    for (int c = 0; c < 3; ++c)
+        out[c] = response.centroid_nm(c);
+}
+
 MetadataJson spectral_metadata(const SpectralParams& params)
 {
     const std::vector<SpectralBand> bands = spectral_bands(params);

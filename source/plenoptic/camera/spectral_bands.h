@@ -41,6 +41,12 @@ std::vector<SpectralBand> spectral_bands(const SpectralParams& params);
 // channel's weights (where its ground truth per channel is computed).
 double channel_wavelength_nm(const std::vector<SpectralBand>& bands, int channel);
 
+// The wavelengths at which ground truth per channel is computed (R, G, B): with spectral sampling
+// channel_wavelength_nm of its bands (where the render's light of that channel comes from); without
+// it, the centroids of the default response's curves (SpectralResponse::centroid_nm), the limit of
+// many bands. The one place that says which wavelength a channel is.
+void channel_wavelengths_nm(const SpectralParams& params, double out[3]);
+
 // The metadata's spectral section: bands, their wavelengths, the channels' weights and
 // wavelengths, the response.
 MetadataJson spectral_metadata(const SpectralParams& params);

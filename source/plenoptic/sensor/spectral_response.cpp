@@ -80,6 +80,17 @@ double SpectralResponse::mean(int channel, double from_nm, double to_nm) const
     return sum / steps;
 }
 
+double SpectralResponse::centroid_nm(int channel) const
+{
+    double sum = 0, weight = 0;
+    for (double nm = kSpectralMinNm + 0.125; nm < kSpectralMaxNm; nm += 0.25) {
+        const double w = at(channel, nm);
+        sum += w * nm;
+        weight += w;
+    }
+    return weight > 0 ? sum / weight : 0;
+}
+
 MetadataJson SpectralResponse::metadata() const
 {
     MetadataJson json = MetadataJson::object();

@@ -49,6 +49,9 @@ struct SpectralResponse {
     // Its mean over [from_nm, to_nm] (midpoint rule on 0.25 nm steps, exact to far below the
     // weights' use for smooth curves; a table's kinks cost at most one step's error).
     double mean(int channel, double from_nm, double to_nm) const;
+    // The mean wavelength of channel c's curve over kSpectralMinNm..kSpectralMaxNm, weighed by the
+    // curve (0.25 nm steps).
+    double centroid_nm(int channel) const;
     // The metadata's description of the curves.
     MetadataJson metadata() const;
 };

@@ -87,8 +87,10 @@ ChiefRay ray_for(bool at_infinity, Vec3 object_or_direction, double pupil_z, dou
 
 } // namespace
 
-DistortionProfile distortion_profile(const PlenopticCamera& m, int count)
+DistortionProfile distortion_profile(const PlenopticCamera& m, int count, const PlenopticCamera* through)
 {
+    // The object points are the camera's own; their chief rays are traced through `through`.
+    const PlenopticCamera& t_camera = through ? *through : m;
     const int W = m.sensor.film.width, H = m.sensor.film.height;
     DistortionProfile out = DistortionProfile();
     out.valid = false;
@@ -130,7 +132,7 @@ DistortionProfile distortion_profile(const PlenopticCamera& m, int count)
         largest = std::max(largest, std::hypot(s.x, s.y));
     }
 
-    const StopAim stop(m);
+    const StopAim stop(t_camera);
     for (int i = 0; i < count; ++i) {
         const double relative = double(i) / (count - 1);
         const double h = relative * largest;
@@ -163,7 +165,7 @@ DistortionProfile distortion_profile(const PlenopticCamera& m, int count)
             t = t0;
         }
         const ChiefRay chief = ray_for(out.object_at_infinity, object, pupil_z, start_z, t);
-        const ImageRay image = m.lens->to_image(chief.origin, chief.direction, false);
+        const ImageRay image = t_camera.lens->to_image(chief.origin, chief.direction, false);
         if (!image.passed || !(image.dir.z < 0))
             break;
         const double along = (out.image_plane_z_mm - image.origin.z) / image.dir.z;

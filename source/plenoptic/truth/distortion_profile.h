@@ -37,7 +37,11 @@ struct DistortionProfile {
 // lens's parametric distortion is part of its trace. The samples stop at the first height whose
 // chief ray does not exist (no ray through the stop's centre, or none reaching the image side).
 // A lens that images z = -D from no real object (D inside the focal length) has no profile.
-DistortionProfile distortion_profile(const PlenopticCamera& model, int count);
+// With `through` (the same camera at another wavelength: at_wavelength), the object points are
+// still this camera's (its paraxial heights and field), and their chief rays are found and traced
+// through `through`'s lens: the heights at which that wavelength's chief rays meet the image plane,
+// against the d line's paraxial heights (lateral colour is the difference between wavelengths).
+DistortionProfile distortion_profile(const PlenopticCamera& model, int count, const PlenopticCamera* through = nullptr);
 
 } // namespace plenoptic
 

@@ -114,6 +114,59 @@ TEST(DistortionProfile, StopPositionGivesTheSignOfASinglesDistortion)
     EXPECT_NEAR(small / large, 1.0 / 64, 0.3 / 64);
 }
 
+// The two-term index (lens/glass.h's model, written here) of n_d 1.5, V_d 20.
+double index_at_nm(double nm) { return 1.5 + 0.5 / 20 * (523655.0 / (nm * nm) - 1.5168); }
+
+TEST(DistortionProfile, ChannelsOfADispersingSingletFollowTheParaxialChiefRayAtTheirIndex)
+{
+    // The singlet with the stop 20 mm in front, its glass dispersing (V_d 20). Traced at another
+    // wavelength, the same object points' chief rays (through the stop's centre, same field
+    // angle) meet the d line's image plane at heights that a paraxial y-u trace at that index
+    // gives for small fields. Written here: from the stop (y = 0) at slope u = tan(angle), over the
+    // gap, refraction n u' = u - y (n - 1) / R1, the thickness, u'' = n u' - y (1 - n) / R2, then D
+    // to the image plane.
+    Prescription lens = singlet_with_stop(20);
+    lens.surfaces[1].glass.abbe = 20;
+    CameraParams p = thin_lens_camera(50, 4, 0);
+    p.main.type = MainLensType::Prescription;
+    p.main.has_focal_length = false;
+    p.main.has_f_number = false;
+    p.main.has_prescription = true;
+    p.main.prescription = lens;
+    p.main.distance_mm = paraxial_image_distance(lens, 2000).mm;
+    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.02;
+    const PlenopticCamera d_line = with_film(make_camera(p), 1500, 1000);
+    const double D = d_line.distance_mm;
+    const DistortionProfile own = distortion_profile(d_line, 33);
+    ASSERT_TRUE(own.valid);
+    double lateral[2] = {0, 0};
+    int which = 0;
+    for (double nm : {450.0, 650.0}) {
+        const PlenopticCamera at = at_wavelength(d_line, nm);
+        const DistortionProfile profile = distortion_profile(d_line, 33, &at);
+        ASSERT_TRUE(profile.valid);
+        ASSERT_EQ(profile.samples.size(), own.samples.size());
+        const double n = index_at_nm(nm);
+        for (int i : {1, 2}) {  // small fields: third-order terms below 1e-3 of the height
+            const DistortionSample& s = profile.samples[size_t(i)];
+            EXPECT_EQ(s.paraxial_height_mm, own.samples[size_t(i)].paraxial_height_mm);
+            EXPECT_NEAR(s.field_angle_deg, own.samples[size_t(i)].field_angle_deg, 1e-9) << "the same object point";
+            const double u0 = std::tan(s.field_angle_deg * kPi / 180);
+            const double y1 = 20 * u0;
+            const double u1 = (u0 - y1 * (n - 1) / 100) / n;
+            const double y2 = y1 + 5 * u1;
+            const double u2 = n * u1 - y2 * (1 - n) / -100;
+            const double y3 = y2 + D * u2;
+            EXPECT_NEAR(s.real_height_mm, std::fabs(y3), 2e-3 * std::fabs(y3)) << nm << " nm, row " << i;
+        }
+        lateral[which++] = profile.samples[2].real_height_mm;
+    }
+    // Lateral colour: blue refracted more; with the stop in front it lands nearer the axis here.
+    EXPECT_NE(lateral[0], lateral[1]);
+    EXPECT_LT(lateral[0], own.samples[2].real_height_mm);
+    EXPECT_GT(lateral[1], own.samples[2].real_height_mm);
+}
+
 TEST(DistortionProfile, NoneWithoutARealObjectOrALens)
 {
     CameraParams inside = thin_lens_camera(50, 4, 40);  // D < F: no real object images onto z = -D

@@ -65,9 +65,38 @@ void layout(const Json& value, int depth, bool one_line, std::string* out)
     *out += object ? '}' : ']';
 }
 
+Json profile_rows(const DistortionProfile& profile)
+{
+    Json samples = Json::array();
+    for (const DistortionSample& s : profile.samples) {
+        const double percent = s.paraxial_height_mm > 0 ? 100 * (s.real_height_mm / s.paraxial_height_mm - 1) : NAN;
+        samples.push_back(Json::array({json_number(s.relative_field), json_number(s.field_angle_deg), json_number(s.paraxial_height_mm),
+                                       json_number(s.real_height_mm), json_number(percent)}));
+    }
+    return samples;
+}
+
+// A dispersing lens's profile per colour channel: the same object points' chief rays traced at
+// each channel's wavelength (channel_wavelengths_nm), against the d line's paraxial heights; null
+// rows for a channel whose profile does not exist.
+Json channel_profiles_json(const PlenopticCamera& m, const CameraParams& params)
+{
+    double nm[3];
+    channel_wavelengths_nm(params.spectral, nm);
+    const char* names[3] = {"r", "g", "b"};
+    Json json = Json::object();
+    json["wavelengths_nm"] = json_numbers(nm, 3);
+    for (int c = 0; c < 3; ++c) {
+        const PlenopticCamera at = at_wavelength(m, nm[c]);
+        const DistortionProfile profile = distortion_profile(m, kDistortionProfileSamples, &at);
+        json[names[c]] = profile.valid ? profile_rows(profile) : Json(nullptr);
+    }
+    return json;
+}
+
 // The chief ray's image height over the field against the paraxial one (null when the lens has
-// no profile).
-Json distortion_profile_json(const PlenopticCamera& m)
+// no profile); a dispersing lens's adds "channels".
+Json distortion_profile_json(const PlenopticCamera& m, const CameraParams& params)
 {
     const DistortionProfile profile = distortion_profile(m, kDistortionProfileSamples);
     if (!profile.valid)
@@ -77,23 +106,19 @@ Json distortion_profile_json(const PlenopticCamera& m)
     json["image_plane_z_mm"] = json_number(profile.image_plane_z_mm);
     json["chief_ray"] = m.lens->chief_ray_description();
     json["columns"] = Json::array({"relative_field", "field_angle_deg", "paraxial_height_mm", "real_height_mm", "distortion_percent"});
-    Json samples = Json::array();
-    for (const DistortionSample& s : profile.samples) {
-        const double percent = s.paraxial_height_mm > 0 ? 100 * (s.real_height_mm / s.paraxial_height_mm - 1) : NAN;
-        samples.push_back(Json::array({json_number(s.relative_field), json_number(s.field_angle_deg), json_number(s.paraxial_height_mm),
-                                       json_number(s.real_height_mm), json_number(percent)}));
-    }
-    json["samples"] = samples;
+    json["samples"] = profile_rows(profile);
+    if (m.lens->prescription() && dispersive(*m.lens->prescription()))
+        json["channels"] = channel_profiles_json(m, params);
     return json;
 }
 
 // The main lens's section as the lens writes it, held where this camera holds it, and the
 // distortion profile measured through the camera.
-Json main_lens(const PlenopticCamera& m)
+Json main_lens(const PlenopticCamera& m, const CameraParams& params)
 {
     Json json = main_lens_metadata(m.lens.get(), LensPlacement{m.distance_mm, m.has_focus_distance,
                                                                m.focus_distance_units, m.lens_file()});
-    json["distortion_profile"] = distortion_profile_json(m);
+    json["distortion_profile"] = distortion_profile_json(m, params);
     return json;
 }
 
@@ -145,6 +170,11 @@ Json microimages_json(const MicroimageSummary* summary)
     Json json = Json::object();
     json["file"] = summary->file;
     json["columns"] = Json::array({"k", "l", "u", "v", "lit_fraction", "residual_u", "residual_v"});
+    if (summary->per_channel) {
+        for (const char* column : {"u_r", "v_r", "u_g", "v_g", "u_b", "v_b"})
+            json["columns"].push_back(column);
+        json["channel_wavelengths_nm"] = json_numbers(summary->channel_wavelengths_nm, 3);
+    }
     json["lenses"] = summary->lenses;
     json["lit_lenses"] = summary->lit_lenses;
     Json integration = Json::object();
@@ -218,7 +248,7 @@ std::string metadata_json(const PlenopticCamera& m, const CameraParams& params, 
     camera_frame["direction"] = json_numbers(frame.direction);
     json["camera_frame"] = camera_frame;
 
-    json["main_lens"] = main_lens(m);
+    json["main_lens"] = main_lens(m, params);
     json["microlens_array"] =
         m.array.present() ? m.array.metadata(params.array.rotate_deg, params.array.translate_mm) : Json(nullptr);
 

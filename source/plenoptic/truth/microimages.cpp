@@ -252,8 +252,11 @@ MicroimageOptions default_microimage_options()
 }
 
 std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const MicroimageOptions& options,
-                                              const MicroimageProgress& progress, const MicroimageCancel& cancelled)
+                                              const MicroimageProgress& progress, const MicroimageCancel& cancelled,
+                                              const PlenopticCamera* through)
 {
+    // The lenses and their start points are this camera's; their light is traced through `through`.
+    const PlenopticCamera& light = through ? *through : m;
     const int W = m.sensor.film.width, H = m.sensor.film.height;
     std::vector<MicroimageTruth> out;
     if (m.array.grid == GridType::None || !m.lens || W <= 0 || H <= 0)
@@ -292,10 +295,10 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         for (int j = 0; j < n; ++j) {
             for (int i = 0; i < n; ++i) {
                 const double lens_u = thin ? (i + 0.5) / n : 0.5, lens_v = thin ? (j + 0.5) / n : 0.5;
-                const Guess guess = guess_region(m, truth.lens, lens_u, lens_v, centres[index]);
+                const Guess guess = guess_region(light, truth.lens, lens_u, lens_v, centres[index]);
                 if (!guess.possible)
                     continue;
-                const LensProbe probe(m, truth.lens, lens_u, lens_v);
+                const LensProbe probe(light, truth.lens, lens_u, lens_v);
                 // A start point anywhere in the disc is at most its diameter from the boundary.
                 const double search = guess.radius_px + 1, reach = 2.1 * guess.radius_px + 1;
                 const Moments region = region_moments(probe, guess.u, guess.v, search, reach, options);
@@ -457,10 +460,14 @@ std::string shortest(double value)
 
 } // namespace
 
-std::string microimages_csv(const PlenopticCamera& m, const std::vector<MicroimageTruth>& truth, const LatticeFit& fit)
+std::string microimages_csv(const PlenopticCamera& m, const std::vector<MicroimageTruth>& truth, const LatticeFit& fit,
+                            const std::vector<std::vector<MicroimageTruth>>& channels)
 {
-    std::string out = "k,l,u,v,lit_fraction,residual_u,residual_v\n";
-    for (const MicroimageTruth& t : truth) {
+    const bool per_channel = channels.size() == 3;
+    std::string out = "k,l,u,v,lit_fraction,residual_u,residual_v";
+    out += per_channel ? ",u_r,v_r,u_g,v_g,u_b,v_b\n" : "\n";
+    for (std::size_t index = 0; index < truth.size(); ++index) {
+        const MicroimageTruth& t = truth[index];
         out += std::to_string(static_cast<long long>(t.lens.k)) + "," + std::to_string(static_cast<long long>(t.lens.l));
         if (t.lit) {
             out += "," + shortest(t.u_px) + "," + shortest(t.v_px) + "," + shortest(t.lit_fraction);
@@ -472,6 +479,10 @@ std::string microimages_csv(const PlenopticCamera& m, const std::vector<Microima
             }
         } else {
             out += ",,," + shortest(t.lit_fraction) + ",,";
+        }
+        for (std::size_t c = 0; per_channel && c < 3; ++c) {
+            const MicroimageTruth& ct = channels[c][index];
+            out += ct.lit ? "," + shortest(ct.u_px) + "," + shortest(ct.v_px) : ",,";
         }
         out += "\n";
     }

@@ -64,9 +64,13 @@ MicroimageOptions default_microimage_options();
 // lattice centre, or the centroid of a coarse search when that point is dark): the region
 // between that point and the first boundary crossing along each direction. Needs a main lens and
 // an array (empty otherwise). Deterministic.
+// With `through` (the same camera at another wavelength: at_wavelength), the lenses and their
+// start points are still this camera's, and the light is traced through `through`: the same lenses
+// in the same order, their microimages at that wavelength.
 std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& model, const MicroimageOptions& options,
                                               const MicroimageProgress& progress = MicroimageProgress(),
-                                              const MicroimageCancel& cancelled = MicroimageCancel());
+                                              const MicroimageCancel& cancelled = MicroimageCancel(),
+                                              const PlenopticCamera* through = nullptr);
 
 // Least-squares lattice through the lit centres: (u, v) = origin + k_s a + l b in skew indices,
 // as the metadata's microimage_lattice, and how far the centres lie from it.
@@ -94,6 +98,10 @@ struct MicroimageSummary {
     LatticeFit fit;
     // How far the lit centres lie from the metadata's microimage_lattice (the paraxial lattice).
     double from_lattice_rms_px, from_lattice_max_px;
+    // With spectral sampling, the centres per channel (u_r, v_r, u_g, v_g, u_b, v_b columns) at
+    // these wavelengths (channel_wavelengths_nm); 0: none.
+    bool per_channel = false;
+    double channel_wavelengths_nm[3] = {0, 0, 0};
 };
 
 MicroimageSummary summarise_microimages(const PlenopticCamera& model, const std::vector<MicroimageTruth>& truth,
@@ -101,9 +109,13 @@ MicroimageSummary summarise_microimages(const PlenopticCamera& model, const std:
 
 // The CSV text: a header line "k,l,u,v,lit_fraction,residual_u,residual_v", then one line per
 // lens (row-form indices, centre-convention pixels, the residuals from the fit); u, v and the
-// residuals are empty for a dark lens, the residuals also when the fit is not valid. Numbers in
-// the shortest form that reads back to the same double.
-std::string microimages_csv(const PlenopticCamera& model, const std::vector<MicroimageTruth>& truth, const LatticeFit& fit);
+// residuals are empty for a dark lens, the residuals also when the fit is not valid. With three
+// `channels` (the same lenses measured at the R, G and B wavelengths), six more columns,
+// u_r,v_r,u_g,v_g,u_b,v_b, empty where that channel's microimage is dark. Numbers in the shortest
+// form that reads back to the same double.
+std::string microimages_csv(const PlenopticCamera& model, const std::vector<MicroimageTruth>& truth, const LatticeFit& fit,
+                            const std::vector<std::vector<MicroimageTruth>>& channels =
+                                std::vector<std::vector<MicroimageTruth>>());
 
 } // namespace plenoptic
 

@@ -238,6 +238,66 @@ TEST(MicroimageTruth, CancellingStopsAtTheNextLensAndReturnsNothing)
     EXPECT_LT(reports, 50u);
 }
 
+// Per channel: the same lenses in the same order; through a lens that does not disperse the
+// centres at any wavelength are the d line's exactly, through one that does they move, and by the
+// camera at that wavelength's own measure (the truth of a camera made at that wavelength).
+TEST(MicroimageTruth, ChannelsAreTheSameLensesMeasuredAtTheirWavelength)
+{
+    Prescription lens = vignetting_triplet();
+    const ImageDistance focus = paraxial_image_distance(lens, 3000);
+    CameraParams params = plenoptic_camera(GridType::Rectangular, 2.5, 0, 8.5, 50, 4, focus.mm);
+    params.main.type = MainLensType::Prescription;
+    params.main.has_focal_length = false;
+    params.main.has_f_number = false;
+    params.main.has_prescription = true;
+    params.main.prescription = lens;
+    params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.5;
+    const int W = 80, H = 80;
+    const PlenopticCamera plain = with_film(make_camera(params), W, H);
+    const PlenopticCamera plain_blue = at_wavelength(plain, 450);
+    const std::vector<MicroimageTruth> a = microimage_truth(plain, default_microimage_options());
+    const std::vector<MicroimageTruth> b = microimage_truth(plain, default_microimage_options(), MicroimageProgress(),
+                                                            MicroimageCancel(), &plain_blue);
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(a[i].u_px, b[i].u_px);
+        EXPECT_EQ(a[i].v_px, b[i].v_px);
+    }
+
+    for (LensSurface& s : params.main.prescription.surfaces)
+        if (s.ior > 1)
+            s.glass.abbe = 25;
+    const PlenopticCamera glass = with_film(make_camera(params), W, H);
+    const PlenopticCamera blue = at_wavelength(glass, 450);
+    const std::vector<MicroimageTruth> d = microimage_truth(glass, default_microimage_options());
+    const std::vector<MicroimageTruth> e = microimage_truth(glass, default_microimage_options(), MicroimageProgress(),
+                                                            MicroimageCancel(), &blue);
+    ASSERT_EQ(d.size(), e.size());
+    double largest = 0;
+    int lit = 0;
+    for (size_t i = 0; i < d.size(); ++i) {
+        EXPECT_EQ(d[i].lens.k, e[i].lens.k);
+        EXPECT_EQ(d[i].lens.l, e[i].lens.l);
+        if (d[i].lit && e[i].lit) {
+            largest = std::max(largest, std::hypot(d[i].u_px - e[i].u_px, d[i].v_px - e[i].v_px));
+            ++lit;
+        }
+    }
+    EXPECT_GT(lit, 4);
+    EXPECT_GT(largest, 1e-3) << "the glass moves the microimages at 450 nm";
+    // The blue camera's own truth of the lenses it shares with the d line's list agrees.
+    const std::vector<MicroimageTruth> own = microimage_truth(blue, default_microimage_options());
+    int matched = 0;
+    for (const MicroimageTruth& o : own)
+        for (const MicroimageTruth& t : e)
+            if (o.lens.k == t.lens.k && o.lens.l == t.lens.l && o.lit && t.lit) {
+                EXPECT_NEAR(o.u_px, t.u_px, 1e-6);
+                EXPECT_NEAR(o.v_px, t.v_px, 1e-6);
+                ++matched;
+            }
+    EXPECT_GT(matched, 4);
+}
+
 TEST(MicroimageTruth, NothingWithoutAnArrayOrAMainLens)
 {
     const PlenopticCamera no_array = with_film(make_camera(test::thin_lens_camera(50, 4, 52)), 100, 100);

@@ -33,7 +33,22 @@ public:
             return true;
         }
         MicroimageSummary summary = summarise_microimages(model, truth, options, base_name(path));
-        if (!write_file_atomically("microimage centres", path, microimages_csv(model, truth, summary.fit)))
+        // With spectral sampling, the same lenses at each channel's wavelength.
+        std::vector<std::vector<MicroimageTruth>> channels;
+        if (model.spectral) {
+            summary.per_channel = true;
+            channel_wavelengths_nm(model.spec.spectral, summary.channel_wavelengths_nm);
+            for (int c = 0; c < 3 && !image.cancelled(); ++c) {
+                const PlenopticCamera at = at_wavelength(model, summary.channel_wavelengths_nm[c]);
+                channels.push_back(microimage_truth(model, options, progress, image.cancelled, &at));
+            }
+            if (image.cancelled()) {
+                std::fprintf(stderr, "plenoptic camera: cancelled: no microimage centres written (%s); the metadata "
+                                     "says \"microimages\": null.\n", path.c_str());
+                return true;
+            }
+        }
+        if (!write_file_atomically("microimage centres", path, microimages_csv(model, truth, summary.fit, channels)))
             return false;
         summary_.reset(new MicroimageSummary(summary));
         files.microimages = summary_.get();
