@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: AGPL-3.0-or-later
-"""Where the programs beside this package are: the plenoptic renderer and plenoptic-project, in
-this source tree's build/, in the prefix the package is installed in, or on PATH."""
+"""Where the programs beside this package are: the plenoptic renderer, plenoptic-project and
+plenoptic-lens-data, in this source tree's build/, in the prefix the package is installed in, or
+on PATH."""
 
 import os
 import shutil
@@ -39,3 +40,12 @@ def find_project(given=None):
     return find_program("plenoptic-project", given,
                         [os.path.join(REPOSITORY, "build", "plenoptic-project"), os.path.join(PREFIX, "bin", "plenoptic-project")],
                         "--project")
+
+
+def find_lens_data(given=None):
+    """plenoptic-lens-data, the optics core's answers about a lens file (plenoptic-lens's optics),
+    built beside the renderer."""
+    return find_program("plenoptic-lens-data", given or os.environ.get("PLENOPTIC_LENS_DATA"),
+                        [os.path.join(REPOSITORY, "build", "plenoptic-lens-data"),
+                         os.path.join(PREFIX, "bin", "plenoptic-lens-data")],
+                        "--lens-data")
