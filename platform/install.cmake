@@ -10,13 +10,15 @@
 #   P/bin/plenoptic-decode                       the decoder's launcher (source/tools/python_tools.cmake)
 #   P/bin/plenoptic-targets                      calibration targets with ground truth (the same)
 #   P/bin/plenoptic-dataset                      data sets, here or on Slurm (the same)
+#   P/bin/plenoptic-lens                         lens import, info and drawing (the same)
+#   P/bin/plenoptic-lens-data                    a lens file's optics as JSON, for plenoptic-lens (source/tools/)
 #   P/lib/python3/dist-packages/plenoptic_lf/    the Python tools' package (python/plenoptic_lf/)
 #   P/share/povray-plenoptic/include/, ini/      POV-Ray's own include and ini files
 #   P/share/povray-plenoptic/scenes/             the repository's scenes/
 #   P/share/povray-plenoptic/lenses/             the repository's lenses/ (main-lens prescriptions)
 #   P/share/povray-plenoptic/docs/               docs/*.md, docs/metadata.schema.json, README.md, LICENSE
 #   P/share/man/man1/*.1                         povray-plenoptic, plenoptic-project, plenoptic-decode, plenoptic-targets,
-#                                                plenoptic-dataset
+#                                                plenoptic-dataset, plenoptic-lens
 #   P/share/doc/povray-plenoptic/copyright       the licence (Debian's place for it)
 #   P/etc/povray-plenoptic/povray.ini, .conf     /etc/povray-plenoptic when P is /usr (GNU rule)
 
@@ -47,6 +49,7 @@ install(FILES "${CMAKE_SOURCE_DIR}/platform/man/povray-plenoptic.1"
               "${CMAKE_SOURCE_DIR}/platform/man/plenoptic-decode.1"
               "${CMAKE_SOURCE_DIR}/platform/man/plenoptic-targets.1"
               "${CMAKE_SOURCE_DIR}/platform/man/plenoptic-dataset.1"
+              "${CMAKE_SOURCE_DIR}/platform/man/plenoptic-lens.1"
         DESTINATION share/man/man1)
 
 # Configuration: the build tree's povray.ini and povray.conf (no path in them names a prefix).

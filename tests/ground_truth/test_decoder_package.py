@@ -36,7 +36,7 @@ DISTRIBUTIONS = {"numpy": "numpy", "scipy": "scipy", "PIL": "Pillow", "OpenImage
                  "jsonschema": "jsonschema"}
 # The table of tools (python/pyproject.toml).
 SCRIPTS = {"plenoptic-decode": "plenoptic_lf.cli:main", "plenoptic-dataset": "plenoptic_lf.dataset.cli:main",
-           "plenoptic-targets": "plenoptic_lf.targets:main"}
+           "plenoptic-targets": "plenoptic_lf.targets:main", "plenoptic-lens": "plenoptic_lf.lens_tool:main"}
 SOURCE_TREE_SCRIPTS = {"bench": "plenoptic_bench.cli:main", "report2018-figures": "plenoptic_report2018.figures:main"}
 # A python3 that lacks numpy (site-packages off), first on PATH.
 NO_NUMPY_PYTHON = '#!/bin/sh\n# Written by tests/ground_truth/test_decoder_package.py: a python3 without numpy.\n' \

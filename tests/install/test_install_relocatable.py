@@ -14,11 +14,13 @@
    file added to the moved include/ both reach a scene, and povray.conf is looked for there.
    The current directory and /tmp are writable, $HOME readable.
 5. plenoptic-project and plenoptic-decode from the moved prefix: the projection prints what
-   the build tree's plenoptic-project prints, the decoder writes its contact sheet.
+   the build tree's plenoptic-project prints, the decoder writes its contact sheet; plenoptic-lens
+   info of an installed lens runs the moved plenoptic-lens-data.
 
 One pytest test (ctest install_relocatable); the first step that fails ends it with its message.
 
 """
+import json
 import os
 import shutil
 import subprocess
@@ -34,6 +36,8 @@ LAYOUT = [
     "bin/plenoptic-decode",
     "bin/plenoptic-targets",
     "bin/plenoptic-dataset",
+    "bin/plenoptic-lens",
+    "bin/plenoptic-lens-data",
     "lib/python3/dist-packages/plenoptic_lf/dataset/cli.py",
     "lib/python3/dist-packages/plenoptic_lf/__init__.py",
     "lib/python3/dist-packages/plenoptic_lf/cli.py",
@@ -49,6 +53,7 @@ LAYOUT = [
     "share/man/man1/plenoptic-decode.1",
     "share/man/man1/plenoptic-targets.1",
     "share/man/man1/plenoptic-dataset.1",
+    "share/man/man1/plenoptic-lens.1",
     "share/povray-plenoptic/scenes/calibration_targets.inc",
     "share/doc/povray-plenoptic/copyright",
     "etc/povray-plenoptic/povray.ini",
@@ -138,7 +143,7 @@ def test_install_relocatable(args):
     # 2. Move the prefix; run from elsewhere with the installed binaries only.
     os.rename(prefix, moved)
     assert not os.path.exists(prefix), "the prefix did not move"
-    env = {k: v for k, v in os.environ.items() if k not in ("POVINI", "POVINC", "PLENOPTIC_PROJECT",
+    env = {k: v for k, v in os.environ.items() if k not in ("POVINI", "POVINC", "PLENOPTIC_PROJECT", "PLENOPTIC_LENS_DATA",
                                                             "PYTHONPATH")}
     env["HOME"] = home
     no_numpy = os.path.join(work, "bin-no-numpy")  # a python3 without numpy, first on PATH
@@ -258,6 +263,12 @@ def test_install_relocatable(args):
     assert (r.returncode == 2 and "sweep.plenoptic" in r.stderr and "reserved word" in r.stderr
             and not os.path.exists(os.path.join(run_dir, "reserved"))), \
         "installed plenoptic-dataset did not refuse a reserved word:\n" + r.stdout[-1500:] + r.stderr[-1500:]
+    # plenoptic-lens finds the moved plenoptic-lens-data by itself: info of an installed lens.
+    lens = os.path.join(moved, "share", "povray-plenoptic", "lenses", "wide_angle_22mm_laikin_f3.5.dat")
+    r = run([os.path.join(moved, "bin", "plenoptic-lens"), "info", lens, "--json"], cwd=run_dir,
+            env=dict(env, PATH="/usr/bin:/bin"))
+    assert r.returncode == 0 and abs(json.loads(r.stdout)["paraxial"]["efl_mm"] - 22.0107) < 1e-3, \
+        "installed plenoptic-lens info failed:\n" + r.stdout[-1500:] + r.stderr[-1500:]
     # The launcher's imports without its main(): where plenoptic_lf came from.
     probe = ("import runpy, sys; runpy.run_path(%r, run_name='probe'); "
              "print(sys.modules['plenoptic_lf'].__file__)" % os.path.join(moved, "bin", "plenoptic-decode"))
