@@ -407,3 +407,26 @@ def test_laikin_round_trip(args, tool):
     tool("draw", LAIKIN, "-o", png)
     from PIL import Image
     assert Image.open(png).size == (1200, 600)
+
+
+def test_stop_on_refracting_surface(args, tool):
+    """STOP on a convex front surface: a stop row of thickness 0 in front of it; on a rear surface
+    of negative radius: behind it, taking the surface's thickness. Either way the paraxial data
+    equal the test's trace of the expected rows, the stop's diameter the surface's aperture."""
+    front = [dict(stop=True, curv=repr(1 / 51.5), disz="4", glas=model(1.5168, 64.17), diam="5"),
+             dict(curv=repr(-1 / 51.5), disz="95", diam="8")]
+    rear = [dict(curv=repr(1 / 51.5), disz="4", glas=model(1.5168, 64.17), diam="8"),
+            dict(stop=True, curv=repr(-1 / 51.5), disz="95", diam="5")]
+    want = {"front": [[0, 0, 1, 10, 0], [51.5, 4, 1.5168, 10, 64.17], [-51.5, 95, 1, 16, 0]],
+            "rear": [[51.5, 4, 1.5168, 16, 64.17], [-51.5, 0, 1, 10, 0], [0, 95, 1, 10, 0]]}
+    for name, surfaces in (("front", front), ("rear", rear)):
+        src = write(os.path.join(args.work, "stop-%s.zmx" % name), zmx(surfaces))
+        out = os.path.join(args.work, "stop-%s.dat" % name)
+        tool("import", src, "-o", out)
+        with open(out) as f:
+            same_rows(data_rows(f.read()), want[name])
+        info = json.loads(tool("info", out, "--json").stdout)
+        efl, bfd = y_nu(want[name])
+        assert info["paraxial"]["efl_mm"] == pytest.approx(efl, rel=1e-10)
+        assert info["paraxial"]["bfd_mm"] == pytest.approx(bfd, rel=1e-10)
+        assert info["paraxial"]["stop_mm"] == 10
