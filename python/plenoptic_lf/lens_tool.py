@@ -635,10 +635,12 @@ def draw_png(data: Dict[str, Any], size: Tuple[int, int]) -> bytes:
     margin = 12
     scale = min((width - 2 * margin) / (z_right - z_left), (height - 2 * margin - 14) / (2 * y_max))
     x_off = margin + 0.5 * ((width - 2 * margin) - scale * (z_right - z_left)) - scale * z_left
-    axis_row = 0.5 * (height - 14)
+    axis_row = float((height - 14) // 2)
 
     def px(y, z):
-        return (x_off + scale * z, axis_row - scale * y)
+        # A point within a quarter pixel of the axis is drawn on it (the axial chief ray, aimed a
+        # hair off the axis, would otherwise wander between two rows).
+        return (x_off + scale * z, axis_row - (scale * y if abs(scale * y) >= 0.25 else 0.0))
 
     picture = Image.new("RGB", (width, height), (255, 255, 255))
     d = ImageDraw.Draw(picture)
