@@ -5,8 +5,11 @@ leave the metadata's paraxial lattice (pupil aberration, vignetting; docs/real-l
 
 The file has one line per lens whose lattice centre lies in the picture: k, l (row form), u, v
 (the centroid of a white scene's light, pixels; empty for a lens that gets no light), then
-lit_fraction and the residuals. Lenses are looked up by skew index (k_s, l) as the metadata's
-lattice numbers them: k_s = k - floor(l / 2) on a hexagonal grid, k_s = k on a rectangular one.
+lit_fraction and the residuals. A render with spectral sampling adds the centres per channel,
+u_r, v_r, u_g, v_g, u_b, v_b (empty where that channel's microimage gets no light); both forms are
+read (MeasuredCentres.channel_centre). Lenses are looked up by skew index (k_s, l) as the
+metadata's lattice numbers them: k_s = k - floor(l / 2) on a hexagonal grid, k_s = k on a
+rectangular one.
 """
 
 import math
@@ -17,6 +20,8 @@ import numpy as np
 from .errors import DecodeError
 
 COLUMNS = ("k", "l", "u", "v")
+# The centres per channel of a spectral render, after the other columns.
+CHANNEL_COLUMNS = ("u_r", "v_r", "u_g", "v_g", "u_b", "v_b")
 # The lookup's status of a lens.
 UNLISTED, LIT, DARK = 0, 1, 2
 
@@ -38,7 +43,7 @@ class MeasuredCentres:
     def __init__(self, meta, path):
         self.path = path
         self.meta = meta
-        rows = self._read(path)
+        rows, channel_rows = self._read(path)
         hexagonal = meta.grid == "hexagonal"
         keys = [(k - (l // 2 if hexagonal else 0), l) for k, l, _, _ in rows]
         if rows:
@@ -60,13 +65,37 @@ class MeasuredCentres:
             self.status[i, j] = DARK if u is None else LIT
             if u is not None:
                 self.u[i, j], self.v[i, j] = u, v
+        # Per channel (spectral renders): u, v arrays of the same shape, NaN where not lit.
+        self.has_channels = channel_rows is not None
+        self.channel_u = [np.full(shape, np.nan) for _ in range(3)]
+        self.channel_v = [np.full(shape, np.nan) for _ in range(3)]
+        for (ks, l), centres in zip(keys, channel_rows or []):
+            for c, (u, v) in enumerate(centres):
+                if u is not None:
+                    self.channel_u[c][l - self.l_min, ks - self.k_min] = u
+                    self.channel_v[c][l - self.l_min, ks - self.k_min] = v
         self.lenses = len(rows)
         self.dark_lenses = int((self.status == DARK).sum())
         self.fit = _lattice_fit(meta)
 
     @staticmethod
+    def _centre(path, number, u_text, v_text):
+        """(u, v) of two cells, (None, None) when both are empty; DecodeError naming the line."""
+        if u_text == "" and v_text == "":
+            return None, None
+        try:
+            u, v = float(u_text), float(v_text)
+        except ValueError:
+            u = v = math.nan
+        if not (math.isfinite(u) and math.isfinite(v)):
+            raise DecodeError("%s, line %d: the centre u, v must be two finite numbers (or both empty for a lens "
+                              "that gets no light), found %r, %r" % (path, number, u_text, v_text))
+        return u, v
+
+    @staticmethod
     def _read(path):
-        """[(k, l, u or None, v or None)] from the file, checked; DecodeError naming the line."""
+        """([(k, l, u or None, v or None)], per channel [((u_r, v_r), (u_g, v_g), (u_b, v_b))] or None
+        without those columns) from the file, checked; DecodeError naming the line."""
         try:
             with open(path, "rb") as f:
                 data = f.read()
@@ -82,7 +111,10 @@ class MeasuredCentres:
         header = [c.strip() for c in lines[0].split(",")]
         if tuple(header[:4]) != COLUMNS:
             raise DecodeError("%s, line 1: the header must start with k,l,u,v, found %r" % (path, lines[0][:80]))
-        rows = []
+        channel_at = None
+        if all(c in header for c in CHANNEL_COLUMNS):
+            channel_at = [header.index(c) for c in CHANNEL_COLUMNS]
+        rows, channel_rows = [], [] if channel_at else None
         seen = set()
         for number, line in enumerate(lines[1:], start=2):
             if not line.strip():
@@ -98,18 +130,29 @@ class MeasuredCentres:
             if (k, l) in seen:
                 raise DecodeError("%s, line %d: lens (%d, %d) is listed twice" % (path, number, k, l))
             seen.add((k, l))
-            if cells[2] == "" and cells[3] == "":
-                rows.append((k, l, None, None))
-                continue
-            try:
-                u, v = float(cells[2]), float(cells[3])
-            except ValueError:
-                u = v = math.nan
-            if not (math.isfinite(u) and math.isfinite(v)):
-                raise DecodeError("%s, line %d: the centre u, v must be two finite numbers (or both empty for a lens "
-                                  "that gets no light), found %r, %r" % (path, number, cells[2], cells[3]))
+            u, v = MeasuredCentres._centre(path, number, cells[2], cells[3])
             rows.append((k, l, u, v))
-        return rows
+            if channel_at:
+                channel_rows.append(tuple(MeasuredCentres._centre(path, number, cells[channel_at[2 * c]],
+                                                                  cells[channel_at[2 * c + 1]]) for c in range(3)))
+        return rows, channel_rows
+
+    def channel_centre(self, channel, k, l):
+        """(u, v, dark) of channel 0 (R), 1 (G) or 2 (B) for skew indices k, l, as centre() gives
+        them (the fallbacks the same); a file without centres per channel gives centre()'s."""
+        u, v, dark = self.centre(k, l)
+        if not self.has_channels:
+            return u, v, dark
+        k = np.asarray(k, dtype=float)
+        l = np.asarray(l, dtype=float)
+        i = np.rint(l).astype(np.int64) - self.l_min
+        j = np.rint(k).astype(np.int64) - self.k_min
+        listed = (i >= 0) & (i < self.status.shape[0]) & (j >= 0) & (j < self.status.shape[1])
+        ii, jj = np.where(listed, i, 0), np.where(listed, j, 0)
+        cu = np.where(listed, self.channel_u[channel][ii, jj], np.nan)
+        cv = np.where(listed, self.channel_v[channel][ii, jj], np.nan)
+        lit = np.isfinite(cu)
+        return np.where(lit, cu, u), np.where(lit, cv, v), dark & ~lit
 
     def _fallback(self, k, l):
         if self.fit is None:

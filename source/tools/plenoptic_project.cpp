@@ -1,14 +1,16 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
 // plenoptic-project: where 3-D points image in a plenoptic render, from its metadata file.
 //
-//   plenoptic-project [--fraction] METADATA.json X Y Z [X Y Z ...]
-//   plenoptic-project [--fraction] METADATA.json - < points.txt
+//   plenoptic-project [--fraction] [--blur] [--wavelength NM] METADATA.json X Y Z [X Y Z ...]
+//   plenoptic-project [--fraction] [--blur] [--wavelength NM] METADATA.json - < points.txt
 //
 // Points are in scene units, world frame. Output: for each point, one line per image,
 // "point_index lens_k lens_l u v" (lens in row form; u, v in pixels, the centre of pixel
 // (column i, row j) at (i, j), as docs/metadata.md defines). A point that images nowhere
 // (behind the camera, outside the picture, seen by no lens) prints no line. --fraction adds a
 // sixth column: the part of the point's light through the main aperture in that image.
+// --wavelength projects through the camera at that wavelength (at_wavelength: the glass of the
+// main lens and the microlenses there, every position as rendered); without it, the d line.
 
 #include <cerrno>
 #include <cmath>
@@ -19,13 +21,14 @@
 #include <vector>
 
 #include "plenoptic_metadata_reader.h"
+#include "plenoptic/sensor/spectral_response.h"
 #include "plenoptic/truth/blur.h"
 
 namespace {
 
 const char* kUsage =
-    "usage: plenoptic-project [--fraction] [--blur] METADATA.json X Y Z [X Y Z ...]\n"
-    "       plenoptic-project [--fraction] [--blur] METADATA.json -   (points from standard input, three numbers each)\n"
+    "usage: plenoptic-project [--fraction] [--blur] [--wavelength NM] METADATA.json X Y Z [X Y Z ...]\n"
+    "       plenoptic-project [--fraction] [--blur] [--wavelength NM] METADATA.json -   (points from standard input, three numbers each)\n"
     "Projects world points (scene units) into the render described by METADATA.json (the\n"
     "<image>.plenoptic.json a plenoptic render writes) and prints, for each point, one line per\n"
     "image of it: point_index lens_k lens_l u v\n"
@@ -37,6 +40,9 @@ const char* kUsage =
     "  --blur       adds a column (after the fraction, if asked for): the signed radius in pixels of\n"
     "               the point's defocus blur through that microlens, libpleno's blur-aware point model\n"
     "               r = (pitch / 2) d (1/f - 1/a - 1/d) (docs/ground-truth.md); nan where undefined\n"
+    "  --wavelength NM  projects through the camera at NM nanometres (380 to 720): the glass of a\n"
+    "               dispersing main lens and microlenses at their indices there, every position as\n"
+    "               rendered; without it, at the d line (587.56 nm), as the render's own truth\n"
     "Exit status: 0 done, 2 bad usage, unreadable or invalid metadata, or a malformed number.\n";
 
 bool parse_number(const std::string& text, double* value)
@@ -64,9 +70,19 @@ int main(int argc, char** argv)
         std::fputs(kUsage, stdout);
         return 0;
     }
-    bool with_fraction = false, with_blur = false;
-    while (!args.empty() && (args[0] == "--fraction" || args[0] == "--blur")) {
-        (args[0] == "--fraction" ? with_fraction : with_blur) = true;
+    bool with_fraction = false, with_blur = false, with_wavelength = false;
+    double wavelength_nm = 0;
+    while (!args.empty() && (args[0] == "--fraction" || args[0] == "--blur" || args[0] == "--wavelength")) {
+        if (args[0] == "--wavelength") {
+            if (args.size() < 2 || !parse_number(args[1], &wavelength_nm))
+                return fail("--wavelength needs a number of nanometres" + (args.size() < 2 ? std::string() : ", found '" + args[1] + "'"));
+            if (!(wavelength_nm >= plenoptic::kSpectralMinNm && wavelength_nm <= plenoptic::kSpectralMaxNm))
+                return fail("--wavelength " + args[1] + " is outside 380 to 720 nm, the wavelengths the glass models are checked over");
+            with_wavelength = true;
+            args.erase(args.begin());
+        } else {
+            (args[0] == "--fraction" ? with_fraction : with_blur) = true;
+        }
         args.erase(args.begin());
     }
     if (args.empty())
@@ -76,7 +92,12 @@ int main(int argc, char** argv)
     const plenoptic::MetadataReading reading = plenoptic::read_metadata_file(path);
     if (!reading.ok())
         return fail(path + ": " + reading.error);
-    const plenoptic::RenderMetadata& metadata = reading.metadata;
+    plenoptic::RenderMetadata at_wavelength;
+    if (with_wavelength) {
+        at_wavelength = reading.metadata;
+        at_wavelength.model = plenoptic::at_wavelength(reading.metadata.model, wavelength_nm);
+    }
+    const plenoptic::RenderMetadata& metadata = with_wavelength ? at_wavelength : reading.metadata;
 
     // The point coordinates, as text, from the command line or standard input.
     std::vector<std::string> words;

@@ -6,7 +6,9 @@ paraxial data by a y-u paraxial ray trace, and the camera's geometry around the 
 Import it as `from plenoptic_testing import lens_tracer`.
 
 Prescription (pbrt's RealisticCamera lens file). One surface a row, object side first, four
-numbers in mm: curvature radius, thickness, index of refraction, clear aperture diameter.
+numbers in mm: curvature radius, thickness, index of refraction, clear aperture diameter; an
+optional fifth, the Abbe number V_d of the medium after the surface (0 or absent: it does not
+disperse).
   - radius: signed; positive when the centre of curvature lies on the image side of the
     vertex. 0 marks the aperture stop (a flat opening). `inf` (dict form: math.inf) is a flat
     refracting surface.
@@ -19,6 +21,9 @@ numbers in mm: curvature radius, thickness, index of refraction, clear aperture 
     lens that medium is air). Any other value on a stop row is refused.
   - aperture: clear diameter. A ray whose hit point lies farther than aperture/2 from the axis
     is blocked. A spherical surface needs aperture/2 <= |radius|.
+  - V_d (optional): the index is then n_d, and at a wavelength lambda (nm) the standard two-term
+    model n(lambda) = n_d + (n_d - 1) / V_d * (523655 / lambda^2 - 1.5168) gives it
+    (`two_term_index`; `surfaces_at_wavelength` turns a prescription into the one at lambda).
 `#` starts a comment. A lens may have at most one stop row; without one, the pupils and the
 f-number are those of the surface that limits an axial beam from infinity.
 
@@ -85,6 +90,7 @@ class Surface(NamedTuple):
     ior: float
     aperture: float
     is_stop: bool
+    abbe: float = 0.0
 
 
 def parse_lens_file(text):
@@ -95,17 +101,33 @@ def parse_lens_file(text):
         fields = line.split("#", 1)[0].split()
         if not fields:
             continue
-        if len(fields) != 4:
-            raise ValueError("line %d: expected 4 numbers (radius thickness ior aperture), got %d"
+        if len(fields) not in (4, 5):
+            raise ValueError("line %d: expected 4 numbers (radius thickness ior aperture), or 5 with V_d, got %d"
                              % (number, len(fields)))
         try:
-            radius, thickness, ior, aperture = (float(f) for f in fields)
+            values = [float(f) for f in fields] + [0.0] * (5 - len(fields))
         except ValueError:
             raise ValueError("line %d: not a number in %r" % (number, line.strip()))
-        surfaces.append(Surface(radius, thickness, ior, aperture, radius == 0.0))
+        radius, thickness, ior, aperture, abbe = values
+        surfaces.append(Surface(radius, thickness, ior, aperture, radius == 0.0, abbe))
     if not surfaces:
         raise ValueError("the lens file has no surface")
     return surfaces
+
+
+def two_term_index(n_d, abbe, wavelength_nm):
+    """The two-term dispersion model (module docstring): the index at wavelength_nm of a glass
+    of d-line index n_d and Abbe number abbe (n_d itself for abbe 0)."""
+    if not abbe:
+        return n_d
+    return n_d + (n_d - 1.0) / abbe * (523655.0 / wavelength_nm ** 2 - 1.5168)
+
+
+def surfaces_at_wavelength(surfaces, wavelength_nm):
+    """The prescription at a wavelength: every medium with an Abbe number at its two-term index
+    there, everything else (radii, thicknesses, apertures, the stop) unchanged."""
+    return [s._replace(ior=two_term_index(s.ior, s.abbe, wavelength_nm)) if s.abbe and not s.is_stop else s
+            for s in surfaces]
 
 
 def surface_from_dict(row):
