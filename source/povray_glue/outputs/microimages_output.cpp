@@ -40,7 +40,9 @@ public:
             channel_wavelengths_nm(model.spec.spectral, summary.channel_wavelengths_nm);
             for (int c = 0; c < 3 && !image.cancelled(); ++c) {
                 const PlenopticCamera at = at_wavelength(model, summary.channel_wavelengths_nm[c]);
-                channels.push_back(microimage_truth(model, options, progress, image.cancelled, &at));
+                // Nothing disperses (the same lens and microlens objects): the d line's centres.
+                const bool same = at.lens == model.lens && at.array.microlens == model.array.microlens;
+                channels.push_back(same ? truth : microimage_truth(model, options, progress, image.cancelled, &at));
             }
             if (image.cancelled()) {
                 std::fprintf(stderr, "plenoptic camera: cancelled: no microimage centres written (%s); the metadata "
