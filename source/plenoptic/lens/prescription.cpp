@@ -295,6 +295,26 @@ AxialLimit axial_limit_sized(const Prescription& lens, double stop_mm, double im
 
 } // namespace
 
+double surface_sag_mm(const LensSurface& s, double r_mm)
+{
+    if (s.stop)
+        return 0;
+    const double u = r_mm * r_mm;
+    double z = 0;
+    if (s.radius_mm != 0) {
+        const double c = 1 / s.radius_mm;
+        const double q = 1 - (1 + s.conic) * c * c * u;
+        if (!(q >= 0))
+            return NAN;
+        z = c * u / (1 + std::sqrt(q));
+    }
+    // a4 r^4 + a6 r^6 + ... by Horner's rule in u = r^2.
+    double poly = 0;
+    for (int j = s.aspheric_count - 1; j >= 0; --j)
+        poly = poly * u + s.aspheric[j];
+    return z + poly * u * u;
+}
+
 double flat_radius(double radius_mm)
 {
     return std::fabs(radius_mm) > kPrescriptionMaxLengthMm ? 0.0 : radius_mm;

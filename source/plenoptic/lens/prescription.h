@@ -30,6 +30,14 @@ struct LensSurface {
     bool stop = false;        // the aperture stop (a flat, non-refracting opening)
     int line = 0;             // where it was written (file or scene line, 0 when unknown)
     Glass glass;              // how the medium after the surface disperses (default: it does not)
+    // Conic and even-asphere terms (surface_sag_mm): the conic constant k (0: a sphere, -1: a
+    // paraboloid) and a4, a6, ..., a18 (mm^-3, mm^-5, ...), the first aspheric_count of them as
+    // written (the rest 0). A surface with k = 0 and every term 0 is spherical (or flat) and is
+    // traced as before.
+    static const int kMaxAspheric = 8;
+    double conic = 0;
+    int aspheric_count = 0;
+    double aspheric[kMaxAspheric] = {0, 0, 0, 0, 0, 0, 0, 0};
 
     LensSurface() = default;
     LensSurface(double radius, double thickness, double index, double aperture, bool is_stop, int at,
@@ -40,7 +48,26 @@ struct LensSurface {
     // The index of the medium after the surface at a wavelength (nm): ior at every wavelength when
     // it does not disperse.
     double index_at(double wavelength_nm) const { return plenoptic::index_at(ior, glass, wavelength_nm); }
+
+    // Whether the surface departs from its sphere (or plane): a conic constant or an aspheric term
+    // other than 0.
+    bool is_aspheric() const
+    {
+        if (conic != 0)
+            return true;
+        for (int j = 0; j < kMaxAspheric; ++j)
+            if (aspheric[j] != 0)
+                return true;
+        return false;
+    }
 };
+
+// The sag of a surface (mm, +z towards the image) at distance r_mm from the axis:
+//   z(r) = c r^2 / (1 + sqrt(1 - (1 + k) c^2 r^2)) + a4 r^4 + a6 r^6 + ... + a18 r^18
+// with c = 1 / radius (0 for a flat surface) and k the conic constant (the even-asphere form
+// without an r^2 term). NaN where the conic's root is not real; 0 for the stop. For a sphere it is
+// R - sign(R) sqrt(R^2 - r^2).
+double surface_sag_mm(const LensSurface& s, double r_mm);
 
 // The surfaces, object side first.
 struct Prescription {
