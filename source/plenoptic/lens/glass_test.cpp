@@ -125,7 +125,7 @@ TEST(Glass, LensFileAbbeColumn)
         const char* says;
     } refused[] = {
         {"0 2 0 10\n60 5 1.5168 20 2\n-60 40 1 20\n", 2, "surface 2: the Abbe number V_d 2 is outside 5 to 150"},
-        {"0 2 0 10\n60 5 1.5168 20 64.17 1\n-60 40 1 20\n", 2, "this one has 6"},
+        {"0 2 0 10\n60 5 1.5168 20 64.17 1 1 2 3 4 5 6 7 8 9\n-60 40 1 20\n", 2, "this one has 15"},
         {"0 2 0 10 30\n60 5 1.5168 20\n-60 40 1 20\n", 1, "the stop does not refract; it takes no Abbe number"},
         {"0 2 0 10\n60 5 1.5168 20\n-60 40 1 20 64\n", 3, "air (index 1), which does not disperse"},
         {"0 2 0 10\n60 5 1.5168 20 nan\n-60 40 1 20\n", 2, "is not a finite number"},

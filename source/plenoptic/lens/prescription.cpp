@@ -55,28 +55,91 @@ double sag(const LensSurface& s, double h)
 // of two sags of one sign is, since d sag / d(h^2) = 1 / (2 sqrt(R^2 - h^2)) shrinks with |R|),
 // so it is least at the axis or at the rim: if the rim's gap is negative, the crossing height is
 // where the gap is 0, found by bisection.
+//
+// With a conic or aspheric surface the gap need not be monotonic: it is sampled at
+// kCrossingSamples heights from the axis to the rim (with the real sag, surface_sag_mm), and the
+// first negative sample's crossing height found by bisection from the sample before it.
+const int kCrossingSamples = 4096;
+
 std::string crossing(const Prescription& lens, int i)
 {
     const LensSurface& a = lens.surfaces[i];
     const LensSurface& b = lens.surfaces[i + 1];
     const double rim = 0.5 * std::min(a.aperture_mm, b.aperture_mm);
-    const auto gap = [&](double h) { return a.thickness_mm + sag(b, h) - sag(a, h); };
-    const double at_rim = gap(rim);
-    const double tolerance = 1e-9 + 1e-12 * (std::fabs(sag(a, rim)) + std::fabs(sag(b, rim)) + a.thickness_mm);
-    if (!(at_rim < -tolerance))
+    const bool real = a.is_aspheric() || b.is_aspheric();
+    const auto gap = [&](double h) {
+        return real ? a.thickness_mm + surface_sag_mm(b, h) - surface_sag_mm(a, h) : a.thickness_mm + sag(b, h) - sag(a, h);
+    };
+    const double tolerance = real ? 1e-9 + 1e-12 * (std::fabs(surface_sag_mm(a, rim)) + std::fabs(surface_sag_mm(b, rim)) +
+                                                    a.thickness_mm)
+                                  : 1e-9 + 1e-12 * (std::fabs(sag(a, rim)) + std::fabs(sag(b, rim)) + a.thickness_mm);
+    double lo = 0, hi = rim, at_rim = gap(rim);  // at_rim: the gap where the crossing is reported
+    if (real) {
+        int k = 1;
+        for (; k <= kCrossingSamples; ++k) {
+            const double h = rim * k / kCrossingSamples;
+            if (gap(h) < -tolerance)
+                break;
+        }
+        if (k > kCrossingSamples)
+            return "";
+        lo = rim * (k - 1) / kCrossingSamples;
+        hi = rim * k / kCrossingSamples;
+        at_rim = gap(hi);
+    } else if (!(at_rim < -tolerance)) {
         return "";
-    double lo = 0, hi = rim;  // gap(lo) >= 0 > gap(hi)
+    }
+    const double reported = hi;  // gap(lo) >= 0 > gap(hi)
     for (int k = 0; k < 200 && hi - lo > 1e-12 * rim; ++k) {
         const double mid = 0.5 * (lo + hi);
         (gap(mid) >= 0 ? lo : hi) = mid;
     }
     std::ostringstream msg;
     msg << row_at(a, i) << " and " << row_at(b, i + 1) << " cross inside their clear apertures: they meet "
-        << mm(lo) << " from the axis, and at " << mm(rim) << " from it (the smaller clear aperture's rim) "
+        << mm(lo) << " from the axis, and at " << mm(reported) << " from it"
+        << (reported == rim ? " (the smaller clear aperture's rim) " : " ")
         << row_name(b, i + 1) << " lies " << mm(-at_rim) << " in front of " << row_name(a, i)
         << "; consecutive surfaces may touch but not cross within their clear apertures (a larger thickness on "
         << row_name(a, i) << ", now " << mm(a.thickness_mm) << ", or smaller apertures)";
     return msg.str();
+}
+
+// A conic or aspheric surface's own refusals: a conic constant on a flat surface (which it would
+// not change), a sag undefined (the conic's root not real) or not finite somewhere within the
+// clear aperture.
+std::string check_asphere(const LensSurface& s)
+{
+    const double rim = 0.5 * s.aperture_mm;
+    std::ostringstream msg;
+    msg << std::setprecision(6);
+    if (s.radius_mm == 0 && s.conic != 0) {
+        msg << "the conic constant " << s.conic
+            << " is given on a flat surface (radius 0), which it does not change; a flat surface takes aspheric "
+               "terms alone (a Schmidt plate's profile)";
+        return msg.str();
+    }
+    if (s.radius_mm != 0) {
+        // 1 - (1 + k) c^2 r^2 falls (k > -1) or rises (k <= -1) with r: its least is at the rim.
+        const double c = 1 / s.radius_mm;
+        if (!(1 - (1 + s.conic) * c * c * rim * rim >= 0)) {
+            msg << "with the conic constant " << s.conic << " and radius " << mm(s.radius_mm)
+                << " the sag is undefined beyond " << mm(std::fabs(s.radius_mm) / std::sqrt(1 + s.conic))
+                << " from the axis (1 - (1 + k) r^2 / R^2 < 0), inside the clear aperture's rim at " << mm(rim)
+                << " (a smaller aperture diameter, or a conic constant nearer -1)";
+            return msg.str();
+        }
+    }
+    // |a4 r^4 + ...| <= |a4| r^4 + ... , which grows with r: finite at the rim, finite everywhere.
+    double bound = 0;
+    for (int j = s.aspheric_count - 1; j >= 0; --j)
+        bound = bound * rim * rim + std::fabs(s.aspheric[j]);
+    bound *= rim * rim * rim * rim;
+    if (!std::isfinite(bound) || !std::isfinite(surface_sag_mm(s, rim)) || bound > kPrescriptionMaxLengthMm) {
+        msg << "the aspheric terms make the sag exceed " << mm(kPrescriptionMaxLengthMm)
+            << " within the clear aperture (rim at " << mm(rim) << ")";
+        return msg.str();
+    }
+    return "";
 }
 
 bool parse_number(const std::string& token, double* value)
@@ -220,9 +283,113 @@ bool meet_surface(const LensSurface& s, double z, const LensRay& ray, Vec3* hit,
     return true;
 }
 
-// z[i]: vertex of surface i; before[i], after[i]: the indices on either side of it.
-Traced trace(const Prescription& lens, const double* z, const double* before, const double* after, const LensRay& in,
-             bool from_image)
+// d sag / d(r^2) at u = r^2 (surface_sag_mm's derivative): c / (2 sqrt(1 - (1 + k) c^2 u)) for the
+// conic, plus 2 a4 u + 3 a6 u^2 + ...; NaN where the conic's root is not real.
+double sag_slope_u(const LensSurface& s, double u)
+{
+    double slope = 0;
+    if (s.radius_mm != 0) {
+        const double c = 1 / s.radius_mm;
+        const double q = 1 - (1 + s.conic) * c * c * u;
+        if (!(q > 0))
+            return NAN;
+        slope = c / (2 * std::sqrt(q));
+    }
+    double poly = 0;
+    for (int j = s.aspheric_count - 1; j >= 0; --j)
+        poly = poly * u + (j + 2) * s.aspheric[j];
+    return slope + poly * u;
+}
+
+// The ray parameter where a ray meets a surface's base conic (k and c, without the aspheric
+// terms), vertex at z: the smallest t > 0 of (1 + k) c z'^2 - 2 z' + c r^2 = 0 (z' = z - vertex)
+// on the sag's branch (1 - (1 + k) c z' >= 0); the vertex plane's t for a flat surface. NaN when
+// the ray meets neither.
+double meet_base_conic(const LensSurface& s, double z, const LensRay& ray)
+{
+    const Vec3 o{ray.origin.x, ray.origin.y, ray.origin.z - z};
+    const Vec3& d = ray.dir;
+    if (s.radius_mm == 0)
+        return d.z != 0 && -o.z / d.z > 0 ? -o.z / d.z : NAN;
+    const double c = 1 / s.radius_mm, p = (1 + s.conic) * c;
+    const double A = c * (d.x * d.x + d.y * d.y) + p * d.z * d.z;
+    const double B = 2 * (c * (o.x * d.x + o.y * d.y) - d.z + p * o.z * d.z);
+    const double C = c * (o.x * o.x + o.y * o.y) - 2 * o.z + p * o.z * o.z;
+    double roots[2];
+    int n = 0;
+    if (std::fabs(A) <= 1e-15 * (std::fabs(B) + std::fabs(C))) {
+        if (B != 0)
+            roots[n++] = -C / B;
+    } else {
+        const double disc = B * B - 4 * A * C;
+        if (!(disc >= 0))
+            return NAN;
+        const double q = -0.5 * (B + (B >= 0 ? 1 : -1) * std::sqrt(disc));
+        roots[n++] = q / A;
+        if (q != 0)
+            roots[n++] = C / q;
+    }
+    double best = NAN;
+    for (int k = 0; k < n; ++k) {
+        const double t = roots[k];
+        if (!(t > 0) || !(1 - p * (o.z + t * d.z) >= 0))
+            continue;
+        if (!(best <= t))
+            best = t;
+    }
+    return best;
+}
+
+} // namespace
+
+const double kAsphereToleranceMm = 1e-9;
+const int kAsphereIterations = 32;
+
+bool meet_aspheric_surface(const LensSurface& s, double z, const LensRay& ray, Vec3* hit, Vec3* normal)
+{
+    // Newton's method on f(t) = z(t) - vertex - sag(r(t)^2) from the base conic's hit (or the vertex
+    // plane's when the ray misses the conic), until a step moves less than kAsphereToleranceMm along
+    // the (unit) ray.
+    double t = meet_base_conic(s, z, ray);
+    if (!std::isfinite(t)) {
+        LensSurface plane;
+        t = meet_base_conic(plane, z, ray);
+        if (!std::isfinite(t))
+            return false;
+    }
+    const Vec3& o = ray.origin;
+    const Vec3& d = ray.dir;
+    for (int k = 0; k < kAsphereIterations; ++k) {
+        const double x = o.x + t * d.x, y = o.y + t * d.y, u = x * x + y * y;
+        const double f = o.z + t * d.z - z - surface_sag_mm(s, std::sqrt(u));
+        const double slope = sag_slope_u(s, u);
+        const double df = d.z - slope * 2 * (x * d.x + y * d.y);
+        if (!std::isfinite(f) || !std::isfinite(df) || df == 0)
+            return false;
+        const double step = f / df;
+        t -= step;
+        if (std::fabs(step) <= kAsphereToleranceMm) {
+            if (!(t > 0))
+                return false;
+            *hit = o + t * d;
+            const double g = sag_slope_u(s, hit->x * hit->x + hit->y * hit->y);
+            if (!std::isfinite(g))
+                return false;
+            *normal = normalized(Vec3{-2 * g * hit->x, -2 * g * hit->y, 1});
+            return true;
+        }
+    }
+    return false;
+}
+
+namespace {
+
+// z[i]: vertex of surface i; before[i], after[i]: the indices on either side of it. With
+// kAspheric, a surface marked in aspheric[] is met by meet_aspheric_surface; without, every surface
+// is a sphere or a plane (the lens has no asphere: the choice is made once per lens).
+template <bool kAspheric>
+Traced trace(const Prescription& lens, const double* z, const double* before, const double* after,
+             const unsigned char* aspheric, const LensRay& in, bool from_image)
 {
     const int count = int(lens.surfaces.size());
     LensRay ray{in.origin, normalized(in.dir)};
@@ -230,7 +397,10 @@ Traced trace(const Prescription& lens, const double* z, const double* before, co
         const int i = from_image ? count - 1 - step : step;
         const LensSurface& s = lens.surfaces[i];
         Vec3 hit, normal;
-        if (!meet_surface(s, z[i], ray, &hit, &normal))
+        if (kAspheric && aspheric[i]) {
+            if (!meet_aspheric_surface(s, z[i], ray, &hit, &normal))
+                return Traced{TraceResult::Missed, ray, i};
+        } else if (!meet_surface(s, z[i], ray, &hit, &normal))
             return Traced{TraceResult::Missed, ray, i};
         if (s.stop) {
             if (!inside_stop(lens, s, hit.x, hit.y))
@@ -360,15 +530,17 @@ ParsedPrescription parse_lens_file(const std::string& file_text)
             tokens.push_back(token);
         if (tokens.empty())
             continue;
-        if (tokens.size() != 4 && tokens.size() != 5) {
+        const size_t most = 6 + LensSurface::kMaxAspheric;
+        if (tokens.size() < 4 || tokens.size() > most) {
             std::ostringstream msg;
             msg << "a lens file row has four numbers (radius, thickness, index of refraction, aperture "
-                   "diameter, in mm) and optionally a fifth (the Abbe number V_d; 0: no dispersion); this one has "
+                   "diameter, in mm) and optionally a fifth (the Abbe number V_d; 0: no dispersion), a sixth (the "
+                   "conic constant) and up to eight more (the aspheric terms a4, a6, ..., a18); this one has "
                 << tokens.size();
             parsed.error = PrescriptionError{msg.str(), number};
             return parsed;
         }
-        double v[5] = {0, 0, 0, 0, 0};
+        double v[6 + LensSurface::kMaxAspheric] = {};
         for (size_t k = 0; k < tokens.size(); ++k)
             if (!parse_number(tokens[k], &v[k])) {
                 parsed.error = PrescriptionError{"'" + tokens[k] + "' is not a finite number", number};
@@ -377,8 +549,12 @@ ParsedPrescription parse_lens_file(const std::string& file_text)
         const bool stop = v[0] == 0;
         Glass glass;
         glass.abbe = v[4];
-        parsed.prescription.surfaces.push_back(
-            LensSurface{stop ? 0.0 : flat_radius(v[0]), v[1], v[2], v[3], stop, number, glass});
+        LensSurface surface{stop ? 0.0 : flat_radius(v[0]), v[1], v[2], v[3], stop, number, glass};
+        surface.conic = v[5];
+        surface.aspheric_count = tokens.size() > 6 ? int(tokens.size()) - 6 : 0;
+        for (int j = 0; j < surface.aspheric_count; ++j)
+            surface.aspheric[j] = v[6 + j];
+        parsed.prescription.surfaces.push_back(surface);
     }
     if (parsed.prescription.surfaces.empty()) {
         const std::string what = file_text.empty()
@@ -422,6 +598,18 @@ PrescriptionError check_prescription(const Prescription& lens)
             return PrescriptionError{name + ": the aperture diameter must be > 0 mm", s.line};
         if (s.thickness_mm < 0)
             return PrescriptionError{name + ": the thickness must be >= 0 mm", s.line};
+        if (!std::isfinite(s.conic))
+            return PrescriptionError{name + ": the conic constant must be finite", s.line};
+        if (s.aspheric_count < 0 || s.aspheric_count > LensSurface::kMaxAspheric)
+            return PrescriptionError{name + ": a surface takes 1 to 8 aspheric terms (a4 to a18)", s.line};
+        for (int j = 0; j < LensSurface::kMaxAspheric; ++j)
+            if (!std::isfinite(s.aspheric[j]))
+                return PrescriptionError{name + ": the aspheric term a" + std::to_string(2 * j + 4) + " must be finite",
+                                         s.line};
+        if (s.stop && s.is_aspheric())
+            return PrescriptionError{name + ": the stop is a flat opening; it takes no conic constant or aspheric terms "
+                                            "(0 in a lens file's sixth and later columns)",
+                                     s.line};
         if (s.stop) {
             if (++stops == 2) {
                 std::ostringstream msg;
@@ -453,7 +641,11 @@ PrescriptionError check_prescription(const Prescription& lens)
             if (!glass.empty())
                 return PrescriptionError{name + ": " + glass, s.line};
         }
-        if (s.radius_mm != 0 && s.aperture_mm > 2 * std::fabs(s.radius_mm))
+        if (s.is_aspheric()) {
+            const std::string message = check_asphere(s);
+            if (!message.empty())
+                return PrescriptionError{name + ": " + message, s.line};
+        } else if (s.radius_mm != 0 && s.aperture_mm > 2 * std::fabs(s.radius_mm))
             return PrescriptionError{name + ": the aperture diameter exceeds the surface's sphere (diameter 2 |radius|)",
                                      s.line};
     }
@@ -596,17 +788,23 @@ TracingLens::TracingLens(const Prescription& lens)
         if (!lens.surfaces[i].stop)
             n = lens.surfaces[i].ior;
         after_[i] = lens.surfaces[i].stop ? before_[i] : lens.surfaces[i].ior;
+        aspheric_.push_back(!lens.surfaces[i].stop && lens.surfaces[i].is_aspheric() ? 1 : 0);
+        any_aspheric_ = any_aspheric_ || aspheric_.back() != 0;
     }
 }
 
 Traced TracingLens::trace_from_image(const LensRay& in) const
 {
-    return trace(lens_, z_.data(), before_.data(), after_.data(), in, true);
+    if (any_aspheric_)
+        return trace<true>(lens_, z_.data(), before_.data(), after_.data(), aspheric_.data(), in, true);
+    return trace<false>(lens_, z_.data(), before_.data(), after_.data(), nullptr, in, true);
 }
 
 Traced TracingLens::trace_from_object(const LensRay& in) const
 {
-    return trace(lens_, z_.data(), before_.data(), after_.data(), in, false);
+    if (any_aspheric_)
+        return trace<true>(lens_, z_.data(), before_.data(), after_.data(), aspheric_.data(), in, false);
+    return trace<false>(lens_, z_.data(), before_.data(), after_.data(), nullptr, in, false);
 }
 
 Traced trace_from_image(const Prescription& lens, const LensRay& in) { return TracingLens(lens).trace_from_image(in); }

@@ -214,6 +214,16 @@ struct LensRay {
     Vec3 dir;
 };
 
+// Meets a conic or aspheric surface (vertex at z) with a ray of unit direction: Newton's method on
+// the sag from the base conic's hit (the vertex plane's when the ray misses the conic), converged
+// when a step moves less than kAsphereToleranceMm along the ray, at most kAsphereIterations steps.
+// False (the ray is blocked as missing the surface) when it does not converge, when the sag is
+// undefined on its way, or when the hit lies behind the ray's origin. The normal is the sag's
+// gradient's (unit, facing +z).
+extern const double kAsphereToleranceMm;
+extern const int kAsphereIterations;
+bool meet_aspheric_surface(const LensSurface& s, double z, const LensRay& ray, Vec3* hit, Vec3* normal);
+
 // Why a trace ended.
 enum class TraceResult { Passed, Missed, ClearAperture, Stop, TotalInternalReflection };
 
@@ -245,6 +255,8 @@ public:
 private:
     Prescription lens_;
     std::vector<double> z_, before_, after_;
+    std::vector<unsigned char> aspheric_;  // per surface: met by meet_aspheric_surface
+    bool any_aspheric_ = false;            // chooses the trace once: spheres only, or with aspheres
 };
 
 // Stop diameter (mm) giving the paraxial f-number N (efl / the stop's entrance pupil diameter).
