@@ -26,6 +26,12 @@ const int kAzimuths = 64;        // boundary directions refined by bisection
 const int kBisections = 24;      // steps of each bisection (2^-24 of the grid radius)
 const double kMargin = 1.01;     // radius margin for the bins, and again for points between them
 const int kMaxFieldDoublings = 60;
+// A lens with a conic or aspheric surface: its rear surface's sag is sampled at kAsphereSagSamples
+// heights for the search square, and every disc's radius is widened by kAsphereMargin more (an
+// asphere can make the passing region less convex than spheres do).
+const int kAsphereSagSamples = 256;
+const double kAsphereSagMargin = 1.05;
+const double kAsphereMargin = 1.03;
 
 struct Probe {
     const MainLens& lens;
@@ -45,7 +51,13 @@ void search_square(const Prescription& lens, double r, double plane_z, double pu
     const LensSurface& rear = lens.surfaces.back();
     const double a = 0.5 * rear.aperture_mm;
     double sag = 0;
-    if (rear.radius_mm != 0 && !rear.stop)
+    if (rear.is_aspheric() && !rear.stop) {
+        // The largest |sag| within the aperture, sampled (check_prescription has made it defined
+        // there), widened by kAsphereSagMargin for what lies between the samples.
+        for (int k = 0; k <= kAsphereSagSamples; ++k)
+            sag = std::max(sag, std::fabs(surface_sag_mm(rear, a * k / kAsphereSagSamples)));
+        sag *= kAsphereSagMargin;
+    } else if (rear.radius_mm != 0 && !rear.stop)
         sag = std::fabs(rear.radius_mm) - std::sqrt(std::max(0.0, rear.radius_mm * rear.radius_mm - a * a));
     double lo = INFINITY, hi = -INFINITY;
     for (double z_rim : {-sag, sag}) {
@@ -128,6 +140,9 @@ PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, doubl
     : plane_z_(plane_z), pupil_z_(traced.exit_pupil_centre().z), step_mm_(0), field_radius_mm_(0), reach_mm_(0)
 {
     const Probe probe{traced, plane_z, pupil_z_};
+    bool aspheric = false;
+    for (const LensSurface& s : lens.surfaces)
+        aspheric = aspheric || (!s.stop && s.is_aspheric());
     // The edge of the field: double a radius until no light passes, then bins up to it.
     double cx, radius;
     double edge = 0.5 * lens.surfaces.back().aperture_mm;
@@ -156,6 +171,8 @@ PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, doubl
         else if (a.radius > 0 || b.radius > 0)
             span = a.radius > 0 ? a : b;  // the field's edge lies between them: keep the lit one
         span.radius *= kMargin;
+        if (aspheric)
+            span.radius *= kAsphereMargin;
         spans_.push_back(span);
         reach_mm_ = std::max(reach_mm_, std::fabs(span.centre_x) + span.radius);
     }

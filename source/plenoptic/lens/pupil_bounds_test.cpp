@@ -47,14 +47,16 @@ struct Case {
 // Every point of a fine grid over the rear element's whole shadow on the exit pupil's plane, from
 // field points on a ray out of the axis (between the bounds' bins as well as on them, and beyond
 // the field's edge): a passing ray lies in the disc, and may_pass agrees.
-void expect_bounds_hold(const Case& c)
+int expect_bounds_hold(const Case& c)
 {
     const std::shared_ptr<const MainLens> traced = make_prescription_lens(c.lens, 0, true);
     const PupilBounds bounds(c.lens, *traced, c.plane_z);
     const double pupil_z = traced->exit_pupil_centre().z;
     const double rear = 0.5 * c.lens.surfaces.back().aperture_mm;
     const double edge = bounds.field_radius_mm();
-    ASSERT_GT(edge, 0) << c.name;
+    EXPECT_GT(edge, 0) << c.name;
+    if (!(edge > 0))
+        return 0;
     const double azimuth = 0.7;  // radians: the discs turn with the point
     int passing = 0, outside = 0, refused = 0, beyond = 0;
     for (int k = 0; k <= 90; ++k) {
@@ -86,12 +88,31 @@ void expect_bounds_hold(const Case& c)
     EXPECT_EQ(outside, 0) << c.name;
     EXPECT_EQ(refused, 0) << c.name;
     EXPECT_EQ(beyond, 0) << c.name;
+    return passing;
 }
 
 TEST(PupilBounds, HoldEveryPassingRayOfTheTriplet)
 {
     expect_bounds_hold(Case{"triplet, sensor 45 mm behind", vignetting_triplet(), -45});
     expect_bounds_hold(Case{"triplet, array 37 mm behind", vignetting_triplet(), -37});
+}
+
+// The triplet with a paraboloid front surface and an r^4, r^6 profile on its rear surface: the
+// asphere changes which rays pass (the brute-force count differs from the spherical triplet's by
+// more than 3 %), and the bounds still hold every one.
+TEST(PupilBounds, HoldEveryPassingRayOfAnAsphericTriplet)
+{
+    Prescription aspheric = vignetting_triplet();
+    aspheric.surfaces[0].conic = -1;
+    LensSurface& rear = aspheric.surfaces.back();
+    rear.aspheric_count = 2;
+    rear.aspheric[0] = -1e-4;
+    rear.aspheric[1] = -5e-7;
+    ASSERT_FALSE(check_prescription(aspheric).any()) << check_prescription(aspheric).message;
+    const int spheres = expect_bounds_hold(Case{"triplet, sensor 45 mm behind", vignetting_triplet(), -45});
+    const int aspheres = expect_bounds_hold(Case{"aspheric triplet, sensor 45 mm behind", aspheric, -45});
+    EXPECT_GT(std::fabs(double(aspheres - spheres)) / spheres, 0.03) << spheres << " against " << aspheres;
+    expect_bounds_hold(Case{"aspheric triplet, array 37 mm behind", aspheric, -37});
 }
 
 TEST(PupilBounds, HoldEveryPassingRayOfTheWideAngle)
