@@ -137,6 +137,8 @@ class PlenopticParser
 		void Parse_Samples(const Keyword& keyword, KeywordRead& read);
 		void Parse_F_Numbers(const Keyword& keyword, KeywordRead& read);
 		void Parse_Vector6(const Keyword& keyword, KeywordRead& read);
+		void Parse_Float_List(const Keyword& keyword, KeywordRead& read);
+		bool Parse_Bracket_Floats(size_t most, std::vector<DBL>* values);
 		void Parse_Camera_Modifier();
 		void Parse_Placement();
 		void Close_Block(KeywordBlock block, const BlockState& state);
@@ -326,6 +328,9 @@ void PlenopticParser::Parse_Keyword(const Keyword& keyword, BlockState& state)
 		case KeywordValue::Vector6:
 			Parse_Vector6(keyword, read);
 			break;
+		case KeywordValue::FloatList:
+			Parse_Float_List(keyword, read);
+			break;
 		case KeywordValue::Block:
 			// The store starts the block; its keywords follow in braces.
 			keyword.store(*setup, read);
@@ -482,18 +487,9 @@ void PlenopticParser::Parse_F_Numbers(const Keyword& keyword, KeywordRead& read)
 	p.Get_Token();
 	if (Token.Token_Id == LEFT_ANGLE_TOKEN)
 	{
-		for (;;)
-		{
-			values.push_back(p.Parse_Float());
-			p.Parse_Comma();
-			p.Get_Token();
-			if (Token.Token_Id == RIGHT_ANGLE_TOKEN)
-				break;
-			p.Unget_Token();
-			if ((int)values.size() >= plenoptic::kMaxWhiteImages)
-				Check_At("white_image f_numbers lists at most " + plenoptic::format_number(plenoptic::kMaxWhiteImages) +
-				         " f-numbers, between '<' and '>'", position, column);
-		}
+		if (!Parse_Bracket_Floats(plenoptic::kMaxWhiteImages, &values))
+			Check_At("white_image f_numbers lists at most " + plenoptic::format_number(plenoptic::kMaxWhiteImages) +
+			         " f-numbers, between '<' and '>'", position, column);
 	}
 	else
 	{
@@ -525,23 +521,49 @@ void PlenopticParser::Parse_Vector6(const Keyword& keyword, KeywordRead& read)
 	if (Token.Token_Id != LEFT_ANGLE_TOKEN)
 		Check_At(six, position, column);
 	std::vector<DBL> values;
-	for (;;)
-	{
-		values.push_back(p.Parse_Float());
-		p.Parse_Comma();
-		p.Get_Token();
-		if (Token.Token_Id == RIGHT_ANGLE_TOKEN)
-			break;
-		p.Unget_Token();
-		if (values.size() >= 6)
-			break;
-	}
-	if (values.size() != 6 || Token.Token_Id != RIGHT_ANGLE_TOKEN)
+	const bool closed = Parse_Bracket_Floats(6, &values);
+	if (values.size() != 6 || !closed)
 		Check_At(six + "; found " + (values.size() == 6 ? std::string("more") : std::to_string(values.size())), position,
 		         column);
 	for (size_t k = 0; k < values.size(); k++)
 		Check_At(plenoptic::check_finite(keyword.value_label(), values[k]), position, column);
 	read.list = values;
+}
+
+// aspheric <a4, a6, ...>: 1 to LensSurface::kMaxAspheric floats in angle brackets, each finite.
+void PlenopticParser::Parse_Float_List(const Keyword& keyword, KeywordRead& read)
+{
+	const FilePos position = Token.Token_File_Pos;
+	const int column = Token.Token_Col_No;
+	const size_t most = plenoptic::LensSurface::kMaxAspheric;
+	const std::string what = std::string(keyword.value_label()) + " takes 1 to " + std::to_string(most) +
+	                         " numbers in angle brackets, " + (keyword.listed != NULL ? keyword.listed : keyword.word);
+	p.Get_Token();
+	if (Token.Token_Id != LEFT_ANGLE_TOKEN)
+		Check_At(what, position, column);
+	std::vector<DBL> values;
+	if (!Parse_Bracket_Floats(most, &values))
+		Check_At(what + "; found more", position, column);
+	for (size_t k = 0; k < values.size(); k++)
+		Check_At(plenoptic::check_finite(keyword.value_label(), values[k]), position, column);
+	read.list = values;
+}
+
+// The floats of an angle-bracket list whose '<' has just been read, separated by optional commas,
+// up to its '>': true when the list closed within `most` values (false: more follow, unread).
+bool PlenopticParser::Parse_Bracket_Floats(size_t most, std::vector<DBL>* values)
+{
+	for (;;)
+	{
+		values->push_back(p.Parse_Float());
+		p.Parse_Comma();
+		p.Get_Token();
+		if (Token.Token_Id == RIGHT_ANGLE_TOKEN)
+			return true;
+		p.Unget_Token();
+		if (values->size() >= most)
+			return false;
+	}
 }
 
 // At camera level, a token that is not one of the camera's keywords: refused, or POV-Ray's

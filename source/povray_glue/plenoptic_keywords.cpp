@@ -279,6 +279,17 @@ std::vector<Keyword> make_table()
                     std::copy(r.list.begin() + 3, r.list.begin() + 6, row(s).glass.sellmeier_c_um2);
                 })
             .labelled("surface sellmeier").listed_as("sellmeier <B1, B2, B3, C1, C2, C3>"),
+        // Conic and even-asphere terms (prescription.h surface_sag_mm); checked at prescription's }.
+        Keyword("conic", B::Surface, V::Number, "0: a sphere", "the conic constant k of the surface (-1: a paraboloid)",
+                [](CameraSetup& s, R r) { row(s).conic = r.values[0]; })
+            .labelled("surface conic"),
+        Keyword("aspheric", B::Surface, V::FloatList, "none", "the even-asphere terms a4, a6, ..., a18 (mm^-3, mm^-5, ...)",
+                [](CameraSetup& s, R r) {
+                    row(s).aspheric_count = int(r.list.size());
+                    std::fill(row(s).aspheric, row(s).aspheric + LensSurface::kMaxAspheric, 0.0);
+                    std::copy(r.list.begin(), r.list.end(), row(s).aspheric);
+                })
+            .labelled("surface aspheric").listed_as("aspheric <a4, a6, ...>"),
 
         // ---- stop { } ----
         Keyword("thickness", B::Stop, V::Number, "", "the axial distance to the next row (mm)",
@@ -490,6 +501,7 @@ const char *keyword_value_name(KeywordValue value)
         case V::Block: return "block";
         case V::Samples: return "samples";
         case V::FNumbers: return "f_numbers";
+        case V::FloatList: return "float_list";
     }
     return "";
 }

@@ -49,7 +49,8 @@ enum class KeywordValue {
     ResponseFile,  // a string: the name of a spectral response table, read into `response`
     Block,     // { } holding the keywords of the block the row opens
     Samples,   // N, or MIN, MAX
-    FNumbers   // N, or <N1, ..., Nk>
+    FNumbers,  // N, or <N1, ..., Nk>
+    FloatList  // <a, b, ...>: 1 to LensSurface::kMaxAspheric numbers in angle brackets (read into the list)
 };
 
 // Keywords a block takes one of (or a keyword it takes once): the second is refused.
@@ -59,7 +60,7 @@ enum class KeywordGroup { None, MainLensKind, LensSource, Distortion, Grid, Micr
 struct KeywordRead {
     double values[3] = {0, 0, 0};  // Number: [0]; Vector2, Vector3: the components; OnOff: 1 on, 0 off;
                                    // Word: the index of the word; Samples: N (or MIN, MAX)
-    std::vector<double> list;      // FNumbers, Vector6: the values
+    std::vector<double> list;      // FNumbers, Vector6, FloatList: the values
     std::string text;              // String: the string
     Prescription prescription;     // String: the surfaces of the lens file it names
     SpectralResponse response;     // ResponseFile: the table it names

@@ -106,7 +106,8 @@ def documented_kind(cell: str) -> str:
 # The table's value kinds and the kind of the specification's value cell each must have.
 KINDS = {"flag": "flag", "number": "number", "vector2": "vector2", "vector3": "vector3", "vector6": "vector6",
          "on/off": "on/off",
-         "word": "word", "string": "string", "block": "block", "samples": "numbers", "f_numbers": "list"}
+         "word": "word", "string": "string", "block": "block", "samples": "numbers", "f_numbers": "list",
+         "float_list": "list"}
 
 
 def named_keywords(cell: str) -> List[str]:
