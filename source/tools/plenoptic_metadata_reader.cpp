@@ -272,6 +272,17 @@ void read_prescription(const Json& v, const std::string& parent, MainLensParams*
             numbers(sellmeier, row + ".sellmeier", "b", 3, false, surface.glass.sellmeier_b);
             numbers(sellmeier, row + ".sellmeier", "c_um2", 3, false, surface.glass.sellmeier_c_um2);
         }
+        // A conic or aspheric surface's terms (absent for a sphere or a plane).
+        if (s.contains("conic"))
+            surface.conic = finite_number(s["conic"], row + ".conic");
+        if (s.contains("aspheric")) {
+            const Json& terms = s["aspheric"];
+            if (!terms.is_array() || terms.empty() || terms.size() > size_t(LensSurface::kMaxAspheric))
+                refuse(row + ".aspheric", "an array of 1 to 8 numbers (a4, a6, ..., a18)", terms);
+            surface.aspheric_count = int(terms.size());
+            for (size_t j = 0; j < terms.size(); ++j)
+                surface.aspheric[j] = finite_number(terms[j], row + ".aspheric[" + std::to_string(j) + "]");
+        }
         m->prescription.surfaces.push_back(surface);
     }
     const Json& blades = member(v, parent, "blades");

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <string>
 
+#include "plenoptic/core/json.h"
+#include "plenoptic/lens/main_lens.h"
 #include "plenoptic/lens/prescription.h"
 
 namespace plenoptic {
@@ -195,6 +197,31 @@ TEST(Asphere, RefusalsNameLineAndValue)
     p.surfaces[1].conic = INFINITY;
     EXPECT_NE(check_prescription(p).message.find("conic constant must be finite"), std::string::npos);
     EXPECT_EQ(check_prescription(p).line, 2);
+}
+
+// The metadata names a conic or aspheric surface's terms (only there), and its paraxial data are
+// those of the base spheres.
+TEST(Asphere, MetadataAndFirstOrderData)
+{
+    const ParsedPrescription plain = parse_lens_file("0 2 0 10\n60 5 1.5 20\n-60 40 1 20\n");
+    const ParsedPrescription asph = parse_lens_file("0 2 0 10\n60 5 1.5 20 0 -0.5 1e-6 0\n-60 40 1 20 0 0 -2e-6\n");
+    ASSERT_FALSE(plain.error.any() || asph.error.any()) << asph.error.message;
+    const LensPlacement at{55, false, 0, ""};
+    const MetadataJson without = main_lens_metadata(make_prescription_lens(plain.prescription, 0, true, 55).get(), at);
+    const MetadataJson with = main_lens_metadata(make_prescription_lens(asph.prescription, 0, true, 55).get(), at);
+    for (const MetadataJson& s : without["prescription"]["surfaces"])
+        EXPECT_FALSE(s.contains("conic") || s.contains("aspheric"));
+    EXPECT_EQ(with["prescription"]["surfaces"][1]["conic"].get<double>(), -0.5);
+    EXPECT_EQ(with["prescription"]["surfaces"][1]["aspheric"].size(), 2u);
+    EXPECT_EQ(with["prescription"]["surfaces"][1]["aspheric"][0].get<double>(), 1e-6);
+    EXPECT_FALSE(with["prescription"]["surfaces"][2].contains("conic"));
+    EXPECT_EQ(with["prescription"]["surfaces"][2]["aspheric"][0].get<double>(), -2e-6);
+    MetadataJson trimmed = with;
+    trimmed["prescription"]["surfaces"][1].erase("conic");
+    trimmed["prescription"]["surfaces"][1].erase("aspheric");
+    trimmed["prescription"]["surfaces"][2].erase("aspheric");
+    EXPECT_EQ(trimmed["paraxial"], without["paraxial"]);
+    EXPECT_EQ(trimmed["prescription"], without["prescription"]);
 }
 
 } // namespace

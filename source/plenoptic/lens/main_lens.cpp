@@ -73,6 +73,18 @@ void add_prescription_metadata(MetadataJson& section, const Prescription& lens, 
             sellmeier["c_um2"] = c;
             row["sellmeier"] = sellmeier;
         }
+        // A conic or aspheric surface's terms (absent for a sphere or a plane).
+        if (s.conic != 0)
+            row["conic"] = json_number(s.conic);
+        bool terms = false;
+        for (int j = 0; j < s.aspheric_count; ++j)
+            terms = terms || s.aspheric[j] != 0;
+        if (terms) {
+            MetadataJson aspheric = MetadataJson::array();
+            for (int j = 0; j < s.aspheric_count; ++j)
+                aspheric.push_back(json_number(s.aspheric[j]));
+            row["aspheric"] = aspheric;
+        }
         surfaces.push_back(row);
     }
     MetadataJson prescription = MetadataJson::object();
