@@ -4,8 +4,8 @@
 // At each tabulated radius r the point P = (r, 0, sensor) is traced towards kPoints points of
 // the upper half of its pupil-bounds disc: a Fibonacci lattice mapped to the half disc by an
 // area-preserving polar map. The lens is symmetric about the plane y = 0 through P (centred
-// spherical surfaces, round stop), so the lower half passes where the upper half does, and the
-// half disc at kPoints points is the whole disc at twice as many. Lit area = disc area times
+// rotationally symmetric surfaces: spheres, conics, even aspheres; a round stop), so the lower
+// half passes where the upper half does, and the half disc at kPoints points is the whole disc at twice as many. Lit area = disc area times
 // the passing share (each passing point counting with its irradiance weight under irradiance
 // radiometry).
 
