@@ -684,15 +684,6 @@ PrescriptionError check_prescription(const Prescription& lens)
     return PrescriptionError{"", 0};
 }
 
-double surface_sag_mm(const LensSurface& s, double r_mm)
-{
-    if (s.stop || s.radius_mm == 0)
-        return 0;
-    if (std::fabs(r_mm) > std::fabs(s.radius_mm))
-        return NAN;
-    return sag(s, r_mm);
-}
-
 std::vector<double> vertex_positions(const Prescription& lens)
 {
     std::vector<double> z(lens.surfaces.size());

@@ -146,11 +146,6 @@ ChromaticFocus chromatic_focus(const Prescription& lens);
 // 360 / blades between the blades' angles.
 double reduced_blade_rotation(double degrees, int blades);
 
-// The surface's sag at height r_mm from the axis: the z of the surface there, from its vertex
-// plane (+z towards the image); 0 for a flat surface and the stop, NaN where the sphere does
-// not reach (|r| > |radius|). Spherical surfaces only in this version.
-double surface_sag_mm(const LensSurface& s, double r_mm);
-
 // The z of each surface's vertex (the first at 0).
 std::vector<double> vertex_positions(const Prescription& lens);
 
