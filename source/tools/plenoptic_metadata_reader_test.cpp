@@ -98,6 +98,34 @@ TEST(MetadataReader, ReadsWhatTheWriterWrites)
     EXPECT_EQ(metadata.params.array.rotate_deg[2], 0.3);
 }
 
+// A real lens with a conic and an aspheric surface: the reader gives back the same terms, so
+// plenoptic-project traces the lens the render traced.
+TEST(MetadataReader, ReadsAConicAndAsphericLensBack)
+{
+    CameraParams p = hexagonal_camera();
+    p.main = MainLensParams();
+    p.main.given = true;
+    p.main.type = MainLensType::Prescription;
+    p.main.has_prescription = true;
+    const ParsedPrescription lens = parse_lens_file("0 2 0 10\n60 5 1.5 20 0 -0.5 1e-6 -3e-9\n-60 40 1 20 0 0 -2e-6\n");
+    ASSERT_FALSE(lens.error.any()) << lens.error.message;
+    p.main.prescription = lens.prescription;
+    p.main.has_distance = true;
+    p.main.distance_mm = paraxial_image_distance(lens.prescription, INFINITY).mm - 0.6;
+    const std::string text = metadata_json(with_film(make_camera(p), 320, 240), p, kFrame, "scene.depth.exr");
+    const MetadataReading reading = parse_metadata(text);
+    ASSERT_TRUE(reading.ok()) << reading.error;
+    const std::vector<LensSurface>& read = reading.metadata.params.main.prescription.surfaces;
+    ASSERT_EQ(read.size(), 3u);
+    for (size_t i = 0; i < 3; ++i) {
+        const LensSurface& s = lens.prescription.surfaces[i];
+        EXPECT_EQ(read[i].conic, s.conic) << i;
+        EXPECT_EQ(read[i].aspheric_count, s.aspheric_count) << i;
+        for (int j = 0; j < LensSurface::kMaxAspheric; ++j)
+            EXPECT_EQ(read[i].aspheric[j], s.aspheric[j]) << i << " " << j;
+    }
+}
+
 TEST(MetadataReader, AcceptsUtf8AndSurrogatePairs)
 {
     // "\u00e9" escaped, U+1F600 as a surrogate pair, and raw UTF-8.
