@@ -463,6 +463,17 @@ AxialLimit axial_limit_sized(const Prescription& lens, double stop_mm, double im
     return limit;
 }
 
+// The trace of a lens with a conic or aspheric surface, kept out of line so that the spherical
+// trace inlines into TracingLens's functions as it did before aspheres existed.
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+Traced trace_aspheric(const Prescription& lens, const double* z, const double* before, const double* after,
+                      const unsigned char* aspheric, const LensRay& in, bool from_image)
+{
+    return trace<true>(lens, z, before, after, aspheric, in, from_image);
+}
+
 } // namespace
 
 double surface_sag_mm(const LensSurface& s, double r_mm)
@@ -787,14 +798,14 @@ TracingLens::TracingLens(const Prescription& lens)
 Traced TracingLens::trace_from_image(const LensRay& in) const
 {
     if (any_aspheric_)
-        return trace<true>(lens_, z_.data(), before_.data(), after_.data(), aspheric_.data(), in, true);
+        return trace_aspheric(lens_, z_.data(), before_.data(), after_.data(), aspheric_.data(), in, true);
     return trace<false>(lens_, z_.data(), before_.data(), after_.data(), nullptr, in, true);
 }
 
 Traced TracingLens::trace_from_object(const LensRay& in) const
 {
     if (any_aspheric_)
-        return trace<true>(lens_, z_.data(), before_.data(), after_.data(), aspheric_.data(), in, false);
+        return trace_aspheric(lens_, z_.data(), before_.data(), after_.data(), aspheric_.data(), in, false);
     return trace<false>(lens_, z_.data(), before_.data(), after_.data(), nullptr, in, false);
 }
 
