@@ -12,6 +12,14 @@
 
 namespace plenoptic {
 
+// The spherical trace's helpers are inlined into both traces (spheres only, with aspheres): used
+// twice, the compiler would call them, and a spherical render would pay for the calls.
+#if defined(__GNUC__)
+#define PLENOPTIC_TRACE_INLINE inline __attribute__((always_inline))
+#else
+#define PLENOPTIC_TRACE_INLINE inline
+#endif
+
 namespace {
 
 std::string row_name(const LensSurface& s, int index)
@@ -209,7 +217,7 @@ int stop_index(const Prescription& lens)
 
 // Inside the stop's opening: the circle of the stop's diameter, or the iris polygon whose corners
 // lie on that circle.
-bool inside_stop(const Prescription& lens, const LensSurface& stop, double x, double y)
+PLENOPTIC_TRACE_INLINE bool inside_stop(const Prescription& lens, const LensSurface& stop, double x, double y)
 {
     const double r = 0.5 * stop.aperture_mm;
     if (x * x + y * y > r * r)
@@ -228,7 +236,7 @@ bool inside_stop(const Prescription& lens, const LensSurface& stop, double x, do
 
 // Refracts unit direction d at a surface with unit normal `normal` (either orientation) from
 // index n1 into index n2. False on total internal reflection.
-bool refract(Vec3 d, Vec3 normal, double n1, double n2, Vec3* out)
+PLENOPTIC_TRACE_INLINE bool refract(Vec3 d, Vec3 normal, double n1, double n2, Vec3* out)
 {
     Vec3 n = normal;
     double cos_i = -dot(n, d);
@@ -246,7 +254,7 @@ bool refract(Vec3 d, Vec3 normal, double n1, double n2, Vec3* out)
 
 // Meets surface i (vertex at z) with the ray; false when it misses the surface's sphere, or
 // meets it only behind the ray's origin.
-bool meet_surface(const LensSurface& s, double z, const LensRay& ray, Vec3* hit, Vec3* normal)
+PLENOPTIC_TRACE_INLINE bool meet_surface(const LensSurface& s, double z, const LensRay& ray, Vec3* hit, Vec3* normal)
 {
     if (s.stop || s.radius_mm == 0) {
         if (ray.dir.z == 0)
@@ -388,7 +396,7 @@ namespace {
 // kAspheric, a surface marked in aspheric[] is met by meet_aspheric_surface; without, every surface
 // is a sphere or a plane (the lens has no asphere: the choice is made once per lens).
 template <bool kAspheric>
-Traced trace(const Prescription& lens, const double* z, const double* before, const double* after,
+PLENOPTIC_TRACE_INLINE Traced trace(const Prescription& lens, const double* z, const double* before, const double* after,
              const unsigned char* aspheric, const LensRay& in, bool from_image)
 {
     const int count = int(lens.surfaces.size());
