@@ -2,7 +2,7 @@
 // The cost of aspheres (BENCHMARKS.md, "Conic and aspheric surfaces"): the benchmark scene through
 // a made-up 53 mm triplet at f/5.6, all spherical, or (Declare=ASPH=1) with a conic on its first
 // surface and r^4, r^6 terms on its last. Render from the repository root:
-//   build/povray +Ibenchmarks/asphere_triplet.pov +W320 +H240 -D [Declare=ASPH=1]
+//   build/povray +Ibenchmarks/asphere_triplet.pov +Lbenchmarks +W320 +H240 -D [Declare=ASPH=1]
 #version 3.7;
 global_settings { assumed_gamma 1 }
 #include "scene.inc"
