@@ -143,12 +143,7 @@ class MeasuredCentres:
         u, v, dark = self.centre(k, l)
         if not self.has_channels:
             return u, v, dark
-        k = np.asarray(k, dtype=float)
-        l = np.asarray(l, dtype=float)
-        i = np.rint(l).astype(np.int64) - self.l_min
-        j = np.rint(k).astype(np.int64) - self.k_min
-        listed = (i >= 0) & (i < self.status.shape[0]) & (j >= 0) & (j < self.status.shape[1])
-        ii, jj = np.where(listed, i, 0), np.where(listed, j, 0)
+        _, _, listed, ii, jj = self._cells(k, l)
         cu = np.where(listed, self.channel_u[channel][ii, jj], np.nan)
         cv = np.where(listed, self.channel_v[channel][ii, jj], np.nan)
         lit = np.isfinite(cu)
@@ -160,14 +155,19 @@ class MeasuredCentres:
         origin, a, b = self.fit
         return origin[0] + k * a[0] + l * b[0], origin[1] + k * a[1] + l * b[1]
 
-    def centre(self, k, l):
-        """(u, v, dark) for skew indices k, l (arrays of whole numbers as floats)."""
+    def _cells(self, k, l):
+        """k, l as float arrays; which of them the file lists; their row and column in the
+        tables (0 where not listed)."""
         k = np.asarray(k, dtype=float)
         l = np.asarray(l, dtype=float)
         i = np.rint(l).astype(np.int64) - self.l_min
         j = np.rint(k).astype(np.int64) - self.k_min
         listed = (i >= 0) & (i < self.status.shape[0]) & (j >= 0) & (j < self.status.shape[1])
-        ii, jj = np.where(listed, i, 0), np.where(listed, j, 0)
+        return k, l, listed, np.where(listed, i, 0), np.where(listed, j, 0)
+
+    def centre(self, k, l):
+        """(u, v, dark) for skew indices k, l (arrays of whole numbers as floats)."""
+        k, l, listed, ii, jj = self._cells(k, l)
         status = np.where(listed, self.status[ii, jj], UNLISTED)
         fallback_u, fallback_v = self._fallback(k, l)
         lit = status == LIT
