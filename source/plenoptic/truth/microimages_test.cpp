@@ -82,18 +82,26 @@ TEST(MicroimageTruth, ThinLensMicroimagesAreThePupilDiscAboutTheLatticeCentres)
 
 using test::vignetting_triplet;
 
-TEST(MicroimageTruth, CatsEyesAgreeWithABruteForceCount)
+// The vignetting triplet focused at 3 m in front of 2.5 mm pinhole microlenses 8.5 mm from a
+// sensor of 0.5 mm pixels: cat's-eye microimages towards the corners.
+CameraParams triplet_pinholes_camera()
 {
     const Prescription lens = vignetting_triplet();
-    const ImageDistance focus = paraxial_image_distance(lens, 3000);
-    ASSERT_TRUE(focus.real);
-    CameraParams params = plenoptic_camera(GridType::Rectangular, 2.5, 0, 8.5, 50, 4, focus.mm);
+    CameraParams params = plenoptic_camera(GridType::Rectangular, 2.5, 0, 8.5, 50, 4,
+                                           paraxial_image_distance(lens, 3000).mm);
     params.main.type = MainLensType::Prescription;
     params.main.has_focal_length = false;
     params.main.has_f_number = false;
     params.main.has_prescription = true;
     params.main.prescription = lens;
     params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.5;
+    return params;
+}
+
+TEST(MicroimageTruth, CatsEyesAgreeWithABruteForceCount)
+{
+    ASSERT_TRUE(paraxial_image_distance(vignetting_triplet(), 3000).real);
+    const CameraParams params = triplet_pinholes_camera();
     const PlenopticCamera m = make_camera(params);
     ASSERT_EQ(test::lens_kind(m), "prescription");
     const int W = 120, H = 120;
@@ -243,15 +251,7 @@ TEST(MicroimageTruth, CancellingStopsAtTheNextLensAndReturnsNothing)
 // camera at that wavelength's own measure (the truth of a camera made at that wavelength).
 TEST(MicroimageTruth, ChannelsAreTheSameLensesMeasuredAtTheirWavelength)
 {
-    Prescription lens = vignetting_triplet();
-    const ImageDistance focus = paraxial_image_distance(lens, 3000);
-    CameraParams params = plenoptic_camera(GridType::Rectangular, 2.5, 0, 8.5, 50, 4, focus.mm);
-    params.main.type = MainLensType::Prescription;
-    params.main.has_focal_length = false;
-    params.main.has_f_number = false;
-    params.main.has_prescription = true;
-    params.main.prescription = lens;
-    params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.5;
+    CameraParams params = triplet_pinholes_camera();
     const int W = 80, H = 80;
     const PlenopticCamera plain = with_film(make_camera(params), W, H);
     const PlenopticCamera plain_blue = at_wavelength(plain, 450);
