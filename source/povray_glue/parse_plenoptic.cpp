@@ -134,6 +134,8 @@ class PlenopticParser
 		std::string Read_Named_File(const char *keyword, const char *kind, bool lenses_folder, std::string *file);
 		void Parse_Lens_File(KeywordRead& read);
 		void Parse_Response_File(KeywordRead& read);
+		void Parse_Lens_Table(KeywordRead& read);
+		void Parse_Number_Pair(const Keyword& keyword, KeywordRead& read);
 		void Parse_Samples(const Keyword& keyword, KeywordRead& read);
 		void Parse_F_Numbers(const Keyword& keyword, KeywordRead& read);
 		void Parse_Vector6(const Keyword& keyword, KeywordRead& read);
@@ -331,6 +333,12 @@ void PlenopticParser::Parse_Keyword(const Keyword& keyword, BlockState& state)
 		case KeywordValue::FloatList:
 			Parse_Float_List(keyword, read);
 			break;
+		case KeywordValue::NumberPair:
+			Parse_Number_Pair(keyword, read);
+			break;
+		case KeywordValue::LensTable:
+			Parse_Lens_Table(read);
+			break;
 		case KeywordValue::Block:
 			// The store starts the block; its keywords follow in braces.
 			keyword.store(*setup, read);
@@ -434,6 +442,28 @@ void PlenopticParser::Parse_Lens_File(KeywordRead& read)
 	read.text = file;
 }
 
+// lens_table "name": a microlens array's measured errors (array/lens_errors.h: a header naming k, l
+// and the error columns, one row per lens), found beside the scene or in the library paths. Errors
+// name the file and its row. The pitch (needed to bound the shifts) is the array's so far; the
+// array's own checks refuse a table read before the pitch.
+void PlenopticParser::Parse_Lens_Table(KeywordRead& read)
+{
+	const FilePos position = Token.Token_File_Pos;
+	const int column = Token.Token_Col_No;
+	std::string file;
+	const std::string text = Read_Named_File("lens_table", "a lens table (k, l, dx_mm, dy_mm, ... per row)", false, &file);
+	const plenoptic::ArrayParams& array = setup->params.array;
+	if (!array.has_pitch)
+		Check_At("lens_table \"" + file + "\" must come after the array's pitch (the shifts are checked against it)",
+		         position, column);
+	const plenoptic::ParsedLensTable table = plenoptic::parse_lens_table(text, array.pitch_mm);
+	if (!table.error.empty())
+		Check_At("lens_table \"" + file + "\", line " + std::to_string(table.error_line) + ": " + table.error, position,
+		         column);
+	read.lens_table = table.rows;
+	read.text = file;
+}
+
 // spectral response_file "name": the sensor's tabulated sensitivities (sensor/spectral_response.h:
 // wavelength_nm, r, g, b per row), found beside the scene or in the library paths. Errors name the
 // file and its row.
@@ -475,6 +505,19 @@ void PlenopticParser::Parse_Samples(const Keyword& keyword, KeywordRead& read)
 	if (first > second)
 		Check_At("samples minimum (" + plenoptic::format_number(first) + ") must not be larger than the maximum (" +
 		         plenoptic::format_number(second) + ")", position, column);
+}
+
+// A float, then optionally a second one (errors position S [, S_z]).
+void PlenopticParser::Parse_Number_Pair(const Keyword& keyword, KeywordRead& read)
+{
+	const FilePos position = Token.Token_File_Pos;
+	const int column = Token.Token_Col_No;
+	read.values[0] = Float(keyword.value_label(), keyword.check);
+	p.Parse_Comma();
+	read.values[1] = Keyword_Follows() ? 0.0 : p.Allow_Float(0.0);
+	Check_At(plenoptic::check_finite(keyword.value_label(), read.values[1]), position, column);
+	if (keyword.check != NULL)
+		Check_At(keyword.check(keyword.value_label(), read.values[1]), position, column);
 }
 
 // white_image f_numbers N | f_numbers <N1, ..., N16>: one f-number, or a list in angle brackets

@@ -53,6 +53,9 @@ std::string Check_Abbe(const char *label, double value)
     const std::string message = check_abbe(value);
     return message.empty() ? message : std::string(label) + ": " + message;
 }
+std::string Check_Fill_Factor(const char *, double value) { return check_fill_factor(value); }
+std::string Check_Error_Deviation(const char *label, double value) { return check_error_deviation(label, value); }
+std::string Check_Error_Rotation(const char *, double value) { return check_error_rotation(value); }
 std::string Check_White_F_Number(const char *, double value)
 {
     const std::string message = check_f_number(value);
@@ -337,6 +340,37 @@ std::vector<Keyword> make_table()
         Keyword("abbe", B::MicrolensArray, V::Number, "0: no dispersion", "the microlenses' Abbe number V_d",
                 [](CameraSetup& s, R r) { array(s).abbe = r.values[0]; })
             .labelled("microlens_array abbe").checked(Check_Abbe),
+        Keyword("errors", B::MicrolensArray, V::Block, "none: ideal lenses", "manufacturing errors drawn lens by lens",
+                [](CameraSetup& s, R) { array(s).has_errors = true; })
+            .opening(B::Errors).listed_as("errors { }").in_group(G::ArrayErrors),
+        Keyword("lens_table", B::MicrolensArray, V::LensTable, "none", "manufacturing errors measured lens by lens (CSV)",
+                [](CameraSetup& s, R r) { array(s).lens_table_file = r.text; array(s).lens_table = r.lens_table; })
+            .listed_as("lens_table \"file.csv\"").in_group(G::ArrayErrors),
+        Keyword("fill_factor", B::MicrolensArray, V::Number, "1", "the part of each cell that is lens",
+                [](CameraSetup& s, R r) { array(s).fill_factor = r.values[0]; })
+            .labelled("microlens_array fill_factor").checked(Check_Fill_Factor),
+        Keyword("mask", B::MicrolensArray, V::OnOff, "off", "the gap between lenses is opaque (a chrome mask)",
+                [](CameraSetup& s, R r) { array(s).mask = r.values[0] != 0; }),
+        Keyword("baffles", B::MicrolensArray, V::OnOff, "off", "walls between microimages: no light under a neighbour",
+                [](CameraSetup& s, R r) { array(s).baffles = r.values[0] != 0; }),
+
+        // ---- microlens_array { errors { } } ----
+        Keyword("position", B::Errors, V::NumberPair, "0", "S [, S_z]: standard deviation of each lens's shift in the "
+                "array's plane [and along its normal] (mm)",
+                [](CameraSetup& s, R r) {
+                    array(s).errors.position_sd_mm = r.values[0];
+                    array(s).errors.position_sd_z_mm = r.values[1];
+                })
+            .labelled("errors position").checked(Check_Error_Deviation),
+        Keyword("focal_length", B::Errors, V::Number, "0", "relative standard deviation of the focal lengths",
+                [](CameraSetup& s, R r) { array(s).errors.focal_sd = r.values[0]; })
+            .labelled("errors focal_length").checked(Check_Error_Deviation),
+        Keyword("rotation", B::Errors, V::Number, "0", "the largest tilt of a lens's axis (degrees)",
+                [](CameraSetup& s, R r) { array(s).errors.rotation_deg = r.values[0]; })
+            .labelled("errors rotation").checked(Check_Error_Rotation),
+        Keyword("seed", B::Errors, V::Number, "0", "which array of the distribution",
+                [](CameraSetup& s, R r) { array(s).errors.seed = (std::int64_t)r.values[0]; })
+            .reserved_word().labelled("errors seed").checked(check_whole_number),
 
         // ---- sensor { }: any read-out keyword (bayer to seed) makes the render write the raw ----
         Keyword("pixel_size", B::Sensor, V::Vector2, "0.01", "the pixel pitch, horizontal and vertical (mm)",
@@ -403,6 +437,7 @@ const KeywordBlockInfo kBlocks[] = {
     {B::WhiteImage, "white_image", "white_image", nullptr, 0},
     {B::Diffraction, "diffraction", "diffraction", nullptr, 1},
     {B::Spectral, "spectral", "spectral", nullptr, 2},
+    {B::Errors, "errors", "microlens_array errors", nullptr, 0},
 };
 
 } // namespace
@@ -460,6 +495,7 @@ const char *keyword_group_message(KeywordGroup group)
         case G::MicrolensKind: return "microlens_array takes one of pinhole, focal_length or focal_lengths, not several";
         case G::ArrayRotate: return "microlens_array takes rotate once (about x, then y, then z, in degrees)";
         case G::ArrayTranslate: return "microlens_array takes translate once (mm, after the rotation)";
+        case G::ArrayErrors: return "microlens_array takes one of errors { } or lens_table, once";
         case G::None: break;
     }
     return "";
@@ -502,6 +538,8 @@ const char *keyword_value_name(KeywordValue value)
         case V::Samples: return "samples";
         case V::FNumbers: return "f_numbers";
         case V::FloatList: return "float_list";
+        case V::NumberPair: return "number_pair";
+        case V::LensTable: return "string";
     }
     return "";
 }

@@ -32,7 +32,8 @@ enum class KeywordBlock {
     Sensor,          // sensor { }
     WhiteImage,      // the modifiers read right after the camera's white_image
     Diffraction,     // the modifiers read right after the camera's diffraction
-    Spectral         // the modifiers read right after the camera's spectral N
+    Spectral,        // the modifiers read right after the camera's spectral N
+    Errors           // microlens_array { errors { } }
 };
 
 // How the parser reads what follows the keyword.
@@ -50,11 +51,14 @@ enum class KeywordValue {
     Block,     // { } holding the keywords of the block the row opens
     Samples,   // N, or MIN, MAX
     FNumbers,  // N, or <N1, ..., Nk>
-    FloatList  // <a, b, ...>: 1 to LensSurface::kMaxAspheric numbers in angle brackets (read into the list)
+    FloatList, // <a, b, ...>: 1 to LensSurface::kMaxAspheric numbers in angle brackets (read into the list)
+    NumberPair,  // a float, then optionally (after an optional comma) a second one: values[0], values[1] (0 when absent)
+    LensTable  // a string: the name of a lens table (array/lens_errors.h), read into `lens_table`
 };
 
 // Keywords a block takes one of (or a keyword it takes once): the second is refused.
-enum class KeywordGroup { None, MainLensKind, LensSource, Distortion, Grid, MicrolensKind, ArrayRotate, ArrayTranslate };
+enum class KeywordGroup { None, MainLensKind, LensSource, Distortion, Grid, MicrolensKind, ArrayRotate, ArrayTranslate,
+                          ArrayErrors };
 
 // A value as the parser read it, handed to the row's store.
 struct KeywordRead {
@@ -64,6 +68,7 @@ struct KeywordRead {
     std::string text;              // String: the string
     Prescription prescription;     // String: the surfaces of the lens file it names
     SpectralResponse response;     // ResponseFile: the table it names
+    std::vector<LensTableRow> lens_table;  // LensTable: the rows of the table it names
     long line = 0;                 // where the keyword is written
     long column = 0;
     long long offset = 0;

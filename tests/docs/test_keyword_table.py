@@ -107,7 +107,7 @@ def documented_kind(cell: str) -> str:
 KINDS = {"flag": "flag", "number": "number", "vector2": "vector2", "vector3": "vector3", "vector6": "vector6",
          "on/off": "on/off",
          "word": "word", "string": "string", "block": "block", "samples": "numbers", "f_numbers": "list",
-         "float_list": "list"}
+         "float_list": "list", "number_pair": "numbers"}
 
 
 def named_keywords(cell: str) -> List[str]:

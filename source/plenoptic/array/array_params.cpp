@@ -3,6 +3,8 @@
 
 #include "plenoptic/array/array_params.h"
 
+#include <cmath>
+
 namespace plenoptic {
 
 std::shared_ptr<const Microlens> make_microlens(const ArrayParams& params)
@@ -24,6 +26,15 @@ MicrolensArray make_microlens_array(const ArrayParams& params, double array_z)
     MicrolensArray array = make_microlens_array(params.grid, params.pitch_mm, make_microlens(params), params.distance_mm,
                                                 make_array_pose(params.rotate_deg, centre));
     array.abbe = params.abbe;
+    if (params.has_errors)
+        array.errors = LensErrors::drawn(params.errors);
+    else if (!params.lens_table_file.empty())
+        array.errors = LensErrors::tabled(params.lens_table, params.lens_table_file, params.focal_lengths_mm,
+                                          params.lens == MicrolensType::Pinhole ? 0 : array.lens_type_count);
+    array.fill_factor = params.fill_factor;
+    array.aperture_scale = params.fill_factor == 1 ? 1 : std::sqrt(params.fill_factor);
+    array.mask = params.mask;
+    array.baffles = params.baffles;
     return array;
 }
 

@@ -6,6 +6,10 @@
 #ifndef PLENOPTIC_ARRAY_PARAMS_H
 #define PLENOPTIC_ARRAY_PARAMS_H
 
+#include <string>
+#include <vector>
+
+#include "plenoptic/array/lens_errors.h"
 #include "plenoptic/array/microlens_array.h"
 #include "plenoptic/core/lattice.h"
 
@@ -28,6 +32,14 @@ struct ArrayParams {
     double rotate_deg[3] = {0, 0, 0};       // about x, then y, then z (POV-Ray's order)
     double translate_mm[3] = {0, 0, 0};     // camera frame, after the rotation
     double abbe = 0;                        // the microlenses' Abbe number V_d; 0: no dispersion
+    // Manufacturing errors: errors { } (has_errors) or lens_table "file" (lens_table_file not empty).
+    bool has_errors = false;
+    ErrorSpec errors;
+    std::string lens_table_file;
+    std::vector<LensTableRow> lens_table;
+    double fill_factor = 1;                 // the part of each cell that is lens
+    bool mask = false;                      // the gap is opaque (a chrome mask)
+    bool baffles = false;                   // walls between microimages: no cross-talk
 };
 
 // The lenses of a checked specification, of their kind.

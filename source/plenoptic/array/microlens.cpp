@@ -32,8 +32,7 @@ public:
 
     ArrayRay sample_ray(const MicrolensArray& array, const Vec3& p, LensIndex lens, double, double) const override
     {
-        const Vec2 c = array.centre_local(lens);
-        const Vec3 leave = array.to_optics(Vec3{c.x, c.y, 0});
+        const Vec3 leave = array.to_optics(array.centre_local3(lens));
         const Vec3 direction = leave - p;
         if (!(dot(direction, array.pose.normal) > 0))
             return no_ray();  // the sensor point is not behind the array
@@ -70,33 +69,42 @@ public:
         return std::make_shared<ThinMicrolens>(focal, type_count_);
     }
 
+    // A point of the lens's cell, uniform over it; refraction in the lens's own frame (the array's,
+    // moved to the lens centre and turned to its axis). A point of the cell's gap (fill_factor)
+    // passes light unbent, unless a mask blocks it.
     ArrayRay sample_ray(const MicrolensArray& array, const Vec3& p, LensIndex lens, double u, double v) const override
     {
-        // A point of the lens cell; refraction in the array's own frame.
-        const double f = focal(array, lens);
-        const Vec2 c = array.centre_local(lens);
+        const LensFrame frame = array.frame(lens);
         const Vec2 offset = array.cell_point(u, v);
-        const Vec3 leave = array.to_optics(Vec3{c.x + offset.x, c.y + offset.y, 0});
-        const Vec3 w = mul_transposed(array.pose.rotation, leave - p);
+        const bool lens_part = array.in_aperture(offset);
+        if (!lens_part && array.mask)
+            return no_ray();
+        const Vec3 in_plane{offset.x, offset.y, 0};
+        const Vec3 leave = array.to_optics(frame.centre + (frame.tilted ? mul(frame.axes, in_plane) : in_plane));
+        Vec3 w = mul_transposed(array.pose.rotation, leave - p);
+        if (frame.tilted)
+            w = mul_transposed(frame.axes, w);
         if (!(w.z > 0))
             return no_ray();
-        const Vec3 refracted{w.x / w.z - offset.x / f, w.y / w.z - offset.y / f, 1};
+        const double f = frame.focal_mm;
+        Vec3 refracted = lens_part ? Vec3{w.x / w.z - offset.x / f, w.y / w.z - offset.y / f, 1} : Vec3{w.x / w.z, w.y / w.z, 1};
+        if (frame.tilted)
+            refracted = mul(frame.axes, refracted);
         return ArrayRay{leave, mul(array.pose.rotation, refracted), true};
     }
 
     // The lens images the target O to the homogeneous point I = (o, 1 - o_z/f) (lens-relative
     // coordinates); every ray from p aimed at I leaves the lens through O. No division by
-    // (1 + D/d - D/f), so near-degenerate set-ups only block rays.
+    // (1 + D/d - D/f), so near-degenerate set-ups only block rays. In the lens's own frame; a point
+    // of the cell's gap is not a point of the lens (fill_factor).
     ArrayRay ray_through(const MicrolensArray& array, const Vec3& p, LensIndex lens, Vec3 target, bool check_cell) const override
     {
-        const Vec2 c = array.centre_local(lens);
-        const double f = focal(array, lens);
-        const Vec3 o = array.to_local(target);
-        const Vec3 s = array.to_local(p);
-        if (!(o.z > 0) || !(s.z < 0))
+        const LensFrame frame = array.frame(lens);
+        const double f = frame.focal_mm;
+        const Vec3 o_rel = to_lens(frame, array.to_local(target));
+        const Vec3 p_rel = to_lens(frame, array.to_local(p));
+        if (!(o_rel.z > 0) || !(p_rel.z < 0))
             return no_ray();
-        const Vec3 o_rel{o.x - c.x, o.y - c.y, o.z};
-        const Vec3 p_rel{s.x - c.x, s.y - c.y, s.z};
         const double w = 1 - o_rel.z / f;
         Vec3 along = o_rel - w * p_rel;  // direction of the line p -> I
         if (along.z < 0)
@@ -106,26 +114,51 @@ public:
         const double t = -p_rel.z / along.z;
         const double hx = p_rel.x + t * along.x;
         const double hy = p_rel.y + t * along.y;
-        if (check_cell && array.nearest(c.x + hx, c.y + hy) != lens)
-            return no_ray();
-        const Vec3 local_out{along.x / along.z - hx / f, along.y / along.z - hy / f, 1};
+        if (check_cell) {
+            const Vec3 h_local = frame.centre + from_lens(frame, Vec3{hx, hy, 0});
+            if (array.nearest(h_local.x, h_local.y) != lens || !array.in_aperture(Vec2{hx, hy}))
+                return no_ray();
+        }
+        const Vec3 local_out = from_lens(frame, Vec3{along.x / along.z - hx / f, along.y / along.z - hy / f, 1});
         return ArrayRay{target, mul(array.pose.rotation, local_out), true};
     }
 
     ArrayRay towards_sensor(const MicrolensArray& array, LensIndex lens, Vec3 h, Vec3 direction) const override
     {
-        const Vec3 w = mul_transposed(array.pose.rotation, direction);
+        const LensFrame frame = array.frame(lens);
+        Vec3 w = mul_transposed(array.pose.rotation, direction);
+        if (frame.tilted)
+            w = mul_transposed(frame.axes, w);
         if (!(w.z < 0))
             return no_ray();
-        const Vec3 h_local = array.to_local(h);
-        const Vec2 c = array.centre_local(lens);
-        const double f = focal(array, lens);
-        const Vec3 out_local{w.x / -w.z - (h_local.x - c.x) / f, w.y / -w.z - (h_local.y - c.y) / f, -1};
-        return ArrayRay{h, mul(array.pose.rotation, out_local), true};
+        // Where the light meets the lens's plane, relative to its centre, in its own frame (h itself
+        // when the lens lies in the array's plane: h is on it).
+        Vec3 rel = array.to_local(h) - frame.centre;
+        double to_plane = 0;
+        if (frame.tilted || frame.centre.z != 0) {
+            if (frame.tilted)
+                rel = mul_transposed(frame.axes, rel);
+            to_plane = rel.z / -w.z;
+        }
+        const double hx = rel.x + to_plane * w.x, hy = rel.y + to_plane * w.y;
+        const bool lens_part = array.in_aperture(Vec2{hx, hy});
+        if (!lens_part && array.mask)
+            return no_ray();
+        const double f = frame.focal_mm;
+        const Vec3 out_local = from_lens(frame, lens_part ? Vec3{w.x / -w.z - hx / f, w.y / -w.z - hy / f, -1}
+                                                          : Vec3{w.x / -w.z, w.y / -w.z, -1});
+        const Vec3 at = to_plane == 0 ? h : array.to_optics(frame.centre + from_lens(frame, Vec3{hx, hy, 0}));
+        return ArrayRay{at, mul(array.pose.rotation, out_local), true};
     }
 
 private:
-    double focal(const MicrolensArray& array, LensIndex lens) const { return focal_mm_[array.type_of(lens)]; }
+    // Array-local points (relative to the array's origin) to the lens's own frame and directions back.
+    static Vec3 to_lens(const LensFrame& frame, Vec3 local)
+    {
+        const Vec3 rel = local - frame.centre;
+        return frame.tilted ? mul_transposed(frame.axes, rel) : rel;
+    }
+    static Vec3 from_lens(const LensFrame& frame, Vec3 v) { return frame.tilted ? mul(frame.axes, v) : v; }
 
     int type_count_;
     double focal_mm_[3];

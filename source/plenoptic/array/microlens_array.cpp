@@ -88,6 +88,30 @@ MicrolensArray make_microlens_array(GridType grid, double pitch_mm, std::shared_
     return array;
 }
 
+LensIndex MicrolensArray::nearest_displaced(LensIndex lattice, double x, double y) const
+{
+    // Every displacement is below a quarter of the pitch (kErrorSigmas and the checks), so the lens
+    // whose actual centre is nearest is the lattice cell's or one of its neighbours'.
+    const std::int64_t skew = skew_k(grid, lattice);
+    const bool hexagonal = grid == GridType::Hexagonal;
+    LensIndex best = lattice;
+    double best_sq = INFINITY;
+    for (int dl = -1; dl <= 1; ++dl) {
+        for (int dk = -1; dk <= 1; ++dk) {
+            if (hexagonal && std::abs(dk + dl) > 1)
+                continue;
+            const LensIndex lens = (dk == 0 && dl == 0) ? lattice : from_skew(grid, skew + dk, lattice.l + dl);
+            const Vec2 c = centre_local(lens);
+            const double sq = (x - c.x) * (x - c.x) + (y - c.y) * (y - c.y);
+            if (sq < best_sq) {
+                best_sq = sq;
+                best = lens;
+            }
+        }
+    }
+    return best;
+}
+
 MicrolensArray MicrolensArray::at_wavelength(double wavelength_nm) const
 {
     MicrolensArray out = *this;
@@ -112,6 +136,13 @@ MetadataJson MicrolensArray::metadata(const double rotate_deg[3], const double t
     json["translate_mm"] = json_numbers(translate_mm, 3);
     if (abbe != 0)
         json["abbe_number"] = json_number(abbe);
+    if (errors || fill_factor != 1 || mask || baffles) {
+        json["fill_factor"] = json_number(fill_factor);
+        json["gap"] = fill_factor == 1 ? "none" : (mask ? "masked" : "clear");
+        json["baffles"] = baffles;
+    }
+    if (errors)
+        json["errors"] = errors->metadata();
     return json;
 }
 

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "plenoptic/array/lens_errors.h"
 #include "plenoptic/array/microlens.h"
 #include "plenoptic/core/lattice.h"
 #include "plenoptic/core/vec.h"
@@ -34,6 +35,16 @@ Mat3 rotation_from_degrees(const double degrees[3]);
 // The pose rotated by `rotate_deg` (about x, then y, then z) with lens (0, 0) at centre_mm.
 ArrayPose make_array_pose(const double rotate_deg[3], Vec3 centre_mm);
 
+// One lens as it is (its manufacturing errors applied): its centre in the array's own frame, its
+// optical axis and its focal length. axes maps the lens's own frame (its cell in the plane z = 0
+// about its centre, its axis +z) to the array's; the identity when it is not tilted.
+struct LensFrame {
+    Vec3 centre;
+    bool tilted;
+    Mat3 axes;
+    double focal_mm;  // NaN for a pinhole
+};
+
 // The array. present() false: the camera has none; grid is then None, every number 0, microlens
 // nullptr, and the pose unrotated at the plane where an array would be (z = -D; 0 without a main
 // lens), so that distances measured to it stay defined. The methods below that concern lenses are
@@ -51,6 +62,18 @@ struct MicrolensArray {
     // microlens's power scales with (n(lambda) - 1) / (n_d - 1) of the two-term model (lens/glass.h),
     // which V_d alone fixes (at_wavelength).
     double abbe = 0;
+    // Manufacturing errors, lens by lens (array/lens_errors.h); nullptr: every lens is ideal.
+    std::shared_ptr<const LensErrors> errors;
+    // The part of each cell that is lens: a copy of the cell scaled by sqrt(fill_factor) about the
+    // lens centre (aperture_scale); the rest of the cell is a gap of flat substrate, through which
+    // light passes unbent, or which a mask (mask true) blocks.
+    double fill_factor = 1;
+    double aperture_scale = 1;
+    bool mask = false;
+    // Walls between the microimages: a pixel receives light through its own lens only. Off (real
+    // arrays have none): light leaving a lens lands wherever it lands, under a neighbour's
+    // microimage too (PlenopticCamera::overlap).
+    bool baffles = false;
 
     bool present() const { return grid != GridType::None; }
 
@@ -58,19 +81,66 @@ struct MicrolensArray {
     Vec3 to_local(Vec3 optics) const { return mul_transposed(pose.rotation, optics - pose.centre_mm); }
     Vec3 to_optics(Vec3 local) const { return pose.centre_mm + mul(pose.rotation, local); }
 
-    // Lens centres: array-local (in its plane), and in the optics frame.
-    Vec2 centre_local(LensIndex lens) const { return lens_centre(grid, pitch_mm, lens); }
-    Vec3 centre_mm(LensIndex lens) const
+    // A lens's lattice point (array-local, in its plane): where an ideal array has its centre.
+    Vec2 lattice_centre_local(LensIndex lens) const { return lens_centre(grid, pitch_mm, lens); }
+    // The lens's error (the ideal lens's when the array has none).
+    LensError error_of(LensIndex lens) const { return errors ? errors->at(lens) : LensError(); }
+    // Lens centres as they are: array-local in its plane (x, y), array-local in 3-D (with the
+    // displacement along the normal), and in the optics frame.
+    Vec2 centre_local(LensIndex lens) const
     {
-        const Vec2 c = centre_local(lens);
-        return to_optics(Vec3{c.x, c.y, 0});
+        const Vec2 c = lattice_centre_local(lens);
+        if (!errors)
+            return c;
+        const LensError e = errors->at(lens);
+        return Vec2{c.x + e.dx_mm, c.y + e.dy_mm};
     }
-    // The lens whose cell contains the array-local point (x, y) (core/lattice.h: nearest_lens).
-    LensIndex nearest(double x, double y) const { return nearest_lens(grid, pitch_mm, x, y); }
+    Vec3 centre_local3(LensIndex lens) const
+    {
+        const Vec2 c = lattice_centre_local(lens);
+        if (!errors)
+            return Vec3{c.x, c.y, 0};
+        const LensError e = errors->at(lens);
+        return Vec3{c.x + e.dx_mm, c.y + e.dy_mm, e.dz_mm};
+    }
+    Vec3 centre_mm(LensIndex lens) const { return to_optics(centre_local3(lens)); }
+    // The lens whose cell contains the array-local point (x, y): its lattice cell
+    // (core/lattice.h: nearest_lens) for an ideal array; with errors, the lens whose actual centre
+    // is nearest, among that cell's lens and its neighbours (the cells of displaced lenses move
+    // with them).
+    LensIndex nearest(double x, double y) const
+    {
+        const LensIndex lattice = nearest_lens(grid, pitch_mm, x, y);
+        return errors ? nearest_displaced(lattice, x, y) : lattice;
+    }
     // Which lens type a lens is (0 .. lens_type_count - 1), and its focal length (lenses that form
-    // an image only).
+    // an image only), its error included.
     int type_of(LensIndex lens) const { return lens_type_count == 1 ? 0 : lens_type(lens, lens_type_count); }
-    double focal_length_mm(LensIndex lens) const { return microlens->focal_length_mm(type_of(lens)); }
+    double focal_length_mm(LensIndex lens) const
+    {
+        const double f = microlens->focal_length_mm(type_of(lens));
+        return errors ? f * errors->at(lens).focal_factor : f;
+    }
+    // The lens as it is: centre, axis and focal length in one lookup.
+    LensFrame frame(LensIndex lens) const
+    {
+        const double f = microlens->focal_length_mm(type_of(lens));
+        const Vec2 c = lattice_centre_local(lens);
+        if (!errors)
+            return LensFrame{Vec3{c.x, c.y, 0}, false, identity_mat3(), f};
+        const LensError e = errors->at(lens);
+        return LensFrame{Vec3{c.x + e.dx_mm, c.y + e.dy_mm, e.dz_mm}, e.tilted(),
+                         e.tilted() ? frame_to_axis(e.axis) : identity_mat3(), f * e.focal_factor};
+    }
+    // Whether a point of a lens's cell (relative to its centre, in its plane) is lens rather than
+    // gap (fill_factor).
+    bool in_aperture(Vec2 offset) const
+    {
+        if (aperture_scale == 1)
+            return true;
+        const LensIndex own = nearest_lens(grid, pitch_mm * aperture_scale, offset.x, offset.y);
+        return own.k == 0 && own.l == 0;
+    }
 
     // A lens's cell, relative to its centre: the point for the sample (u, v) in [0, 1)^2 (uniform,
     // (0.5, 0.5) the centre), and its corners counter-clockwise (returns 4 or 6).
@@ -86,6 +156,9 @@ struct MicrolensArray {
     // The metadata's microlens_array section (present arrays only): grid, lens kind, pitch, the
     // focal lengths, d, and the pose as the scene gave it (degrees and mm, from the spec).
     nlohmann::ordered_json metadata(const double rotate_deg[3], const double translate_mm[3]) const;
+
+private:
+    LensIndex nearest_displaced(LensIndex lattice, double x, double y) const;
 };
 
 // No array: see MicrolensArray; plane_z is where an array would be.

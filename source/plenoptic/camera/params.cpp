@@ -412,6 +412,68 @@ std::string check_array(const ArrayParams& array)
         if (!(message = check_translation("translate", array.translate_mm[i])).empty())
             return message;
     }
+    return check_array_errors(array);
+}
+
+std::string check_error_deviation(const char* keyword, double value)
+{
+    if (!(value >= 0))
+        return std::string(keyword) + " " + format_number(value) + " must be zero or positive (a standard deviation)";
+    return "";
+}
+
+std::string check_error_rotation(double degrees)
+{
+    if (!(degrees >= 0 && degrees < 30))
+        return "errors rotation " + format_number(degrees) + " must be in [0, 30) degrees (the largest tilt of a lens's axis)";
+    return "";
+}
+
+std::string check_fill_factor(double value)
+{
+    if (!(value > 0 && value <= 1))
+        return "microlens_array fill_factor " + format_number(value) +
+               " must be in (0, 1] (the part of each cell that is lens)";
+    return "";
+}
+
+std::string check_array_errors(const ArrayParams& array)
+{
+    const bool pinholes = array.lens == MicrolensType::Pinhole;
+    if (array.has_errors && !array.lens_table_file.empty())
+        return "microlens_array takes errors { } or lens_table, not both";
+    if (array.has_errors) {
+        const ErrorSpec& e = array.errors;
+        // Every lens within a quarter pitch of its lattice point (kErrorSigmas standard deviations),
+        // so that a lens is found from its lattice cell and its neighbours.
+        const double largest = array.pitch_mm / (4 * kErrorSigmas * std::sqrt(2.0));
+        if (!(e.position_sd_mm < largest))
+            return "errors position " + format_number(e.position_sd_mm) + " must be below " + format_number(largest) +
+                   " mm for pitch " + format_number(array.pitch_mm) + " mm (pitch / (16 sqrt 2): every lens within a quarter "
+                   "pitch of its lattice point)";
+        if (!(e.position_sd_z_mm < array.pitch_mm / (4 * kErrorSigmas)))
+            return "errors position: S_z " + format_number(e.position_sd_z_mm) + " must be below " +
+                   format_number(array.pitch_mm / (4 * kErrorSigmas)) + " mm (pitch / 16)";
+        if (!(e.focal_sd < 0.2 / kErrorSigmas))
+            return "errors focal_length " + format_number(e.focal_sd) + " must be below " +
+                   format_number(0.2 / kErrorSigmas) + " (a relative standard deviation: 0.01 is 1 %)";
+        if (pinholes && (e.focal_sd > 0 || e.rotation_deg > 0))
+            return "errors focal_length and rotation need microlenses that form an image (pinholes have neither a focal "
+                   "length nor an axis): use position only";
+    }
+    if (!array.lens_table_file.empty() && pinholes)
+        for (const LensTableRow& row : array.lens_table)
+            if (row.focal_length_mm > 0 || row.error.tilt_deg > 0)
+                return "lens_table \"" + array.lens_table_file + "\": lens (" + std::to_string(row.lens.k) + ", " +
+                       std::to_string(row.lens.l) + ") has a focal length or a tilt, which pinholes do not have";
+    if (array.fill_factor != 1 || array.mask) {
+        if (pinholes)
+            return "microlens_array fill_factor and mask need microlenses that form an image (a pinhole passes light "
+                   "at its centre only)";
+        const std::string message = check_fill_factor(array.fill_factor);
+        if (!message.empty())
+            return message;
+    }
     return "";
 }
 

@@ -104,6 +104,9 @@ std::string check_confidence(double value);
 std::string check_blades(double value);                                     // a whole number 3..kMaxBlades
 std::string check_variance(double value);
 std::string check_angular_exponent(double value);                          // 0 .. kMaxAngularExponent
+std::string check_error_deviation(const char* keyword, double value);      // errors position, focal_length: >= 0
+std::string check_error_rotation(double degrees);                           // errors rotation: [0, 30)
+std::string check_fill_factor(double value);                                // (0, 1]
 
 // ---- Cross-field checks, run when a block's closing brace is read. ----
 std::string check_main_lens(const MainLensParams& main, double mm_per_unit);
@@ -120,6 +123,8 @@ std::string describe_surface(const Prescription& lens, int index, const std::str
 // suggest a value to type.
 std::string format_rounded(double value, bool round_up);
 std::string check_array(const ArrayParams& array);
+// Part of check_array: manufacturing errors, fill factor and mask.
+std::string check_array_errors(const ArrayParams& array);
 std::string check_sensor(const SensorParams& sensor);
 std::string check_sampling(const SamplingParams& sampling);
 // spectral N with its response (camera/spectral_bands.h): "" when off or usable.

@@ -22,11 +22,12 @@ struct OverlapGeometry {
     double blur_mm;        // reach of a lens cell's light beyond that, on the sensor
     double blur_inradius_mm; // same with the cell's inradius (a round lens of diameter p)
     double cell_mm;        // inradius of a microimage cell on the sensor
+    double shift_mm;       // how far manufacturing errors can move a microimage from its cell
 };
 
 OverlapGeometry overlap_geometry(const PlenopticCamera& m)
 {
-    OverlapGeometry g{0, 0, 0, 0, 0};
+    OverlapGeometry g{0, 0, 0, 0, 0, 0};
     const double main_distance = effective_main_distance_mm(m);
     const double array_distance = effective_array_distance_mm(m);
     g.magnification = array_distance / main_distance;
@@ -35,12 +36,25 @@ OverlapGeometry overlap_geometry(const PlenopticCamera& m)
     else if (m.lens)
         g.disc_mm = m.lens->exit_pupil_radius() * g.magnification;
     if (m.array.microlens->forms_image()) {
-        double worst = 0;
-        for (int t = 0; t < m.array.lens_type_count; ++t)
-            worst = std::max(worst, std::fabs(1 + g.magnification - array_distance / m.array.microlens->focal_length_mm(t)));
-        g.blur_mm = m.array.cell_circumradius_mm * worst;
+        // worst: the ideal lenses' defocus, which the warning speaks of; reach: with the errors'
+        // focal lengths and a clear gap's unbent light too, which the modelling must cover.
+        double worst = 0, reach = 0;
+        const double deviation = m.array.errors ? m.array.errors->max_focal_deviation() : 0;
+        for (int t = 0; t < m.array.lens_type_count; ++t) {
+            const double f = m.array.microlens->focal_length_mm(t);
+            worst = std::max(worst, std::fabs(1 + g.magnification - array_distance / f));
+            for (double scale : {1 - deviation, 1 + deviation})
+                reach = std::max(reach, std::fabs(1 + g.magnification - array_distance / (scale * f)));
+        }
+        reach = std::max(reach, worst);
+        if (m.array.fill_factor < 1 && !m.array.mask)
+            reach = std::max(reach, 1 + g.magnification);  // light through a clear gap is not bent
+        g.blur_mm = m.array.cell_circumradius_mm * reach;
         g.blur_inradius_mm = m.array.cell_inradius_mm * worst;
     }
+    // Displaced lenses move their microimages by up to this relative to their cells.
+    if (m.array.errors)
+        g.shift_mm = 2 * (m.array.errors->max_shift_mm() + m.array.errors->max_dz_mm()) * (1 + g.magnification);
     g.cell_mm = m.array.cell_inradius_mm * (1 + g.magnification);
     return g;
 }
@@ -62,10 +76,10 @@ void place_pupil_bounds(PlenopticCamera& m)
 Overlap overlap_of(const PlenopticCamera& m)
 {
     Overlap overlap;
-    if (m.array.grid == GridType::None || !m.lens)
+    if (m.array.grid == GridType::None || !m.lens || m.array.baffles)
         return overlap;
     const OverlapGeometry g = overlap_geometry(m);
-    const double reach = g.disc_mm + g.blur_mm;
+    const double reach = g.disc_mm + g.blur_mm + g.shift_mm;
     if (!(reach > g.cell_mm))
         return overlap;
     overlap.modelled = true;
@@ -73,7 +87,8 @@ Overlap overlap_of(const PlenopticCamera& m)
     const double lattice_reach = (reach + pixel_reach) / (1 + g.magnification) + m.array.cell_circumradius_mm;
     // Ring r of the lattice is at least r times this far from the own lens.
     const double ring_step = m.array.row_spacing_mm();
-    double rings = std::ceil(lattice_reach / ring_step) + (m.array.pose.tilted ? 1 : 0);
+    const bool lenses_tilt = m.array.errors && m.array.errors->tilts();
+    double rings = std::ceil(lattice_reach / ring_step) + (m.array.pose.tilted || lenses_tilt ? 1 : 0);
     if (!(rings >= 1))
         rings = 1;
     if (!(rings <= kMaxOverlapRings)) {

@@ -3,6 +3,7 @@
 
 #include "plenoptic/camera/rays.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "plenoptic/camera/radiometry.h"
@@ -155,10 +156,16 @@ bool lens_reaches_pixel(const PlenopticCamera& m, LensIndex lens, Vec3 p)
     const double mx = (c.x - e.x) * (1 + k) - (p.x - e.x) * k;
     const double my = (c.y - e.y) * (1 + k) - (p.y - e.y) * k;
     double spread = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]) * k;
-    if (m.array.microlens->forms_image())
-        spread += m.array.cell_circumradius_mm * std::fabs(1 + k - main_distance / m.array.focal_length_mm(lens));
+    if (m.array.microlens->forms_image()) {
+        double blur = std::fabs(1 + k - main_distance / m.array.focal_length_mm(lens));
+        if (m.array.fill_factor < 1 && !m.array.mask)
+            blur = std::max(blur, 1 + k);  // light through a clear gap is not bent
+        spread += m.array.cell_circumradius_mm * blur;
+    }
     if (m.array.pose.tilted)
         spread *= 1.25 + 4 * m.array.pose.tilt_sine;
+    if (m.array.errors && m.array.errors->tilts())
+        spread *= 1.25 + 4 * std::sin(m.array.errors->max_tilt_deg() * (kPi / 180));
     if (m.pupil_bounds) {
         // A real lens: the region where light from the lens centre passes its apertures.
         const PupilDisc disc = m.pupil_bounds->disc_for(c);

@@ -52,6 +52,8 @@ inline Vec3 normalized(Vec3 a)
 // Row-major 3x3 matrix: m[row][column].
 struct Mat3 { double m[3][3]; };
 
+inline Mat3 identity_mat3() { return Mat3{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}}; }
+
 inline Vec3 mul(const Mat3& r, Vec3 v)
 {
     return Vec3{r.m[0][0] * v.x + r.m[0][1] * v.y + r.m[0][2] * v.z,

@@ -117,7 +117,7 @@ void fit_lftoolbox(const PlenopticCamera& m, MicroimageLattice* lattice)
 MicroimageCentre microimage_centre_px(const PlenopticCamera& m, LensIndex lens)
 {
     Vec2 px;
-    if (m.array.grid == GridType::None || !local_to_px(m, m.array.centre_local(lens), &px))
+    if (m.array.grid == GridType::None || !local_to_px(m, m.array.lattice_centre_local(lens), &px))
         return MicroimageCentre{0, 0, false};
     return MicroimageCentre{px.x, px.y, true};
 }

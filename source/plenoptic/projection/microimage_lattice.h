@@ -17,7 +17,8 @@ struct MicroimageCentre {
 };
 
 // Centre of lens `lens`'s microimage in pixels (centre convention): the central projection of the
-// posed lens centre from the main-lens centre onto the sensor (orthogonal without main lens).
+// posed lens centre from the main-lens centre onto the sensor (orthogonal without main lens); with
+// manufacturing errors, of its lattice point (where an ideal array has it).
 MicroimageCentre microimage_centre_px(const PlenopticCamera& model, LensIndex lens);
 
 // The microimage-centre lattice in pixel coordinates (centre convention) and its LFToolbox form.
