@@ -150,9 +150,10 @@ LensError LensErrors::draw(LensIndex lens) const
     // deviation leaves the other errors of every lens as they were.
     const double nx = stream.normal(), ny = stream.normal(), nz = stream.normal(), nf = stream.normal();
     const double tilt_u = stream.uniform(), azimuth_u = stream.uniform();
-    e.dx_mm = spec_.position_sd_mm * nx;
-    e.dy_mm = spec_.position_sd_mm * ny;
-    e.dz_mm = spec_.position_sd_z_mm * nz;
+    // + 0.0: a zero standard deviation gives +0, never -0.
+    e.dx_mm = spec_.position_sd_mm * nx + 0.0;
+    e.dy_mm = spec_.position_sd_mm * ny + 0.0;
+    e.dz_mm = spec_.position_sd_z_mm * nz + 0.0;
     e.focal_factor = 1 + spec_.focal_sd * nf;
     if (spec_.rotation_deg > 0) {
         const double cos_max = std::cos(spec_.rotation_deg * (kPi / 180));

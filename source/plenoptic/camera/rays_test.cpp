@@ -418,6 +418,24 @@ TEST(Optics, OverlapPruningNeverDropsALensThatDeliversLight)
     pinhole_main.main.distance_mm = 55;
     test::add_array(&pinhole_main, GridType::Hexagonal, 0.2, 0.5, 2.0);
     check_overlap_pruning("pinhole main lens, strong microlenses", pinhole_main, 0.6);
+    // Manufacturing errors: displaced, tilted lenses of scattered focal lengths, and clear gaps.
+    CameraParams jittered = plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 2.5, 50);
+    jittered.array.has_errors = true;
+    jittered.array.errors.position_sd_mm = 0.004;
+    jittered.array.errors.position_sd_z_mm = 0.003;
+    jittered.array.errors.focal_sd = 0.04;
+    jittered.array.errors.rotation_deg = 5;
+    jittered.array.errors.seed = 11;
+    check_overlap_pruning("plenoptic 1.0 with errors", jittered, 0.6);
+    CameraParams focused_errors = plenoptic_camera(GridType::Rectangular, 0.2, 1.5, 2.0, 50, 2, 55);
+    focused_errors.array.has_errors = true;
+    focused_errors.array.errors.position_sd_mm = 0.006;
+    focused_errors.array.errors.focal_sd = 0.03;
+    focused_errors.array.errors.rotation_deg = 2;
+    check_overlap_pruning("focused 2.0 with errors", focused_errors, 0.6);
+    CameraParams clear_gap = plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 5, 50);
+    clear_gap.array.fill_factor = 0.6;
+    check_overlap_pruning("matched plenoptic 1.0 with clear gaps", clear_gap, 0.8);
 }
 
 TEST(Optics, OverlapLensesListsTheOwnLensFirst)

@@ -175,6 +175,9 @@ Json microimages_json(const MicroimageSummary* summary)
             json["columns"].push_back(column);
         json["channel_wavelengths_nm"] = json_numbers(summary->channel_wavelengths_nm, 3);
     }
+    if (summary->lens_errors)
+        for (const char* column : {"dx_mm", "dy_mm", "dz_mm", "focal_length_mm", "tilt_deg", "tilt_azimuth_deg"})
+            json["columns"].push_back(column);
     json["lenses"] = summary->lenses;
     json["lit_lenses"] = summary->lit_lenses;
     Json integration = Json::object();

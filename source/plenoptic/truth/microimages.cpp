@@ -425,6 +425,7 @@ MicroimageSummary summarise_microimages(const PlenopticCamera& m, const std::vec
     summary.lenses = truth.size();
     summary.lit_lenses = 0;
     summary.options = options;
+    summary.lens_errors = m.array.errors != nullptr;
     summary.fit = fit_microimage_lattice(m, truth);
     double sum2 = 0, largest = 0;
     for (const MicroimageTruth& t : truth) {
@@ -464,8 +465,10 @@ std::string microimages_csv(const PlenopticCamera& m, const std::vector<Microima
                             const std::vector<std::vector<MicroimageTruth>>& channels)
 {
     const bool per_channel = channels.size() == 3;
+    const bool errors = m.array.errors != nullptr;
     std::string out = "k,l,u,v,lit_fraction,residual_u,residual_v";
-    out += per_channel ? ",u_r,v_r,u_g,v_g,u_b,v_b\n" : "\n";
+    out += per_channel ? ",u_r,v_r,u_g,v_g,u_b,v_b" : "";
+    out += errors ? ",dx_mm,dy_mm,dz_mm,focal_length_mm,tilt_deg,tilt_azimuth_deg\n" : "\n";
     for (std::size_t index = 0; index < truth.size(); ++index) {
         const MicroimageTruth& t = truth[index];
         out += std::to_string(static_cast<long long>(t.lens.k)) + "," + std::to_string(static_cast<long long>(t.lens.l));
@@ -483,6 +486,13 @@ std::string microimages_csv(const PlenopticCamera& m, const std::vector<Microima
         for (std::size_t c = 0; per_channel && c < 3; ++c) {
             const MicroimageTruth& ct = channels[c][index];
             out += ct.lit ? "," + shortest(ct.u_px) + "," + shortest(ct.v_px) : ",,";
+        }
+        if (errors) {
+            // The lens as it is (array/lens_errors.h): the columns a lens_table reads back.
+            const LensError e = m.array.error_of(t.lens);
+            out += "," + shortest(e.dx_mm) + "," + shortest(e.dy_mm) + "," + shortest(e.dz_mm) + ",";
+            out += m.array.microlens->forms_image() ? shortest(m.array.focal_length_mm(t.lens)) : std::string();
+            out += "," + shortest(e.tilt_deg) + "," + shortest(e.tilt_azimuth_deg);
         }
         out += "\n";
     }

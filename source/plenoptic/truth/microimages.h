@@ -102,6 +102,8 @@ struct MicroimageSummary {
     // these wavelengths (channel_wavelengths_nm); 0: none.
     bool per_channel = false;
     double channel_wavelengths_nm[3] = {0, 0, 0};
+    // The array has manufacturing errors: the file has each lens's (dx_mm ... tilt_azimuth_deg).
+    bool lens_errors = false;
 };
 
 MicroimageSummary summarise_microimages(const PlenopticCamera& model, const std::vector<MicroimageTruth>& truth,
@@ -111,7 +113,9 @@ MicroimageSummary summarise_microimages(const PlenopticCamera& model, const std:
 // lens (row-form indices, centre-convention pixels, the residuals from the fit); u, v and the
 // residuals are empty for a dark lens, the residuals also when the fit is not valid. With three
 // `channels` (the same lenses measured at the R, G and B wavelengths), six more columns,
-// u_r,v_r,u_g,v_g,u_b,v_b, empty where that channel's microimage is dark. Numbers in the shortest
+// u_r,v_r,u_g,v_g,u_b,v_b, empty where that channel's microimage is dark. With manufacturing errors
+// (array/lens_errors.h), each lens as it is: dx_mm,dy_mm,dz_mm,focal_length_mm,tilt_deg,
+// tilt_azimuth_deg (the focal length empty for pinholes), which lens_table reads back. Numbers in the shortest
 // form that reads back to the same double.
 std::string microimages_csv(const PlenopticCamera& model, const std::vector<MicroimageTruth>& truth, const LatticeFit& fit,
                             const std::vector<std::vector<MicroimageTruth>>& channels =

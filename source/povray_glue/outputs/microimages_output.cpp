@@ -2,7 +2,8 @@
 // The microimage centres output: <image>.microimages.csv, the microimages of a white scene through
 // this camera (truth/microimages.h), and their summary in the metadata. Needs a main lens and an
 // array; `microimage_centres` on or off, and by default written only where the centres leave the
-// lattice the metadata gives (a traced lens, a thin lens with distortion).
+// lattice the metadata gives (a traced lens, a thin lens with distortion, an array with manufacturing
+// errors).
 
 #include <cstdio>
 
@@ -67,7 +68,7 @@ std::unique_ptr<Output> start_microimages(const Render& render, const RenderArea
 {
     const PlenopticCamera& model = render.model();
     const CameraSetup::MicroimageCentres asked = render.setup().microimage_centres;
-    const bool off_lattice = (model.lens && model.lens->traced()) || model.distortion();
+    const bool off_lattice = (model.lens && model.lens->traced()) || model.distortion() || model.array.errors;
     if (model.array.grid == GridType::None || !model.lens ||
         !(asked == CameraSetup::kWrite || (asked == CameraSetup::kDefault && off_lattice)))
         return nullptr;
