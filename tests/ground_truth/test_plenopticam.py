@@ -86,14 +86,14 @@ def venv_python(args):
     return python
 
 
-def camera(grid, pitch, extra=""):
+def camera(grid, pitch, extra="", array_extra=""):
     f_micro = N * pitch  # f/2 microlenses at d = f (plenoptic 1.0, f-number matched)
     return ("camera { plenoptic location <0, 0, -%r> look_at <0, 0, 0>\n"
             "  main_lens { thin_lens focal_length %r f_number %r focus_distance %r }\n"
-            "  microlens_array { %s pitch %r focal_length %r distance %r }\n"
+            "  microlens_array { %s pitch %r focal_length %r distance %r %s }\n"
             "  sensor { pixel_size %r angular_response 32 }\n"
             "  samples 16 radiometry irradiance diffraction white_image %s }\n"
-            % (FOCUS_M, F, N, FOCUS_M, grid, pitch, f_micro, f_micro, PIXEL, extra))
+            % (FOCUS_M, F, N, FOCUS_M, grid, pitch, f_micro, f_micro, array_extra, PIXEL, extra))
 
 
 def to_npy(png, npy):
@@ -131,7 +131,7 @@ def area_resize(img, rows, cols):
 _RUN_THIS_SESSION = set()
 
 
-def run_plenopticam(args, venv_python, name, grid, pitch):
+def run_plenopticam(args, venv_python, name, grid, pitch, array_extra=""):
     """Renders the camera and runs PlenoptiCam on it once per test session (files left in the
     work folder by an earlier session, perhaps by another build, are not reused): (metadata,
     report, out)."""
@@ -142,7 +142,7 @@ def run_plenopticam(args, venv_python, name, grid, pitch):
     if name not in _RUN_THIS_SESSION:
         if os.path.exists(report_path):
             os.remove(report_path)
-        png = pt.render(args.povray, work, name, CHART + camera(grid, pitch), W, H)
+        png = pt.render(args.povray, work, name, CHART + camera(grid, pitch, array_extra=array_extra), W, H)
         white_png = os.path.splitext(png)[0] + ".white.png"
         os.makedirs(out, exist_ok=True)
         # In its output folder: PlenoptiCam writes some files relative to the working directory.
@@ -197,3 +197,37 @@ def test_plenopticam_decodes_our_raw(args, venv_python, name, grid, pitch):
           % (name, view.shape[1], view.shape[0], report.get("patch"), score))
     pt.save_png(os.path.join(work, name + "_central_view.png"), np.kron(view[..., :3] / view.max(), np.ones((6, 6, 1))))
     assert score > 0.9, score
+
+
+# An array with manufacturing errors: lens centres scattered by 0.5 um (about 0.36 px of microimage
+# shift at 14-pixel microimages). The truth per lens is the render's microimages.csv.
+JITTER = "errors { position 0.0005 seed 3 }"
+
+
+def test_plenopticam_on_a_jittered_array(args, venv_python):
+    name = "hexagonal_14px_jittered"
+    meta, report, out, work = run_plenopticam(args, venv_python, name, "hexagonal", 0.020, JITTER)
+    assert meta["microlens_array"]["errors"]["position_sd_mm"] == 0.0005
+    centroids = np.load(os.path.join(out, "centroids.npy"))[:, [1, 0]]  # (u, v)
+    rows = np.genfromtxt(os.path.join(work, name + ".microimages.csv"), delimiter=",", names=True)
+    rows = rows[np.isfinite(rows["u"])]
+    truth = np.stack([rows["u"], rows["v"]], axis=1)
+    lattice, spacing = lattice_points(meta)
+    # Each PlenoptiCam centre against the nearest true centre, and against the nearest point of the
+    # regular lattice the ideal array would have.
+    to_truth = np.sqrt(((centroids[:, None, :] - truth[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
+    to_lattice = np.sqrt(((centroids[:, None, :] - lattice[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
+    truth_from_lattice = np.sqrt(((truth[:, None, :] - lattice[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
+    print("%s: PlenoptiCam found %d microimages; the true centres lie %.3f px (mean; rms %.3f) from the regular"
+          " lattice; PlenoptiCam's centres lie %.3f px from the truth (mean; max %.3f) and %.3f px from the lattice"
+          " (mean; max %.3f)" % (name, len(centroids), truth_from_lattice.mean(), math.sqrt((truth_from_lattice ** 2).mean()),
+                                 to_truth.mean(), to_truth.max(), to_lattice.mean(), to_lattice.max()))
+    assert len(centroids) >= 0.5 * len(truth)
+    # The scatter is real: the true centres leave the lattice by about 0.5 px rms.
+    assert math.sqrt((truth_from_lattice ** 2).mean()) > 0.3
+    # PlenoptiCam 0.9.3 finds every microimage within half a pixel of its true centre on average, but
+    # it does not resolve the lenses' displacements: its centres stay nearer a regular lattice than
+    # the true centres are (measured: 0.36 px from the truth, 0.31 px from the lattice, against the
+    # truth's 0.44 px mean from the lattice; docs/camera.md, "Real microlens arrays").
+    assert to_truth.mean() < 0.5, to_truth.mean()
+    assert to_lattice.mean() < truth_from_lattice.mean(), (to_lattice.mean(), truth_from_lattice.mean())

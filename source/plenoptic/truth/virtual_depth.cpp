@@ -47,7 +47,19 @@ float pixel_virtual_depth(const PlenopticCamera& m, int i, int j, float distance
     // At infinity: a point as far as a length can be (1e12 mm) images within 1e-10 of the
     // focal plane, below a float's resolution of v.
     const double along = std::isinf(distance_units) ? kMaxLengthMm : double(distance_units) * m.mm_per_unit;
-    return float(virtual_depth(m, origin + along * dir));
+    const Vec3 point = origin + along * dir;
+    if (m.array.errors && m.lens && m.lens->forms_image()) {
+        // A lens displaced along the normal: v from its own plane, v = -a_L / d_L.
+        const OwnLens own = own_lens(m, m.sensor.point(i + 0.5, j + 0.5));
+        const HomogeneousPoint image = m.lens->paraxial_image(point);
+        if (own.found && image.w != 0) {
+            const Vec3 c = m.array.centre_mm(own.lens);
+            const Vec3 x = (1 / image.w) * image.xyz;
+            const double v = -dot(m.array.pose.normal, x - c) / dot(m.array.pose.normal, c - Vec3{0, 0, m.sensor.z_mm});
+            return std::isfinite(v) ? float(v) : std::numeric_limits<float>::quiet_NaN();
+        }
+    }
+    return float(virtual_depth(m, point));
 }
 
 } // namespace plenoptic

@@ -1,0 +1,134 @@
+# SPDX-License-Identifier: AGPL-3.0-or-later
+"""Microlens arrays with manufacturing errors, fill factors and masks, rendered (docs/camera.md,
+"Real microlens arrays").
+
+- Jittered lenses: each microimage's centroid in a white world, measured on the rendered image,
+  must lie within 0.05 px of the truth the render writes (microimages.csv) and of the independent
+  answer: the central projection of the displaced lens centre (the CSV's dx_mm, dy_mm added to the
+  lattice point written out here) from the thin main lens's centre onto the sensor. The lenses
+  really move (the truth leaves the lattice by more than the tolerance).
+- A lens table made of that CSV gives the same render (the truth reads back as the array).
+- Energy: a white world through a masked array delivers the fill factor's share of the light of
+  the ideal array (the lens part of the array's area); through clear gaps all of it.
+"""
+import math
+import os
+
+import numpy as np
+
+import plenoptic_testing as pt
+
+W, H = 200, 150
+PIXEL = 0.01            # mm
+PITCH, F_MICRO = 0.15, 0.6
+FOCAL, FOCUS_MM = 25.0, 2000.0
+D = FOCAL * FOCUS_MM / (FOCUS_MM - FOCAL)  # thin-lens conjugate: the array's distance
+
+
+def scene(f_number, array_extra, extra="samples 64"):
+    return (pt.WORLD_HEADER + "background { rgb 1 }\n"
+            "camera { plenoptic location <0, 0, -2> look_at <0, 0, 0>\n"
+            "  main_lens { thin_lens focal_length %r f_number %r focus_distance 2 }\n"
+            "  microlens_array { hexagonal pitch %r focal_length %r distance %r %s }\n"
+            "  sensor { pixel_size %r }\n  %s\n}\n"
+            % (FOCAL, f_number, PITCH, F_MICRO, F_MICRO, array_extra, PIXEL, extra))
+
+
+def render(args, name, text):
+    work = os.path.join(args.work, "array_errors")
+    path = pt.render(args.povray, work, name, text, W, H)
+    return path, work
+
+
+def projected_centre_px(k, l, dx, dy):
+    """Pixel (centre convention) of the displaced lens centre projected from the main lens's centre."""
+    x = (k + (l % 2) / 2.0) * PITCH + dx
+    y = l * PITCH * math.sqrt(3) / 2 + dy
+    scale = (D + F_MICRO) / D
+    return W / 2.0 - 0.5 - x * scale / PIXEL, H / 2.0 - 0.5 + y * scale / PIXEL
+
+
+def component_centroids(image):
+    """Centroid (u, v) and summed value of each lit microimage not touching the picture's edge."""
+    value = image[..., :3].mean(axis=2)
+    labels, count = pt.label_components(value > 0, connectivity=8)
+    out = []
+    vv, uu = np.mgrid[0:H, 0:W]
+    for index in range(1, count + 1):
+        mask = labels == index
+        if mask[0, :].any() or mask[-1, :].any() or mask[:, 0].any() or mask[:, -1].any():
+            continue
+        w = value[mask]
+        out.append((float((uu[mask] * w).sum() / w.sum()), float((vv[mask] * w).sum() / w.sum()), float(w.sum())))
+    return np.array(out)
+
+
+def test_jittered_microimages_sit_where_the_truth_says(args):
+    # f/8 main lens behind f/4 microlenses: microimages of half the cell, apart from each other.
+    path, work = render(args, "jittered", scene(8, "errors { position 0.005 seed 5 }"))
+    meta = pt.metadata_of(path)
+    errors = meta["microlens_array"]["errors"]
+    assert errors["source"] == "drawn" and errors["position_sd_mm"] == 0.005 and errors["seed"] == 5
+    rows = np.genfromtxt(os.path.join(work, "jittered.microimages.csv"), delimiter=",", names=True)
+    assert "dx_mm" in rows.dtype.names and "tilt_deg" in rows.dtype.names
+    assert meta["microimages"]["columns"][-6:] == ["dx_mm", "dy_mm", "dz_mm", "focal_length_mm", "tilt_deg",
+                                                   "tilt_azimuth_deg"]
+    rows = rows[np.isfinite(rows["u"])]
+    truth = np.stack([rows["u"], rows["v"]], axis=1)
+    projected = np.array([projected_centre_px(int(r["k"]), int(r["l"]), r["dx_mm"], r["dy_mm"]) for r in rows])
+    lattice = np.array([projected_centre_px(int(r["k"]), int(r["l"]), 0.0, 0.0) for r in rows])
+    # The truth is the projection of the displaced centre (a thin lens, d = f, no vignetting).
+    assert np.abs(truth - projected).max() < 0.01, np.abs(truth - projected).max()
+    moved = np.hypot(*(truth - lattice).T)
+    print("true centres from the lattice: rms %.3f px, max %.3f px" % (math.sqrt((moved ** 2).mean()), moved.max()))
+    assert math.sqrt((moved ** 2).mean()) > 0.2
+    # The rendered microimages.
+    found = component_centroids(pt.read_linear(path))
+    assert len(found) >= 40, len(found)
+    distances = []
+    for u, v, _ in found:
+        d = np.hypot(truth[:, 0] - u, truth[:, 1] - v)
+        i = int(d.argmin())
+        distances.append(d[i])
+        assert d[i] < 0.05, "microimage at (%.2f, %.2f): truth (%.3f, %.3f) is %.3f px away" % (
+            u, v, truth[i, 0], truth[i, 1], d[i])
+    print("rendered centroids from the truth: mean %.4f px, max %.4f px over %d microimages"
+          % (np.mean(distances), np.max(distances), len(found)))
+
+
+def test_a_lens_table_made_of_the_truth_gives_the_same_render(args):
+    errors = "errors { position 0.003 0.002 focal_length 0.02 rotation 2 seed 9 }"
+    drawn, work = render(args, "drawn", scene(4, errors, "samples 16"))
+    table = os.path.join(work, "drawn.microimages.csv")
+    tabled, _ = render(args, "tabled", scene(4, 'lens_table "%s"' % table, "samples 16"))
+    meta = pt.metadata_of(tabled)
+    assert meta["microlens_array"]["errors"]["source"] == "lens_table"
+    a, b = pt.read_linear(drawn), pt.read_linear(tabled)
+    # The table holds the lenses whose microimages are in the picture; the lenses beyond it (ideal in
+    # the tabled render) reach only the picture's edge, so compare 20 px inside it. The focal lengths
+    # read back within a rounding (f from the CSV over the type's f), which may move a sample across
+    # a rim: at most one sample of 16 in one pixel of 1000.
+    d = np.abs(a - b).max(axis=2)[20:-20, 20:-20]
+    print("tabled against drawn: %d of %d interior pixels differ, by at most %.4f" % ((d > 2e-3).sum(), d.size, d.max()))
+    assert (d > 2e-3).sum() <= d.size // 1000
+    assert d.max() < 1 / 16.0 + 2e-3
+    ideal = pt.read_linear(render(args, "ideal", scene(4, "", "samples 16"))[0])
+    assert np.abs(a - ideal).max() > 0.1, "the errors change the picture"
+
+
+def central_mean(path):
+    image = pt.read_linear(path)[..., :3]
+    return float(image[H // 4: 3 * H // 4, W // 4: 3 * W // 4].mean())
+
+
+def test_masked_array_delivers_the_fill_factors_share_of_the_light(args):
+    ideal = central_mean(render(args, "full", scene(4, ""))[0])
+    masked_path, _ = render(args, "masked", scene(4, "fill_factor 0.6 mask on"))
+    masked = central_mean(masked_path)
+    clear = central_mean(render(args, "clear", scene(4, "fill_factor 0.6"))[0])
+    meta = pt.metadata_of(masked_path)["microlens_array"]
+    assert meta["fill_factor"] == 0.6 and meta["gap"] == "masked" and meta["baffles"] is False
+    print("white world, central half: ideal %.5f, masked %.5f (ratio %.4f), clear gaps %.5f (ratio %.4f)"
+          % (ideal, masked, masked / ideal, clear, clear / ideal))
+    assert abs(masked / ideal - 0.6) < 0.01
+    assert abs(clear / ideal - 1.0) < 0.01
