@@ -74,6 +74,18 @@ public:
     // passes light unbent, unless a mask blocks it.
     ArrayRay sample_ray(const MicrolensArray& array, const Vec3& p, LensIndex lens, double u, double v) const override
     {
+        if (!array.errors && array.aperture_scale == 1) {
+            // Ideal lenses filling their cells: the lattice centre, the type's focal length.
+            const double f = focal_mm_[array.type_of(lens)];
+            const Vec2 c = array.lattice_centre_local(lens);
+            const Vec2 offset = array.cell_point(u, v);
+            const Vec3 leave = array.to_optics(Vec3{c.x + offset.x, c.y + offset.y, 0});
+            const Vec3 w = mul_transposed(array.pose.rotation, leave - p);
+            if (!(w.z > 0))
+                return no_ray();
+            const Vec3 refracted{w.x / w.z - offset.x / f, w.y / w.z - offset.y / f, 1};
+            return ArrayRay{leave, mul(array.pose.rotation, refracted), true};
+        }
         const LensFrame frame = array.frame(lens);
         const Vec2 offset = array.cell_point(u, v);
         const bool lens_part = array.in_aperture(offset);
