@@ -12,6 +12,7 @@ from . import __doc__ as USAGE
 from .build import section_build
 from .dark import section_dark
 from .spectral import section_spectral
+from .arrays import section_arrays
 from .dataset import section_dataset
 from .fullsize import section_fullsize
 from .lenses import section_lenses
@@ -50,7 +51,7 @@ def main():
         return 2
     runs = 1 if args.quick else args.runs
     sections = args.only or ["overhead", "lenses", "trade", "dark", "threads", "fullsize", "real_lens",
-                             "fullsize_real_lens", "realism", "spectral", "dataset"]
+                             "fullsize_real_lens", "realism", "spectral", "arrays", "dataset"]
     os.makedirs(args.out, exist_ok=True)
     work = tempfile.mkdtemp(prefix="plenoptic-bench-")
     b = Bench(os.path.abspath(args.povray), work, runs)
@@ -135,6 +136,11 @@ def main():
                              (64, 48) if args.quick else (966, 671), 32 if args.quick else 128, results)
             save()
             done("spectral")
+        if "arrays" in sections:
+            section_arrays(b, (64, 48) if args.quick else (480, 320), 1 if args.quick else max(runs, 5),
+                           (32, 24) if args.quick else (96, 64), results)
+            save()
+            done("arrays")
         if "dataset" in sections:
             section_dataset(b, args.quick, runs, results)
             save()

@@ -350,6 +350,9 @@ def write_report(results, path, plots, results_path):
         realism_report(L, results)
     if results.get("spectral"):
         spectral_report(L, results)
+    if results.get("arrays"):
+        from .arrays import arrays_report
+        arrays_report(L, results)
     if results.get("dataset"):
         dataset_report(L, results)
     analysis = os.path.join(ROOT, "benchmarks", "analysis.md")

@@ -54,6 +54,8 @@ using plenoptic::KeywordValue;
 // Most bytes read from a lens file: a prescription is a few hundred; this bounds a wrong file
 // (a device, an image) to a prompt refusal.
 const size_t kMaxLensFileBytes = 1 << 20;
+// A lens table has a row per lens: millions of lenses fit.
+const size_t kMaxLensTableBytes = size_t(1) << 28;
 // A traced lens with this many surfaces or more prints its setup's progress (about a second's work for 100).
 const size_t kSetupProgressSurfaces = 100;
 
@@ -131,7 +133,8 @@ class PlenopticParser
 		void Parse_Keyword(const Keyword& keyword, BlockState& state);
 		void Parse_Modifiers(KeywordBlock block);
 		void Parse_Word(const Keyword& keyword, KeywordRead& read);
-		std::string Read_Named_File(const char *keyword, const char *kind, bool lenses_folder, std::string *file);
+		std::string Read_Named_File(const char *keyword, const char *kind, bool lenses_folder, std::string *file,
+		                            size_t max_bytes = kMaxLensFileBytes);
 		void Parse_Lens_File(KeywordRead& read);
 		void Parse_Response_File(KeywordRead& read);
 		void Parse_Lens_Table(KeywordRead& read);
@@ -391,7 +394,8 @@ void PlenopticParser::Parse_Word(const Keyword& keyword, KeywordRead& read)
 // lenses/ folder installed with the program. *file is the name as written. Refused (naming the
 // keyword, the file and `kind`, what the file should be): an empty name, a file not found, a
 // directory, a file larger than kMaxLensFileBytes.
-std::string PlenopticParser::Read_Named_File(const char *keyword, const char *kind, bool lenses_folder, std::string *file)
+std::string PlenopticParser::Read_Named_File(const char *keyword, const char *kind, bool lenses_folder, std::string *file,
+                                             size_t max_bytes)
 {
 	const FilePos position = Token.Token_File_Pos;
 	const int column = Token.Token_Col_No;
@@ -418,11 +422,11 @@ std::string PlenopticParser::Read_Named_File(const char *keyword, const char *ki
 		Check_At(quoted + " names a directory (" + path + "), not " + kind, position, column);
 	}
 	std::string text;
-	for (int c = stream->Read_Byte(); c != EOF && text.size() <= kMaxLensFileBytes; c = stream->Read_Byte())
+	for (int c = stream->Read_Byte(); c != EOF && text.size() <= max_bytes; c = stream->Read_Byte())
 		text.push_back((char)c);
 	delete stream;
-	if (text.size() > kMaxLensFileBytes)
-		Check_At(quoted + " is larger than " + std::to_string(kMaxLensFileBytes) + " bytes: not " + kind, position, column);
+	if (text.size() > max_bytes)
+		Check_At(quoted + " is larger than " + std::to_string(max_bytes) + " bytes: not " + kind, position, column);
 	return text;
 }
 
@@ -451,7 +455,8 @@ void PlenopticParser::Parse_Lens_Table(KeywordRead& read)
 	const FilePos position = Token.Token_File_Pos;
 	const int column = Token.Token_Col_No;
 	std::string file;
-	const std::string text = Read_Named_File("lens_table", "a lens table (k, l, dx_mm, dy_mm, ... per row)", false, &file);
+	const std::string text = Read_Named_File("lens_table", "a lens table (k, l, dx_mm, dy_mm, ... per row)", false, &file,
+	                                         kMaxLensTableBytes);
 	const plenoptic::ArrayParams& array = setup->params.array;
 	if (!array.has_pitch)
 		Check_At("lens_table \"" + file + "\" must come after the array's pitch (the shifts are checked against it)",

@@ -165,7 +165,7 @@ LensError LensErrors::draw(LensIndex lens) const
     return e;
 }
 
-LensError LensErrors::at(LensIndex lens) const
+const LensError& LensErrors::at(LensIndex lens) const
 {
     thread_local CacheSlot cache[kCacheSlots];
     CacheSlot& slot = cache[lens_key(lens) & (kCacheSlots - 1)];

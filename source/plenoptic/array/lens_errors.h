@@ -80,7 +80,7 @@ public:
                                                     const double* type_focal_mm, int type_count);
 
     // The lens's error; the same for every caller, in any order, on any thread.
-    LensError at(LensIndex lens) const;
+    const LensError& at(LensIndex lens) const;
 
     // Bounds over every lens: the largest in-plane displacement, |dz|, |focal factor - 1|, tilt.
     double max_shift_mm() const { return max_shift_mm_; }

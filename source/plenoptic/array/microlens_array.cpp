@@ -91,16 +91,24 @@ MicrolensArray make_microlens_array(GridType grid, double pitch_mm, std::shared_
 LensIndex MicrolensArray::nearest_displaced(LensIndex lattice, double x, double y) const
 {
     // Every displacement is below a quarter of the pitch (kErrorSigmas and the checks), so the lens
-    // whose actual centre is nearest is the lattice cell's or one of its neighbours'.
+    // whose actual centre is nearest is the lattice cell's or one of its neighbours'. A neighbour
+    // whose lattice point is farther than the best distance so far plus the largest shift cannot
+    // be nearer: its error is not looked up (most points are well inside their cells).
     const std::int64_t skew = skew_k(grid, lattice);
     const bool hexagonal = grid == GridType::Hexagonal;
+    const double shift = errors->max_shift_mm();
     LensIndex best = lattice;
-    double best_sq = INFINITY;
+    const Vec2 c0 = centre_local(lattice);
+    double best_sq = (x - c0.x) * (x - c0.x) + (y - c0.y) * (y - c0.y);
     for (int dl = -1; dl <= 1; ++dl) {
         for (int dk = -1; dk <= 1; ++dk) {
-            if (hexagonal && std::abs(dk + dl) > 1)
+            if ((dk == 0 && dl == 0) || (hexagonal && std::abs(dk + dl) > 1))
                 continue;
-            const LensIndex lens = (dk == 0 && dl == 0) ? lattice : from_skew(grid, skew + dk, lattice.l + dl);
+            const LensIndex lens = from_skew(grid, skew + dk, lattice.l + dl);
+            const Vec2 n = lattice_centre_local(lens);
+            const double reach = std::sqrt(best_sq) + shift;
+            if ((x - n.x) * (x - n.x) + (y - n.y) * (y - n.y) > reach * reach)
+                continue;
             const Vec2 c = centre_local(lens);
             const double sq = (x - c.x) * (x - c.x) + (y - c.y) * (y - c.y);
             if (sq < best_sq) {

@@ -92,7 +92,7 @@ struct MicrolensArray {
         const Vec2 c = lattice_centre_local(lens);
         if (!errors)
             return c;
-        const LensError e = errors->at(lens);
+        const LensError& e = errors->at(lens);
         return Vec2{c.x + e.dx_mm, c.y + e.dy_mm};
     }
     Vec3 centre_local3(LensIndex lens) const
@@ -100,7 +100,7 @@ struct MicrolensArray {
         const Vec2 c = lattice_centre_local(lens);
         if (!errors)
             return Vec3{c.x, c.y, 0};
-        const LensError e = errors->at(lens);
+        const LensError& e = errors->at(lens);
         return Vec3{c.x + e.dx_mm, c.y + e.dy_mm, e.dz_mm};
     }
     Vec3 centre_mm(LensIndex lens) const { return to_optics(centre_local3(lens)); }
@@ -128,7 +128,7 @@ struct MicrolensArray {
         const Vec2 c = lattice_centre_local(lens);
         if (!errors)
             return LensFrame{Vec3{c.x, c.y, 0}, false, identity_mat3(), f};
-        const LensError e = errors->at(lens);
+        const LensError& e = errors->at(lens);
         return LensFrame{Vec3{c.x + e.dx_mm, c.y + e.dy_mm, e.dz_mm}, e.tilted(),
                          e.tilted() ? frame_to_axis(e.axis) : identity_mat3(), f * e.focal_factor};
     }

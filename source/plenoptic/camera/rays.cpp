@@ -164,8 +164,12 @@ bool lens_reaches_pixel(const PlenopticCamera& m, LensIndex lens, Vec3 p)
     }
     if (m.array.pose.tilted)
         spread *= 1.25 + 4 * m.array.pose.tilt_sine;
-    if (m.array.errors && m.array.errors->tilts())
-        spread *= 1.25 + 4 * std::sin(m.array.errors->max_tilt_deg() * (kPi / 180));
+    if (m.array.errors && m.array.errors->tilts()) {
+        // This lens's own tilt, with the margin of a tilted array (validated by brute force).
+        const double tilt = m.array.errors->at(lens).tilt_deg;
+        if (tilt > 0)
+            spread *= 1.25 + 4 * std::sin(tilt * (kPi / 180));
+    }
     if (m.pupil_bounds) {
         // A real lens: the region where light from the lens centre passes its apertures.
         const PupilDisc disc = m.pupil_bounds->disc_for(c);
