@@ -387,7 +387,7 @@ void read_main_lens(const Json& root, CameraParams* params)
     m.distance_mm = positive_number(member(main, parent, "distance_mm"), parent + ".distance_mm");
 }
 
-void read_array(const Json& root, CameraParams* params)
+void read_array(const Json& root, CameraParams* params, const std::string& folder)
 {
     const std::string parent = "microlens_array";
     const Json& v = member(root, "", parent);
@@ -437,6 +437,52 @@ void read_array(const Json& root, CameraParams* params)
     // The microlenses' Abbe number: absent when they do not disperse.
     if (v.contains("abbe_number"))
         a.abbe = finite_number(v["abbe_number"], parent + ".abbe_number");
+    // A real array: fill factor, gap, baffles, and its manufacturing errors (drawn again from
+    // their seed, or read from the microimages file beside the metadata, which lists each lens of
+    // the picture as it was).
+    if (v.contains("fill_factor")) {
+        a.fill_factor = positive_number(v["fill_factor"], parent + ".fill_factor");
+        a.mask = string_member(v, parent, "gap") == "masked";
+        const Json& baffles = member(v, parent, "baffles");
+        if (!baffles.is_boolean())
+            refuse(parent + ".baffles", "true or false", baffles);
+        a.baffles = baffles.get<bool>();
+    }
+    if (v.contains("errors")) {
+        const std::string where = parent + ".errors";
+        const Json& e = object_member(v, parent, "errors");
+        const std::string source = string_member(e, where, "source");
+        if (source == "drawn") {
+            a.has_errors = true;
+            a.errors.position_sd_mm = finite_number(member(e, where, "position_sd_mm"), where + ".position_sd_mm");
+            a.errors.position_sd_z_mm = finite_number(member(e, where, "position_sd_z_mm"), where + ".position_sd_z_mm");
+            a.errors.focal_sd = finite_number(member(e, where, "focal_length_sd"), where + ".focal_length_sd");
+            a.errors.rotation_deg = finite_number(member(e, where, "rotation_deg"), where + ".rotation_deg");
+            const Json& seed = member(e, where, "seed");
+            if (!seed.is_number_integer())
+                refuse(where + ".seed", "a whole number", seed);
+            a.errors.seed = seed.get<std::int64_t>();
+        } else if (source == "lens_table") {
+            const Json& microimages = member(root, "", "microimages");
+            if (!microimages.is_object() || folder.empty())
+                refuse(where, "errors that a reader can rebuild: a lens table needs the microimages file beside the "
+                              "metadata (read the metadata file, not its text)", e);
+            const std::string file = folder + "/" + string_member(microimages, "microimages", "file");
+            std::ifstream in(file.c_str(), std::ios::binary);
+            std::ostringstream text;
+            text << in.rdbuf();
+            if (!in)
+                refuse(where, "a lens table's lenses, read from the microimages file " + file + " (which cannot be opened)", e);
+            const ParsedLensTable table = parse_lens_table(text.str(), a.pitch_mm);
+            if (!table.error.empty())
+                refuse(where, "a lens table's lenses from " + file + " (line " + std::to_string(table.error_line) + ": " +
+                                  table.error + ")", e);
+            a.lens_table_file = file;
+            a.lens_table = table.rows;
+        } else {
+            refuse(where + ".source", "\"drawn\" or \"lens_table\"", member(e, where, "source"));
+        }
+    }
 }
 
 void read_frame(const Json& root, CameraFrame* frame)
@@ -459,7 +505,7 @@ void read_frame(const Json& root, CameraFrame* frame)
                          "(they must span 3-D space)");
 }
 
-void read_all(const Json& root, RenderMetadata* out)
+void read_all(const Json& root, RenderMetadata* out, const std::string& folder)
 {
     if (!root.is_object())
         refuse("(top level)", "an object", root);
@@ -479,7 +525,7 @@ void read_all(const Json& root, RenderMetadata* out)
     p.mm_per_unit = positive_number(member(root, "", "mm_per_unit"), "mm_per_unit");
     read_frame(root, &out->frame);
     read_main_lens(root, &p);
-    read_array(root, &p);
+    read_array(root, &p, folder);
 
     const Json& sensor = object_member(root, "", "sensor");
     numbers(sensor, "sensor", "pixel_size_mm", 2, true, p.sensor.pixel_size_mm);
@@ -533,7 +579,7 @@ void read_all(const Json& root, RenderMetadata* out)
 
 } // namespace
 
-MetadataReading parse_metadata(const std::string& text)
+MetadataReading parse_metadata(const std::string& text, const std::string& folder)
 {
     MetadataReading reading;
     Json root;
@@ -548,7 +594,7 @@ MetadataReading parse_metadata(const std::string& text)
         return reading;
     }
     try {
-        read_all(root, &reading.metadata);
+        read_all(root, &reading.metadata, folder);
         return reading;
     } catch (const FieldError& e) {
         reading.error = e.what();
@@ -573,7 +619,8 @@ MetadataReading read_metadata_file(const std::string& path)
         reading.error = "cannot read the metadata file";
         return reading;
     }
-    return parse_metadata(text.str());
+    const std::size_t slash = path.find_last_of('/');
+    return parse_metadata(text.str(), slash == std::string::npos ? std::string(".") : path.substr(0, slash));
 }
 
 OpticsPoint world_to_optics_mm(const RenderMetadata& md, Vec3 world)

@@ -38,7 +38,9 @@ struct MetadataReading {
 // the offending field, e.g. "field 'main_lens.focal_length_mm' must be a positive number, found
 // null". Also checks that the stored derived values (sensor plane, principal point, lattice
 // origin) agree with the parameters, to catch edited files.
-MetadataReading parse_metadata(const std::string& text);
+// `folder`: where the metadata file is, for the files it names that the camera needs (the
+// microimages file of an array whose errors came from a lens table); "" when there is none.
+MetadataReading parse_metadata(const std::string& text, const std::string& folder = "");
 
 // Reads the file, then parse_metadata. Errors start with the cause ("cannot open", "not valid
 // JSON (...)", "field ..."); the caller names the file.

@@ -126,6 +126,42 @@ TEST(MetadataReader, ReadsAConicAndAsphericLensBack)
     }
 }
 
+// An array with drawn manufacturing errors, a fill factor and a mask: the reader draws the same
+// lenses again, so plenoptic-project projects through the array the render traced.
+TEST(MetadataReader, ReadsAnArrayWithErrorsBack)
+{
+    CameraParams p = hexagonal_camera();
+    p.array.has_errors = true;
+    p.array.errors.position_sd_mm = 0.003;
+    p.array.errors.position_sd_z_mm = 0.001;
+    p.array.errors.focal_sd = 0.02;
+    p.array.errors.rotation_deg = 2;
+    p.array.errors.seed = 17;
+    p.array.fill_factor = 0.8;
+    p.array.mask = true;
+    const PlenopticCamera m = with_film(make_camera(p), 320, 240);
+    const MetadataReading reading = parse_metadata(metadata_json(m, p, kFrame, "scene.depth.exr"));
+    ASSERT_TRUE(reading.ok()) << reading.error;
+    const MicrolensArray& read = reading.metadata.model.array;
+    ASSERT_TRUE(read.errors != nullptr);
+    EXPECT_EQ(read.fill_factor, 0.8);
+    EXPECT_TRUE(read.mask);
+    EXPECT_FALSE(read.baffles);
+    for (int k = -4; k <= 4; ++k) {
+        const LensIndex lens{k, 3 - 2 * k};
+        const Vec3 a = m.array.centre_mm(lens), b = read.centre_mm(lens);
+        EXPECT_EQ(a.x, b.x);
+        EXPECT_EQ(a.z, b.z);
+        EXPECT_EQ(m.array.focal_length_mm(lens), read.focal_length_mm(lens));
+        EXPECT_EQ(m.array.error_of(lens).tilt_deg, read.error_of(lens).tilt_deg);
+        EXPECT_NE(a.x, m.array.to_optics(Vec3{m.array.lattice_centre_local(lens).x, 0, 0}).x);
+    }
+    // Errors from a lens table need the microimages file beside the metadata file.
+    const std::string tabled = edited(metadata_json(m, p, kFrame, "scene.depth.exr"), "\"source\": \"drawn\"",
+                                      "\"source\": \"lens_table\"");
+    EXPECT_TRUE(contains(refusal(tabled), "microlens_array.errors")) << refusal(tabled);
+}
+
 TEST(MetadataReader, AcceptsUtf8AndSurrogatePairs)
 {
     // "\u00e9" escaped, U+1F600 as a surrogate pair, and raw UTF-8.
