@@ -51,7 +51,8 @@ Diffraction diffraction_of(const PlenopticCamera& m, const DiffractionParams& pa
         if (!m.array.microlens->forms_image())
             return out;  // a pinhole has no aperture with a size
         out.aperture = "microlens";
-        out.aperture_diameter_mm = 2 * m.array.cell_inradius_mm;
+        // The lens part of the cell (fill_factor): a copy of the cell scaled by sqrt(F).
+        out.aperture_diameter_mm = 2 * m.array.cell_inradius_mm * m.array.aperture_scale;
         out.distance_mm = effective_array_distance_mm(m);
     } else {
         if (!m.lens || !(m.lens->exit_pupil_radius() > 0))

@@ -51,7 +51,9 @@ double blur_radius_px(const PlenopticCamera& m, Vec3 point, LensIndex lens)
     }
     const double f = m.array.focal_length_mm(lens);
     const double d = c.z - m.sensor.z_mm;
-    const double r = 0.5 * m.array.pitch_mm * d * (1 / f - inverse_a - 1 / d);
+    // The lens's aperture: a disc of diameter p (the BAP model), scaled with the lens part of the
+    // cell (fill_factor).
+    const double r = 0.5 * m.array.pitch_mm * m.array.aperture_scale * d * (1 / f - inverse_a - 1 / d);
     return std::isfinite(r) ? r / m.sensor.pixel_size_mm[0] : kNaN;
 }
 
