@@ -461,11 +461,11 @@ void PlenopticParser::Parse_Lens_Table(KeywordRead& read)
 	if (!array.has_pitch)
 		Check_At("lens_table \"" + file + "\" must come after the array's pitch (the shifts are checked against it)",
 		         position, column);
-	const plenoptic::ParsedLensTable table = plenoptic::parse_lens_table(text, array.pitch_mm);
+	plenoptic::ParsedLensTable table = plenoptic::parse_lens_table(text, array.pitch_mm);
 	if (!table.error.empty())
 		Check_At("lens_table \"" + file + "\", line " + std::to_string(table.error_line) + ": " + table.error, position,
 		         column);
-	read.lens_table = table.rows;
+	read.lens_table = std::make_shared<const std::vector<plenoptic::LensTableRow>>(std::move(table.rows));
 	read.text = file;
 }
 

@@ -68,7 +68,7 @@ struct KeywordRead {
     std::string text;              // String: the string
     Prescription prescription;     // String: the surfaces of the lens file it names
     SpectralResponse response;     // ResponseFile: the table it names
-    std::vector<LensTableRow> lens_table;  // LensTable: the rows of the table it names
+    std::shared_ptr<const std::vector<LensTableRow>> lens_table;  // LensTable: the rows of the table it names
     long line = 0;                 // where the keyword is written
     long column = 0;
     long long offset = 0;

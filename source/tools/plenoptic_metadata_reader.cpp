@@ -478,7 +478,7 @@ void read_array(const Json& root, CameraParams* params, const std::string& folde
                 refuse(where, "a lens table's lenses from " + file + " (line " + std::to_string(table.error_line) + ": " +
                                   table.error + ")", e);
             a.lens_table_file = file;
-            a.lens_table = table.rows;
+            a.lens_table = std::make_shared<const std::vector<LensTableRow>>(table.rows);
         } else {
             refuse(where + ".source", "\"drawn\" or \"lens_table\"", member(e, where, "source"));
         }

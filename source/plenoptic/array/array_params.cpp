@@ -29,7 +29,7 @@ MicrolensArray make_microlens_array(const ArrayParams& params, double array_z)
     if (params.has_errors)
         array.errors = LensErrors::drawn(params.errors);
     else if (!params.lens_table_file.empty())
-        array.errors = LensErrors::tabled(params.lens_table, params.lens_table_file, params.focal_lengths_mm,
+        array.errors = LensErrors::tabled(params.lens_table ? *params.lens_table : std::vector<LensTableRow>(), params.lens_table_file, params.focal_lengths_mm,
                                           params.lens == MicrolensType::Pinhole ? 0 : array.lens_type_count);
     array.fill_factor = params.fill_factor;
     array.aperture_scale = params.fill_factor == 1 ? 1 : std::sqrt(params.fill_factor);

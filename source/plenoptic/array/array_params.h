@@ -6,6 +6,7 @@
 #ifndef PLENOPTIC_ARRAY_PARAMS_H
 #define PLENOPTIC_ARRAY_PARAMS_H
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -36,7 +37,9 @@ struct ArrayParams {
     bool has_errors = false;
     ErrorSpec errors;
     std::string lens_table_file;
-    std::vector<LensTableRow> lens_table;
+    // The table's rows, shared: camera parameters are copied often, and a table may hold a row for
+    // each of hundreds of thousands of lenses.
+    std::shared_ptr<const std::vector<LensTableRow>> lens_table;
     double fill_factor = 1;                 // the part of each cell that is lens
     bool mask = false;                      // the gap is opaque (a chrome mask)
     bool baffles = false;                   // walls between microimages: no cross-talk

@@ -461,8 +461,8 @@ std::string check_array_errors(const ArrayParams& array)
             return "errors focal_length and rotation need microlenses that form an image (pinholes have neither a focal "
                    "length nor an axis): use position only";
     }
-    if (!array.lens_table_file.empty() && pinholes)
-        for (const LensTableRow& row : array.lens_table)
+    if (!array.lens_table_file.empty() && pinholes && array.lens_table)
+        for (const LensTableRow& row : *array.lens_table)
             if (row.focal_length_mm > 0 || row.error.tilt_deg > 0)
                 return "lens_table \"" + array.lens_table_file + "\": lens (" + std::to_string(row.lens.k) + ", " +
                        std::to_string(row.lens.l) + ") has a focal length or a tilt, which pinholes do not have";
