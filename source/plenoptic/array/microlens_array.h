@@ -76,6 +76,9 @@ struct MicrolensArray {
     bool baffles = false;
 
     bool present() const { return grid != GridType::None; }
+    // Every lens lies in the array's plane (no error moves or tilts one out of it): what the main
+    // lens's pupil bounds, made for points of that plane, need.
+    bool lenses_in_plane() const { return !errors || (errors->max_dz_mm() == 0 && !errors->tilts()); }
 
     // The array's own frame (lens (0, 0) at the origin, the lenses in its plane z = 0) and back.
     Vec3 to_local(Vec3 optics) const { return mul_transposed(pose.rotation, optics - pose.centre_mm); }

@@ -129,7 +129,8 @@ bool trace_sensor_point(const PlenopticCamera& m, Vec3 p, const LensIndex* force
     // (PupilBounds holds every point through which light from that point passes, and the bounds
     // were made for points of this plane), so it is blocked without the surface-by-surface trace:
     // most of the rays at the rims of microimages and their vignetting probes.
-    if (check_apertures && m.pupil_bounds && !m.array.pose.tilted && !m.pupil_bounds->may_pass(leave, direction))
+    if (check_apertures && m.pupil_bounds && !m.array.pose.tilted && m.array.lenses_in_plane() &&
+        !m.pupil_bounds->may_pass(leave, direction))
         return false;
     // On through the main lens (a ray that misses its apertures carries no light).
     return weigh(m, emit(m.lens->to_scene(leave, direction, check_apertures), out), p, leave, m.array.pose.normal, out);

@@ -436,6 +436,20 @@ TEST(Optics, OverlapPruningNeverDropsALensThatDeliversLight)
     CameraParams clear_gap = plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 5, 50);
     clear_gap.array.fill_factor = 0.6;
     check_overlap_pruning("matched plenoptic 1.0 with clear gaps", clear_gap, 0.8);
+    // Behind a traced lens (pupil bounds decide), lenses displaced along the normal and tilted.
+    const Prescription triplet = test::vignetting_triplet();
+    CameraParams real = plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 4, paraxial_image_distance(triplet, 3000).mm);
+    real.main.type = MainLensType::Prescription;
+    real.main.has_focal_length = false;
+    real.main.has_f_number = false;
+    real.main.has_prescription = true;
+    real.main.prescription = triplet;
+    real.array.has_errors = true;
+    real.array.errors.position_sd_mm = 0.004;
+    real.array.errors.position_sd_z_mm = 0.005;
+    real.array.errors.focal_sd = 0.03;
+    real.array.errors.rotation_deg = 4;
+    check_overlap_pruning("traced triplet, lenses with errors", real, 0.8);
 }
 
 TEST(Optics, OverlapLensesListsTheOwnLensFirst)
