@@ -64,6 +64,9 @@ std::string Check_White_F_Number(const char *, double value)
 
 const BayerPattern kBayerPatterns[] = {BayerPattern::RGGB, BayerPattern::BGGR, BayerPattern::GRBG, BayerPattern::GBRG};
 const char *Bayer_Word(int index) { return (index >= 0 && index < 4) ? bayer_name(kBayerPatterns[index]) : nullptr; }
+const char *Curved_Side_Word(int index) { return index == 0 ? "scene" : index == 1 ? "sensor" : nullptr; }
+std::string Check_Microlens_Ior(const char *label, double value) { return check_microlens_ior(label, value); }
+std::string Check_Microlens_Conic(const char *label, double value) { return check_microlens_conic(label, value); }
 const Radiometry kRadiometries[] = {Radiometry::Flat, Radiometry::Irradiance};
 const char *Radiometry_Word(int index) { return (index >= 0 && index < 2) ? radiometry_name(kRadiometries[index]) : nullptr; }
 
@@ -327,6 +330,12 @@ std::vector<Keyword> make_table()
         Keyword("pinhole", B::MicrolensArray, V::Flag, "", "every microlens a pinhole",
                 [](CameraSetup& s, R) { set_microlens(s, MicrolensType::Pinhole, 0); })
             .in_group(G::MicrolensKind),
+        Keyword("lens", B::MicrolensArray, V::Block, "", "every microlens a refracting plano-convex cap on a substrate",
+                [](CameraSetup& s, R) {
+                    set_microlens(s, MicrolensType::Refracting, 0);
+                    array(s).refracting = RefractingShape();
+                })
+            .in_group(G::MicrolensKind).opening(B::Microlens).listed_as("lens { }"),
         Keyword("distance", B::MicrolensArray, V::Number, "", "d: array to sensor (mm)",
                 [](CameraSetup& s, R r) { array(s).distance_mm = r.values[0]; array(s).has_distance = true; })
             .reserved_word().labelled("microlens_array distance").checked(check_positive_length),
@@ -371,6 +380,34 @@ std::vector<Keyword> make_table()
         Keyword("seed", B::Errors, V::Number, "0", "which array of the distribution",
                 [](CameraSetup& s, R r) { array(s).errors.seed = (std::int64_t)r.values[0]; })
             .reserved_word().labelled("errors seed").checked(check_whole_number),
+
+        // ---- microlens_array { lens { } }: refracting microlenses (array/refracting_microlens.h) ----
+        Keyword("surface", B::Microlens, V::Block, "", "the cap's curved surface",
+                [](CameraSetup& s, R) {
+                    array(s).refracting.radius_mm = 0;
+                    array(s).refracting.conic = 0;
+                })
+            .in_group(G::MicrolensSurface).needed_in_block().opening(B::MicrolensSurface).listed_as("surface { }"),
+        Keyword("thickness", B::Microlens, V::Number, "", "t: the cap's centre thickness (mm)",
+                [](CameraSetup& s, R r) { array(s).refracting.cap_mm = r.values[0]; })
+            .reserved_word().labelled("microlens_array lens thickness").checked(check_positive_length).needed_in_block(),
+        Keyword("ior", B::Microlens, V::Number, "", "n: the index of refraction of the cap and substrate",
+                [](CameraSetup& s, R r) { array(s).refracting.ior = r.values[0]; })
+            .reserved_word().labelled("microlens_array lens ior").checked(Check_Microlens_Ior).needed_in_block(),
+        Keyword("substrate", B::Microlens, V::Number, "", "T: the substrate's thickness below the caps (mm)",
+                [](CameraSetup& s, R r) { array(s).refracting.substrate_mm = r.values[0]; })
+            .labelled("microlens_array lens substrate").checked(check_positive_length).needed_in_block(),
+        Keyword("curved_side", B::Microlens, V::Word, "scene", "which side the caps face: scene or sensor",
+                [](CameraSetup& s, R r) { array(s).refracting.curved_towards_scene = (int)r.values[0] == 0; })
+            .words(Curved_Side_Word).listed_as("curved_side scene|sensor"),
+
+        // ---- microlens_array { lens { surface { } } } ----
+        Keyword("radius", B::MicrolensSurface, V::Number, "", "R: the cap's radius of curvature at its vertex (mm)",
+                [](CameraSetup& s, R r) { array(s).refracting.radius_mm = r.values[0]; })
+            .reserved_word().labelled("microlens_array lens surface radius").checked(check_positive_length).needed_in_block(),
+        Keyword("conic", B::MicrolensSurface, V::Number, "0: a sphere", "k: the cap's conic constant",
+                [](CameraSetup& s, R r) { array(s).refracting.conic = r.values[0]; })
+            .labelled("microlens_array lens surface conic").checked(Check_Microlens_Conic),
 
         // ---- sensor { }: any read-out keyword (bayer to seed) makes the render write the raw ----
         Keyword("pixel_size", B::Sensor, V::Vector2, "0.01", "the pixel pitch, horizontal and vertical (mm)",
@@ -433,6 +470,8 @@ const KeywordBlockInfo kBlocks[] = {
     {B::Surface, "surface", "surface", nullptr, 0},
     {B::Stop, "stop", "stop", nullptr, 0},
     {B::MicrolensArray, "microlens_array", "microlens_array", nullptr, 0},
+    {B::Microlens, "microlens", "microlens_array lens", nullptr, 0},
+    {B::MicrolensSurface, "microlens_surface", "microlens_array lens surface", nullptr, 0},
     {B::Sensor, "sensor", "sensor", nullptr, 0},
     {B::WhiteImage, "white_image", "white_image", nullptr, 0},
     {B::Diffraction, "diffraction", "diffraction", nullptr, 1},
@@ -492,7 +531,8 @@ const char *keyword_group_message(KeywordGroup group)
         case G::LensSource: return "main_lens takes one lens_file or one prescription { }, not several";
         case G::Distortion: return "main_lens takes one distortion { }, not several";
         case G::Grid: return "microlens_array takes one of hexagonal or rectangular, not both";
-        case G::MicrolensKind: return "microlens_array takes one of pinhole, focal_length or focal_lengths, not several";
+        case G::MicrolensKind: return "microlens_array takes one of pinhole, focal_length, focal_lengths or lens { }, not several";
+        case G::MicrolensSurface: return "microlens_array lens takes one surface { } (the cap; its other side is flat)";
         case G::ArrayRotate: return "microlens_array takes rotate once (about x, then y, then z, in degrees)";
         case G::ArrayTranslate: return "microlens_array takes translate once (mm, after the rotation)";
         case G::ArrayErrors: return "microlens_array takes one of errors { } or lens_table, once";

@@ -29,6 +29,8 @@ enum class KeywordBlock {
     Surface,         // prescription { surface { } }
     Stop,            // prescription { stop { } }
     MicrolensArray,  // microlens_array { }
+    Microlens,       // microlens_array { lens { } }: refracting microlenses
+    MicrolensSurface,  // microlens_array { lens { surface { } } }
     Sensor,          // sensor { }
     WhiteImage,      // the modifiers read right after the camera's white_image
     Diffraction,     // the modifiers read right after the camera's diffraction
@@ -58,7 +60,7 @@ enum class KeywordValue {
 
 // Keywords a block takes one of (or a keyword it takes once): the second is refused.
 enum class KeywordGroup { None, MainLensKind, LensSource, Distortion, Grid, MicrolensKind, ArrayRotate, ArrayTranslate,
-                          ArrayErrors };
+                          ArrayErrors, MicrolensSurface };
 
 // A value as the parser read it, handed to the row's store.
 struct KeywordRead {

@@ -425,8 +425,28 @@ void read_array(const Json& root, CameraParams* params, const std::string& folde
         for (size_t i = 0; i < count; ++i)
             a.focal_lengths_mm[i] =
                 positive_number(focal[i], parent + ".focal_lengths_mm[" + std::to_string(i) + "]");
+    } else if (lens == "refracting") {
+        // The shape as written; focal_lengths_mm (the paraxial focal length) follows from it.
+        a.lens = MicrolensType::Refracting;
+        a.focal_length_count = 0;
+        const std::string where = parent + ".refracting";
+        const Json& r = member(v, parent, "refracting");
+        if (!r.is_object())
+            refuse(where, "an object", r);
+        const Json& surface = member(r, where, "surface");
+        if (!surface.is_object())
+            refuse(where + ".surface", "an object", surface);
+        a.refracting.radius_mm = positive_number(member(surface, where + ".surface", "radius_mm"), where + ".surface.radius_mm");
+        a.refracting.conic = finite_number(member(surface, where + ".surface", "conic"), where + ".surface.conic");
+        a.refracting.ior = positive_number(member(r, where, "ior"), where + ".ior");
+        a.refracting.cap_mm = positive_number(member(r, where, "thickness_mm"), where + ".thickness_mm");
+        a.refracting.substrate_mm = positive_number(member(r, where, "substrate_mm"), where + ".substrate_mm");
+        const std::string side = string_member(r, where, "curved_side");
+        if (side != "scene" && side != "sensor")
+            refuse(where + ".curved_side", "\"scene\" or \"sensor\"", member(r, where, "curved_side"));
+        a.refracting.curved_towards_scene = side == "scene";
     } else {
-        refuse(parent + ".lens", "\"thin_lens\" or \"pinhole\"", member(v, parent, "lens"));
+        refuse(parent + ".lens", "\"thin_lens\", \"pinhole\" or \"refracting\"", member(v, parent, "lens"));
     }
     a.has_pitch = true;
     a.pitch_mm = positive_number(member(v, parent, "pitch_mm"), parent + ".pitch_mm");

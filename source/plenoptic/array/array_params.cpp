@@ -12,6 +12,8 @@ std::shared_ptr<const Microlens> make_microlens(const ArrayParams& params)
     switch (params.lens) {
     case MicrolensType::ThinLens:
         return make_thin_microlens(params.focal_lengths_mm, params.focal_length_count == 3 ? 3 : 1);
+    case MicrolensType::Refracting:
+        return make_refracting_microlens(params.refracting);
     case MicrolensType::Pinhole:
         break;
     }

@@ -12,11 +12,12 @@
 
 #include "plenoptic/array/lens_errors.h"
 #include "plenoptic/array/microlens_array.h"
+#include "plenoptic/array/refracting_microlens.h"
 #include "plenoptic/core/lattice.h"
 
 namespace plenoptic {
 
-enum class MicrolensType { Pinhole, ThinLens };
+enum class MicrolensType { Pinhole, ThinLens, Refracting };
 
 // microlens_array { ... }. `given` is false when the scene has no array (grid stays None).
 struct ArrayParams {
@@ -24,10 +25,11 @@ struct ArrayParams {
     GridType grid = GridType::None;         // None inside a given block: no grid keyword
     bool has_pitch = false;
     double pitch_mm = 0;
-    bool has_lens = false;                  // one of pinhole / focal_length / focal_lengths was read
+    bool has_lens = false;                  // one of pinhole / focal_length / focal_lengths / lens { } was read
     MicrolensType lens = MicrolensType::Pinhole;
     int focal_length_count = 0;             // 0 = pinhole, 1 = focal_length, 3 = focal_lengths
     double focal_lengths_mm[3] = {0, 0, 0};
+    RefractingShape refracting;             // lens { }: the refracting lenses' shape
     bool has_distance = false;
     double distance_mm = 0;                 // d: array -> sensor
     double rotate_deg[3] = {0, 0, 0};       // about x, then y, then z (POV-Ray's order)

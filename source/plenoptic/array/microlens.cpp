@@ -21,7 +21,7 @@ std::vector<double> Microlens::focal_lengths_mm() const
 
 namespace {
 
-ArrayRay no_ray() { return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false}; }
+ArrayRay no_ray() { return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false, Vec3{0, 0, 0}}; }
 
 // A pinhole at each lens centre: every ray through it goes straight on.
 class PinholeMicrolens : public Microlens {
@@ -36,14 +36,14 @@ public:
         const Vec3 direction = leave - p;
         if (!(dot(direction, array.pose.normal) > 0))
             return no_ray();  // the sensor point is not behind the array
-        return ArrayRay{leave, direction, true};
+        return ArrayRay{leave, direction, true, leave};
     }
 
     ArrayRay ray_through(const MicrolensArray&, const Vec3&, LensIndex, Vec3, bool) const override { return no_ray(); }
 
     ArrayRay towards_sensor(const MicrolensArray&, LensIndex, Vec3 h, Vec3 direction) const override
     {
-        return ArrayRay{h, direction, true};
+        return ArrayRay{h, direction, true, h};
     }
 };
 
@@ -102,7 +102,7 @@ public:
         Vec3 refracted = lens_part ? Vec3{w.x / w.z - offset.x / f, w.y / w.z - offset.y / f, 1} : Vec3{w.x / w.z, w.y / w.z, 1};
         if (frame.tilted)
             refracted = mul(frame.axes, refracted);
-        return ArrayRay{leave, mul(array.pose.rotation, refracted), true};
+        return ArrayRay{leave, mul(array.pose.rotation, refracted), true, leave};
     }
 
     // The lens images the target O to the homogeneous point I = (o, 1 - o_z/f) (lens-relative
@@ -132,7 +132,7 @@ public:
                 return no_ray();
         }
         const Vec3 local_out = from_lens(frame, Vec3{along.x / along.z - hx / f, along.y / along.z - hy / f, 1});
-        return ArrayRay{target, mul(array.pose.rotation, local_out), true};
+        return ArrayRay{target, mul(array.pose.rotation, local_out), true, target};
     }
 
     ArrayRay towards_sensor(const MicrolensArray& array, LensIndex lens, Vec3 h, Vec3 direction) const override
@@ -160,7 +160,7 @@ public:
         const Vec3 out_local = from_lens(frame, lens_part ? Vec3{w.x / -w.z - hx / f, w.y / -w.z - hy / f, -1}
                                                           : Vec3{w.x / -w.z, w.y / -w.z, -1});
         const Vec3 at = to_plane == 0 ? h : array.to_optics(frame.centre + from_lens(frame, Vec3{hx, hy, 0}));
-        return ArrayRay{at, mul(array.pose.rotation, out_local), true};
+        return ArrayRay{at, mul(array.pose.rotation, out_local), true, at};
     }
 
 private:

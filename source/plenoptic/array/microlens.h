@@ -18,11 +18,14 @@ namespace plenoptic {
 struct MicrolensArray;
 
 // A ray leaving a microlens: where it leaves (optics frame, mm) and its direction (any length).
-// passed false: there is no such ray (the other fields are then meaningless).
+// passed false: there is no such ray (the other fields are then meaningless). `sampled`: the
+// point of the array's plane that the sample picked (sample_ray), where the solid angle the sample
+// stands for is measured from the sensor point; the origin itself for lenses without thickness.
 struct ArrayRay {
     Vec3 origin;
     Vec3 direction;
     bool passed;
+    Vec3 sampled;
 };
 
 // The lenses of one array, all of one kind. Lens types (multi-focus arrays have 3) differ only in
@@ -33,12 +36,17 @@ class Microlens {
 public:
     virtual ~Microlens() {}
 
-    // What the metadata calls this kind of lens (microlens_array.lens: "pinhole", "thin_lens").
+    // What the metadata calls this kind of lens (microlens_array.lens: "pinhole", "thin_lens",
+    // "refracting").
     virtual const char* kind_name() const = 0;
     // A pinhole forms no image: light passes it only at its centre, undeviated; it has no focal
     // length, nothing blurs through it, and it has no area to be lit through or to diffract.
     // A lens that forms one passes light anywhere in its lattice cell.
     virtual bool forms_image() const = 0;
+    // Whether first-order optics is exact for these lenses (a thin lens of focal_length_mm in the
+    // array's plane, or a pinhole), so that bounds built on it hold. False for refracting lenses,
+    // whose thickness and spherical aberration first-order optics leaves out.
+    virtual bool first_order_exact() const { return true; }
     // How many lens types the array's lenses come in (1, or 3 for a multi-focus array).
     virtual int type_count() const { return 1; }
     // The paraxial focal length of lens type `type` (0 <= type < type_count()); only for lenses that
@@ -78,6 +86,7 @@ public:
 
 // Pinholes.
 std::shared_ptr<const Microlens> make_pinhole_microlens();
+// Refracting lenses: array/refracting_microlens.h.
 // Ideal thin lenses of focal lengths focal_mm[0 .. type_count - 1] (type_count 1 or 3): a ray
 // meeting a lens at offset h from its centre, its direction normalised to unit component along the
 // lens normal, leaves with w' = w - h / f, in either direction of travel.

@@ -3,6 +3,7 @@
 
 #include "plenoptic/array/microlens_array.h"
 
+#include "plenoptic/array/refracting_microlens.h"
 #include "plenoptic/lens/glass.h"
 
 #include "plenoptic/core/json.h"
@@ -151,6 +152,26 @@ MetadataJson MicrolensArray::metadata(const double rotate_deg[3], const double t
     }
     if (errors)
         json["errors"] = errors->metadata();
+    if (const RefractingShape* shape = refracting_shape(*microlens)) {
+        // The lenses' shape as written, and their paraxial (first-order) data: the effective focal
+        // length (also focal_lengths_mm) and the principal planes, measured from the array's plane
+        // (its face nearest the sensor) towards the scene.
+        MetadataJson lens = MetadataJson::object();
+        MetadataJson surface = MetadataJson::object();
+        surface["radius_mm"] = json_number(shape->radius_mm);
+        surface["conic"] = json_number(shape->conic);
+        lens["surface"] = surface;
+        lens["ior"] = json_number(shape->ior);
+        lens["thickness_mm"] = json_number(shape->cap_mm);
+        lens["substrate_mm"] = json_number(shape->substrate_mm);
+        lens["curved_side"] = shape->curved_towards_scene ? "scene" : "sensor";
+        lens["paraxial_focal_length_mm"] = json_number(shape->focal_length_mm());
+        MetadataJson planes = MetadataJson::object();
+        planes["front_mm"] = json_number(shape->front_principal_z());
+        planes["rear_mm"] = json_number(shape->rear_principal_z());
+        lens["principal_planes"] = planes;
+        json["refracting"] = lens;
+    }
     return json;
 }
 

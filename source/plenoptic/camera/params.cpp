@@ -366,6 +366,48 @@ std::string check_main_lens(const MainLensParams& main, double mm_per_unit)
     return check_real_lens(main, mm_per_unit);
 }
 
+std::string check_microlens_ior(const char* keyword, double value)
+{
+    if (!(value > 1 && value <= kMaxMicrolensIor))
+        return str(keyword) + " is the index of refraction of the microlenses' glass, greater than 1 and at most " +
+               format_number(kMaxMicrolensIor) + ", got " + format_number(value);
+    return "";
+}
+
+std::string check_microlens_conic(const char* keyword, double value)
+{
+    if (!(value >= kMinMicrolensConic && value <= kMaxMicrolensConic))
+        return str(keyword) + " is the cap's conic constant, from " + format_number(kMinMicrolensConic) + " to " +
+               format_number(kMaxMicrolensConic) + ", got " + format_number(value);
+    return "";
+}
+
+std::string check_refracting_shape(const ArrayParams& array)
+{
+    const RefractingShape& s = array.refracting;
+    if (array.fill_factor != 1 || array.mask)
+        return "microlens_array fill_factor and mask are not modelled for refracting microlenses (lens { }): their "
+               "caps fill their cells";
+    const double corner = cell_circumradius(array.grid, array.pitch_mm);
+    const char* grid = array.grid == GridType::Hexagonal ? "hexagonal" : "rectangular";
+    // The cap's surface must exist over the whole cell: a sphere out to its radius, a conic out to
+    // R / sqrt(1 + k) (k > -1).
+    const double reach = s.conic > -1 ? s.radius_mm / std::sqrt(1 + s.conic) : INFINITY;
+    if (!(reach > corner))
+        return "microlens_array lens surface radius " + format_number(s.radius_mm) + " mm" +
+               (s.conic != 0 ? " with conic " + format_number(s.conic) + " (the surface ends " +
+                               format_number(reach) + " mm from the axis)" : std::string()) +
+               " does not cover the lens's cell: its corners are " + format_number(corner) + " mm from the centre (" +
+               grid + " pitch " + format_number(array.pitch_mm) + " mm); the radius must exceed that (a flatter cap)";
+    const double height = s.sag(corner * corner);
+    if (!(height <= s.cap_mm))
+        return "microlens_array lens: the cap rises " + format_number(height) + " mm from its cell's corners to its "
+               "vertex (surface radius " + format_number(s.radius_mm) + " mm over " + format_number(corner) +
+               " mm), more than its thickness " + format_number(s.cap_mm) +
+               " mm; give thickness at least that, or a larger radius";
+    return "";
+}
+
 std::string check_array(const ArrayParams& array)
 {
     if (!array.given)
@@ -378,7 +420,12 @@ std::string check_array(const ArrayParams& array)
     if (!message.empty())
         return message;
     if (!array.has_lens)
-        return "microlens_array needs focal_length, focal_lengths or pinhole";
+        return "microlens_array needs focal_length, focal_lengths, pinhole or lens { }";
+    if (array.lens == MicrolensType::Refracting) {
+        message = check_refracting_shape(array);
+        if (!message.empty())
+            return message;
+    }
     if (array.lens == MicrolensType::Pinhole && array.focal_length_count != 0)
         return "microlens_array: give pinhole or focal_length(s), not both";
     if (array.lens == MicrolensType::ThinLens && array.focal_length_count != 1 && array.focal_length_count != 3)
@@ -575,6 +622,10 @@ std::string check_camera(const CameraParams& camera)
                "pinhole main_lens each microlens focuses the pinhole's light onto a point, whose irradiance depends "
                "on the pinhole's size, which the camera does not have; use a thin_lens main lens, pinhole "
                "microlenses, or radiometry flat";
+    if (has_main && camera.main.type == MainLensType::Pinhole && array.lens == MicrolensType::Refracting)
+        return "a pinhole main_lens with refracting microlenses (microlens_array lens { }) is not supported: behind a "
+               "pinhole each sensor point sees the one ray through the pinhole, which the exact trace through the caps "
+               "has no closed form for; use a thin_lens or real main lens, or thin microlenses (focal_length)";
     if (has_main && camera.main.type == MainLensType::Pinhole && array.lens == MicrolensType::Pinhole)
         return "a pinhole main_lens with a pinhole microlens_array is degenerate: no light reaches the "
                "sensor (a ray would have to pass two points and the pixel at once); make one of them "
@@ -656,7 +707,8 @@ std::string check_placement(const double right[3], const double up[3], const dou
 
 int default_samples(const CameraParams& camera)
 {
-    const bool thin_microlenses = camera.array.given && camera.array.lens == MicrolensType::ThinLens;
+    const bool thin_microlenses = camera.array.given && (camera.array.lens == MicrolensType::ThinLens ||
+                                                         camera.array.lens == MicrolensType::Refracting);
     const bool bare_thin_main = !camera.array.given && camera.main.given && camera.main.type != MainLensType::Pinhole;
     return thin_microlenses || bare_thin_main ? kDefaultSamplesApertures : kDefaultSamplesPinholes;
 }

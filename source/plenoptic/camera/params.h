@@ -125,6 +125,14 @@ std::string format_rounded(double value, bool round_up);
 std::string check_array(const ArrayParams& array);
 // Part of check_array: manufacturing errors, fill factor and mask.
 std::string check_array_errors(const ArrayParams& array);
+// microlens_array lens { }: the glass's index (1 < n <= kMaxMicrolensIor) and the cap's conic
+// constant (kMinMicrolensConic to kMaxMicrolensConic), at their keywords; the shape against the
+// array's cell (the cap covers its cell, is no taller than its thickness) in check_array.
+const double kMaxMicrolensIor = 4;
+const double kMinMicrolensConic = -100, kMaxMicrolensConic = 100;
+std::string check_microlens_ior(const char* keyword, double value);
+std::string check_microlens_conic(const char* keyword, double value);
+std::string check_refracting_shape(const ArrayParams& array);
 std::string check_sensor(const SensorParams& sensor);
 std::string check_sampling(const SamplingParams& sampling);
 // spectral N with its response (camera/spectral_bands.h): "" when off or usable.

@@ -122,7 +122,7 @@ bool trace_sensor_point(const PlenopticCamera& m, Vec3 p, const LensIndex* force
     const Vec3& direction = ray.direction;
 
     if (!m.lens)
-        return weigh(m, finish(leave, direction, out), p, leave, m.array.pose.normal, out);
+        return weigh(m, finish(leave, direction, out), p, ray.sampled, m.array.pose.normal, out);
 
     // A real lens behind an array parallel to the sensor: a ray that crosses the exit pupil's plane
     // outside the pupil-bounds disc of the point where it leaves the array cannot pass the lens
@@ -133,7 +133,8 @@ bool trace_sensor_point(const PlenopticCamera& m, Vec3 p, const LensIndex* force
         !m.pupil_bounds->may_pass(leave, direction))
         return false;
     // On through the main lens (a ray that misses its apertures carries no light).
-    return weigh(m, emit(m.lens->to_scene(leave, direction, check_apertures), out), p, leave, m.array.pose.normal, out);
+    return weigh(m, emit(m.lens->to_scene(leave, direction, check_apertures), out), p, ray.sampled, m.array.pose.normal,
+                 out);
 }
 
 // Whether light through `lens` can reach some point of the pixel centred at p. With k = D/d
@@ -158,6 +159,8 @@ bool lens_reaches_pixel(const PlenopticCamera& m, LensIndex lens, Vec3 p)
     const double my = (c.y - e.y) * (1 + k) - (p.y - e.y) * k;
     double spread = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]) * k;
     if (m.array.microlens->forms_image()) {
+        if (!m.array.microlens->first_order_exact())
+            return true;  // no first-order bound for a refracting lens: every lens may reach the pixel
         double blur = std::fabs(1 + k - main_distance / m.array.focal_length_mm(lens));
         if (m.array.fill_factor < 1 && !m.array.mask)
             blur = std::max(blur, 1 + k);  // light through a clear gap is not bent

@@ -25,10 +25,10 @@ bool sensor_hit_through_lens(const PlenopticCamera& m, LensIndex lens, Vec3 h, V
     const Vec3 direction = bent.direction;
     if (!(direction.z < 0))
         return false;
-    const double travel = (m.sensor.z_mm - h.z) / direction.z;
+    const double travel = (m.sensor.z_mm - bent.origin.z) / direction.z;
     if (!(travel > 0))
         return false;
-    *hit = h + travel * direction;
+    *hit = bent.origin + travel * direction;
     return is_finite(*hit);
 }
 

@@ -17,8 +17,9 @@ namespace detail {
 
 // Sensor hit of a ray arriving at array point h (optics frame) with direction `towards_sensor`,
 // passed by `lens` as its kind passes light (Microlens::towards_sensor: a thin lens refracts it by
-// the rule of ray generation, a pinhole lets it through unchanged). False when it does not reach
-// the sensor plane.
+// the rule of ray generation, a pinhole lets it through unchanged, a refracting lens traces it
+// through its glass and the ray goes on from where it leaves the lens). False when it does not
+// reach the sensor plane.
 bool sensor_hit_through_lens(const PlenopticCamera& m, LensIndex lens, Vec3 h, Vec3 towards_sensor, Vec3* hit);
 
 // Lenses whose microimage cells may receive light through a lens: the renderer gives a sensor

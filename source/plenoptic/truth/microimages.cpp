@@ -180,7 +180,8 @@ struct Guess {
 // microlens to the sensor: the ray from h towards point q of that plane came from the sensor
 // point h - (h_z - sensor_z) (w' + (h - c) / f), w' = (q - h) / (q_z - h_z) (pinholes: no
 // (h - c) / f). Exact for an array parallel to the sensor, a guess otherwise (the bracket grows
-// where light reaches farther). A pinhole main lens has no pupil disc: the cell's image then.
+// where light reaches farther; for a refracting lens a paraxial guess with a wider bracket). A
+// pinhole main lens has no pupil disc: the cell's image then.
 Guess guess_region(const PlenopticCamera& m, LensIndex lens, double lens_u, double lens_v, Vec2 lattice_px)
 {
     const double pixel = std::min(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]);
@@ -210,6 +211,12 @@ Guess guess_region(const PlenopticCamera& m, LensIndex lens, double lens_u, doub
         wy += shift.y;
     }
     Guess guess{true, 0, 0, disc.radius * drop / along / pixel};
+    if (thin && !m.array.microlens->first_order_exact()) {
+        // A refracting lens: the paraxial guess, with a bracket wider by as far as the lens bends
+        // light from the cell's corner (its thickness and spherical aberration move the region by
+        // less than that).
+        guess.radius_px += m.array.cell_circumradius_mm * drop / m.array.focal_length_mm(lens) / pixel + 2;
+    }
     const PixelPoint centre = m.sensor.to_pixel(h.x - drop * wx, h.y - drop * wy);
     guess.u = centre.u;
     guess.v = centre.v;
