@@ -80,6 +80,14 @@ CAMERA_BRACE = "}  " + MARK
 THIN = ("thin_lens", "focal_length 16", "f_number 4", "focus_distance 2")
 HEX = ("hexagonal", "pitch 0.08", "focal_length 0.32", "distance 0.32")
 
+
+def refracting(surface="surface { radius 0.1 }", thickness="thickness 0.015", ior="ior 1.5", substrate="substrate 0.03",
+               extra=(), close="}", head="lens {"):
+    """A hexagonal array (pitch 0.08: corners 0.046 mm from the centre) of refracting microlenses,
+    one keyword of lens { } per line; None leaves a line out."""
+    body = [head] + ["  " + b for b in (surface, thickness, ior, substrate) + tuple(extra) if b is not None] + [close]
+    return ("hexagonal", "pitch 0.08") + tuple(body) + ("distance 0.2",)
+
 # (name, camera block, fragments the error message must contain, why it is refused)
 CASES = [
     # ---- main_lens: values
@@ -431,6 +439,39 @@ REAL_LENS_CASES = [
      ["microlens_array abbe 40", "pinhole"], "a pinhole has no glass"),
     ("microlens abbe out of range", camera(array=array_with(*HEX, "abbe 200  " + MARK)),
      ["microlens_array abbe", "200", "5 to 150"], "an Abbe number no glass has"),
+    # ---- microlens_array { lens { } }: refracting microlenses
+    ("refracting cap narrower than its cell", camera(array=array_with(*refracting(surface="surface { radius 0.04 }"), close=BRACE)),
+     ["microlens_array lens surface radius 0.04", "does not cover the lens's cell", "0.046", "hexagonal pitch 0.08"],
+     "the cap's clear aperture is its whole cell"),
+    ("refracting conic narrows the cap", camera(array=array_with(*refracting(surface="surface { radius 0.1 conic 4 }"), close=BRACE)),
+     ["radius 0.1", "conic 4", "does not cover"], "an oblate cap ends at R / sqrt(1 + k)"),
+    ("refracting cap taller than its thickness", camera(array=array_with(*refracting(thickness="thickness 0.005"), close=BRACE)),
+     ["cap rises", "more than its thickness 0.005"], "the cap's sag over its cell must fit in t"),
+    ("refracting ior 1", camera(array=array_with(*refracting(ior="ior 1  " + MARK))),
+     ["microlens_array lens ior", "greater than 1", "got 1"], "no power without glass"),
+    ("refracting ior NaN", camera(array=array_with(*refracting(ior="ior pow(-8, 1/3)  " + MARK))),
+     ["microlens_array lens ior", "finite", "nan"], "no NaN"),
+    ("refracting substrate negative", camera(array=array_with(*refracting(substrate="substrate -0.03  " + MARK))),
+     ["microlens_array lens substrate", "positive", "-0.03"], "lengths are positive"),
+    ("refracting radius zero", camera(array=array_with(*refracting(surface="surface { radius 0 }  " + MARK))),
+     ["microlens_array lens surface radius", "positive", "got 0"], "a cap has a curvature"),
+    ("refracting conic out of range", camera(array=array_with(*refracting(surface="surface { radius 0.1 conic 1000 }  " + MARK))),
+     ["microlens_array lens surface conic", "-100 to 100", "1000"], "the conic's range"),
+    ("refracting without substrate", camera(array=array_with(*refracting(substrate=None, close="}  " + MARK))),
+     ["microlens_array lens needs", "substrate"], "every dimension of the lens is given"),
+    ("refracting surface without radius", camera(array=array_with(*refracting(surface="surface { conic -1 }  " + MARK))),
+     ["microlens_array lens surface needs radius"], "the cap's radius is required"),
+    ("refracting two surfaces", camera(array=array_with(*refracting(extra=("surface { radius 0.2 }  " + MARK,)))),
+     ["one surface"], "the lens is plano-convex: one curved surface"),
+    ("refracting curved_side unknown", camera(array=array_with(*refracting(extra=("curved_side up  " + MARK,)))),
+     ["curved_side", "scene", "sensor"], "the side is one of two words"),
+    ("refracting unknown keyword", camera(array=array_with(*refracting(extra=("focal_length 0.2  " + MARK,)))),
+     ["focal_length", "microlens_array lens keyword", "allowed"], "unknown keywords are errors, never ignored"),
+    ("refracting with focal_length", camera(array=array_with("focal_length 0.2", *refracting(head="lens {  " + MARK))),
+     ["lens { }", "not several"], "one kind of microlens"),
+    ("refracting behind a pinhole main lens", camera(main=main_with("pinhole", "distance 17"), array=array_with(*refracting()),
+                                                     close=CAMERA_BRACE),
+     ["pinhole main_lens with refracting microlenses", "not supported"], "no closed form for the one ray through a pinhole"),
 ]
 
 GROUPS = {"camera": CASES, "placement": PLACEMENT_CASES, "real_lens": REAL_LENS_CASES}

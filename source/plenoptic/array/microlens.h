@@ -47,6 +47,9 @@ public:
     // array's plane, or a pinhole), so that bounds built on it hold. False for refracting lenses,
     // whose thickness and spherical aberration first-order optics leaves out.
     virtual bool first_order_exact() const { return true; }
+    // How far the lenses' glass extends from the array's plane towards the scene (mm): 0 for lenses
+    // without thickness.
+    virtual double thickness_mm() const { return 0; }
     // How many lens types the array's lenses come in (1, or 3 for a multi-focus array).
     virtual int type_count() const { return 1; }
     // The paraxial focal length of lens type `type` (0 <= type < type_count()); only for lenses that

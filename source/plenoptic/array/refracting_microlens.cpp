@@ -215,6 +215,7 @@ public:
     const char* kind_name() const override { return "refracting"; }
     bool forms_image() const override { return true; }
     bool first_order_exact() const override { return false; }
+    double thickness_mm() const override { return shape_.thickness_mm(); }
     double focal_length_mm(int) const override { return shape_.focal_length_mm(); }
     // Dispersion: the glass's index at the wavelength, n' = 1 + (n - 1) factor, which scales the
     // lens's power (n - 1) / R by the factor.

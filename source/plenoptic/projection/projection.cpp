@@ -445,6 +445,59 @@ void add_spot_hit(const PlenopticCamera& m, LensIndex lens, const std::vector<Ve
     hits->push_back(PixelHit{lens, px.u, px.v, fraction * std::min(1.0, kept / area)});
 }
 
+// Light of the point whose image is X' through a lens whose trace is not first-order (a
+// refracting microlens): the cone's footprint within the lens's cell grown by the glass's
+// thickness (light crossing the array's plane there may still enter and leave this lens), sampled
+// on a grid of kTracedGrid a side over that part's box; each sample's light from X' through the
+// lens, traced to the sensor. The image is the centroid of the passing samples' hits, their share
+// of the cone's footprint its fraction; the centroid is kept when it lands in light the renderer
+// delivers (delivered_point).
+const int kTracedGrid = 48;
+
+void project_through_traced_lens(const PlenopticCamera& m, Homogeneous image, LensIndex lens,
+                                 const std::vector<Vec2>& cone_polygon, double cone_area, std::vector<PixelHit>* hits)
+{
+    Vec2 cell[6];
+    const int count = m.array.cell_corners(cell);
+    const Vec2 c = m.array.centre_local(lens);
+    const double grow = 1 + m.array.microlens->thickness_mm() / m.array.cell_inradius_mm;
+    std::vector<Vec2> corners(count);
+    for (int i = 0; i < count; ++i)
+        corners[i] = c + grow * cell[i];
+    const std::vector<Vec2> part = clip_polygon(cone_polygon, corners);
+    if (part.size() < 3)
+        return;
+    const Box region = bounding_box(part);
+    const double dx = (region.x1 - region.x0) / kTracedGrid, dy = (region.y1 - region.y0) / kTracedGrid;
+    if (!(dx > 0) || !(dy > 0))
+        return;
+    double passed = 0, sx = 0, sy = 0;
+    for (int j = 0; j < kTracedGrid; ++j) {
+        for (int i = 0; i < kTracedGrid; ++i) {
+            const Vec2 q{region.x0 + (i + 0.5) * dx, region.y0 + (j + 0.5) * dy};
+            bool inside = true;  // the part is convex (a convex cone's footprint clipped by a convex cell)
+            for (size_t k = 0; k < part.size() && inside; ++k)
+                inside = cross(part[(k + 1) % part.size()] - part[k], q - part[k]) >= 0;
+            if (!inside)
+                continue;
+            const Vec3 h = m.array.to_optics(Vec3{q.x, q.y, 0});
+            Vec3 towards = image.w == 0 ? image.xyz : (1 / image.w) * image.xyz - h;
+            if (dot(towards, m.array.pose.normal) > 0)
+                towards = -towards;
+            Vec3 hit;
+            if (!sensor_hit_through_lens(m, lens, h, towards, &hit))
+                continue;
+            passed += 1;
+            sx += hit.x;
+            sy += hit.y;
+        }
+    }
+    if (!(passed > 0))
+        return;
+    const double fraction = std::min(1.0, passed * dx * dy / cone_area);
+    add_point_hit(m, lens, Vec3{sx / passed, sy / passed, m.sensor.z_mm}, fraction, hits);
+}
+
 // The picture on the sensor plane (x, y, mm), as a box.
 Box picture_box(const PlenopticCamera& m) { return bounding_box(picture_polygon(m)); }
 
@@ -560,7 +613,16 @@ void project_through_thin_main(const PlenopticCamera& m, Vec3 point, std::vector
     const double cone_area = use_footprint ? area_centroid(cone_polygon, &unused) : 0;
 
     const Box picture = picture_box(m);
+    const bool traced_microlenses = thin_microlenses && !m.array.microlens->first_order_exact();
     for_each_lens_in_box(m, box, [&](LensIndex lens) {
+        if (traced_microlenses) {
+            // Refracting microlenses: not affine, and their light crosses the array's plane up
+            // to the glass's thickness outside their cell, so the cone's footprint near the cell is
+            // sampled and each sample's light traced (the lens decides whether it passes).
+            if (use_footprint && cone_area > 0)
+                project_through_traced_lens(m, image, lens, cone_polygon, cone_area, hits);
+            return;
+        }
         if (!lens_sees(m, image, lens))
             return;
         if (use_footprint && cone_area > 0) {

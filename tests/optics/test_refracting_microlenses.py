@@ -1,0 +1,255 @@
+# SPDX-License-Identifier: AGPL-3.0-or-later
+"""Refracting microlenses (microlens_array { lens { surface { radius R } thickness t ior n
+substrate T curved_side ... } }): rendered microimages against a tracer written here.
+
+A white world behind a thin main lens (f/3.5), a hexagonal array of plano-convex caps, both ways
+round. The tracer below is this file's own: the cap's sphere found from its centre, Snell's law in
+tangential form, the cap's clear aperture the hexagonal cell (a path must cross both faces inside
+it), the main lens's aperture disc; each pixel's value is the share of (pixel point, cell point)
+pairs whose ray passes, integrated on a grid. Rendered microimage centroids must agree within
+0.05 px and their lit areas (the sum of the pixel values) within 1 %. The metadata must carry the
+shape and the paraxial data worked out here from the thick-lens formulas; <image>.microimages.csv
+is compared with the same tracer.
+"""
+import math
+import os
+
+import numpy as np
+import pytest
+
+import plenoptic_testing as pt
+
+F, N = 50.0, 3.5
+D = 50.0                      # main lens -> array's plane (mm)
+PITCH = 0.1                   # hexagonal
+R, IOR, CAP, SUBSTRATE = 0.09, 1.5, 0.025, 0.05
+PIXEL = 0.002
+W = H = 150
+LENSES = [(0, 0), (1, 0), (-1, 0), (0, 1), (-1, 1), (0, -1), (-1, -1)]
+# The array -> sensor distance per side: near the paraxial back focal distance.
+DISTANCE = {"scene": 0.13, "sensor": 0.17}
+SQRT3 = math.sqrt(3.0)
+
+
+def scene(side):
+    return ("#version 3.7;\nglobal_settings { assumed_gamma 1.0 }\nbackground { rgb 1 }\n"
+            "camera { plenoptic location <0, 0, 0> look_at <0, 0, 1>\n"
+            "  main_lens { thin_lens focal_length %r f_number %r distance %r }\n"
+            "  microlens_array { hexagonal pitch %r\n"
+            "    lens { surface { radius %r } thickness %r ior %r substrate %r curved_side %s }\n"
+            "    distance %r }\n"
+            "  sensor { pixel_size <%r, %r> } samples 400 microimage_centres on\n}\n"
+            % (F, N, D, PITCH, R, CAP, IOR, SUBSTRATE, side, DISTANCE[side], PIXEL, PIXEL))
+
+
+# ---- the test's tracer, in the frame of one lens: its centre at the origin, +z to the scene,
+# z = 0 the array's plane (its face nearest the sensor) ----
+
+def normalise(v):
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def snell(d, normal, n1, n2):
+    """Unit directions d (..., 3) through surfaces of normal `normal` (either sign); NaN rows on
+    total internal reflection."""
+    nn = normalise(normal)
+    nn = np.where((d * nn).sum(-1, keepdims=True) < 0, -nn, nn)
+    along = (d * nn).sum(-1, keepdims=True)
+    tangential = (n1 / n2) * (d - along * nn)
+    t2 = (tangential ** 2).sum(-1, keepdims=True)
+    with np.errstate(invalid="ignore"):
+        return np.where(t2 <= 1, tangential + np.sqrt(1 - t2) * nn, np.nan)
+
+
+def sphere_hit(origin, d, centre, upper):
+    """The first point ahead on the cap's hemisphere (upper: above the sphere's centre)."""
+    o = origin - centre
+    b = (o * d).sum(-1)
+    c = (o * o).sum(-1) - R * R
+    disc = b * b - c
+    with np.errstate(invalid="ignore"):
+        root = np.sqrt(disc)
+    best = np.full(b.shape, np.nan)
+    for t in (-b + root, -b - root):  # the smaller last: it wins when both qualify
+        z = origin[..., 2] + t * d[..., 2]
+        ok = (disc >= 0) & (t > 0) & ((z > centre[2]) == upper)
+        best = np.where(ok, t, best)
+    return origin + best[..., None] * d
+
+
+def in_cell(q):
+    """Inside the hexagonal cell (neighbours at 0, 60 and 120 degrees) of the lens at the origin."""
+    x, y = q[..., 0], q[..., 1]
+    half = PITCH / 2
+    return (np.abs(x) <= half) & (np.abs(0.5 * x + SQRT3 / 2 * y) <= half) & (np.abs(-0.5 * x + SQRT3 / 2 * y) <= half)
+
+
+def passes(side, p, h0, main_centre):
+    """Whether the ray from sensor point p (lens frame) through cell point h0 (z = 0) passes the
+    lens and the main lens's aperture (its plane z = D, its centre at main_centre)."""
+    L = CAP + SUBSTRATE
+    d = normalise(h0 - p)
+    if side == "scene":
+        inside = snell(d, np.array([0.0, 0.0, 1.0]), 1.0, IOR)
+        centre = np.array([0.0, 0.0, L - R])
+        q = sphere_hit(h0, inside, centre, True)
+        out = snell(inside, q - centre, IOR, 1.0)
+        lit = in_cell(h0) & in_cell(q)
+        exit_point = q
+    else:
+        centre = np.array([0.0, 0.0, R])
+        q = sphere_hit(h0 - d, d, centre, False)
+        inside = snell(d, q - centre, 1.0, IOR)
+        front = q + ((L - q[..., 2]) / inside[..., 2])[..., None] * inside
+        out = snell(inside, np.array([0.0, 0.0, 1.0]), IOR, 1.0)
+        lit = in_cell(q) & in_cell(front)
+        exit_point = front
+    with np.errstate(invalid="ignore"):
+        at_main = exit_point + ((D - exit_point[..., 2]) / out[..., 2])[..., None] * out
+        radial = np.hypot(at_main[..., 0] - main_centre[0], at_main[..., 1] - main_centre[1])
+        return lit & (out[..., 2] > 0) & (radial <= F / N / 2)
+
+
+def cell_points(step):
+    g = (np.arange(-int(PITCH / step), int(PITCH / step) + 1)) * step
+    xx, yy = np.meshgrid(g, g)
+    pts = np.stack([xx.ravel(), yy.ravel(), np.zeros(xx.size)], axis=1)
+    return pts[in_cell(pts)]
+
+
+def lens_centre(k, l):
+    return np.array([(k + (l % 2) / 2.0) * PITCH, l * PITCH * SQRT3 / 2.0])
+
+
+def reference_microimage(side, k, l, sub=3, step=PITCH / 22):
+    """Pixel values (a dict (i, j) -> value) of lens (k, l)'s microimage, from the tracer, over the
+    pixels that belong to it (the line from the main lens's centre through the pixel meets its cell)."""
+    d = DISTANCE[side]
+    c = lens_centre(k, l)
+    centre_px = np.array([W / 2.0 - c[0] * (D + d) / D / PIXEL, H / 2.0 + c[1] * (D + d) / D / PIXEL])
+    half = int(math.ceil(0.6 * PITCH * (D + d) / D / PIXEL))
+    i0, j0 = int(centre_px[0]) - half, int(centre_px[1]) - half
+    ii, jj = np.meshgrid(np.arange(i0, i0 + 2 * half + 1), np.arange(j0, j0 + 2 * half + 1))
+    ii, jj = ii.ravel(), jj.ravel()
+    # Own lens: the pixel centre projected from the main lens's centre onto the array.
+    x = -((ii + 0.5) - W / 2.0) * PIXEL
+    y = ((jj + 0.5) - H / 2.0) * PIXEL
+    kk, ll, _ = pt.nearest_lens_local("hexagonal", PITCH, np.stack([x * D / (D + d), y * D / (D + d)], axis=-1))
+    mine = (kk == k) & (ll == l) & (ii >= 0) & (ii < W) & (jj >= 0) & (jj < H)
+    ii, jj = ii[mine], jj[mine]
+    cells = cell_points(step)
+    offsets = (np.arange(sub) + 0.5) / sub
+    values = np.zeros(len(ii))
+    main_centre = -c
+    for a in offsets:
+        for b in offsets:
+            px = -((ii + a) - W / 2.0) * PIXEL - c[0]
+            py = ((jj + b) - H / 2.0) * PIXEL - c[1]
+            p = np.stack([px, py, np.full(len(px), -d)], axis=1)
+            for start in range(0, len(p), 64):
+                chunk = p[start:start + 64]
+                lit = passes(side, chunk[:, None, :], cells[None, :, :], main_centre)
+                values[start:start + 64] += lit.mean(axis=1) / (sub * sub)
+    return {(int(i), int(j)): v for i, j, v in zip(ii, jj, values)}
+
+
+def moments(values):
+    total = sum(values.values())
+    u = sum(v * i for (i, j), v in values.items()) / total
+    v_ = sum(v * j for (i, j), v in values.items()) / total
+    return u, v_, total
+
+
+@pytest.mark.parametrize("side", ["scene", "sensor"])
+def test_microimages_match_an_independent_tracer(args, side):
+    name = "refracting_" + side
+    path = pt.render(args.povray, args.work, name, scene(side), W, H, timeout=600)
+    image = pt.read_linear(path)[..., :3].mean(axis=2)
+    meta = pt.metadata_of(path)
+
+    # The metadata: the kind, the shape, and the thick lens's paraxial data worked out here.
+    array = meta["microlens_array"]
+    assert array["lens"] == "refracting"
+    L = CAP + SUBSTRATE
+    f = 1 / ((IOR - 1) / R)  # lensmaker's formula, one surface flat (the thickness drops out)
+    assert array["focal_lengths_mm"] == [pytest.approx(f, rel=1e-12)]
+    lens = array["refracting"]
+    assert lens["surface"] == {"radius_mm": R, "conic": 0}
+    assert (lens["ior"], lens["thickness_mm"], lens["substrate_mm"], lens["curved_side"]) == (IOR, CAP, SUBSTRATE, side)
+    assert lens["paraxial_focal_length_mm"] == pytest.approx(f, rel=1e-12)
+    # Principal planes: the curved side's at its vertex, the flat side's L/n into the glass.
+    front, rear = (L, L / IOR) if side == "scene" else (L - L / IOR, 0.0)
+    assert lens["principal_planes"]["front_mm"] == pytest.approx(front, abs=1e-12)
+    assert lens["principal_planes"]["rear_mm"] == pytest.approx(rear, abs=1e-12)
+
+    csv = np.genfromtxt(os.path.join(args.work, name + ".microimages.csv"), delimiter=",", names=True)
+    truth = {(int(r["k"]), int(r["l"])): r for r in csv}
+    d = DISTANCE[side]
+    cell_px = (SQRT3 / 2 * PITCH * PITCH) * ((D + d) / D) ** 2 / PIXEL ** 2
+    counted = np.zeros(image.shape, bool)
+    worst_centre = worst_area = worst_truth_centre = worst_truth_area = 0.0
+    for k, l in LENSES:
+        ref = reference_microimage(side, k, l)
+        rendered = {ij: float(image[ij[1], ij[0]]) for ij in ref}
+        for i, j in ref:
+            counted[j, i] = True
+        ru, rv, rarea = moments(ref)
+        gu, gv, garea = moments(rendered)
+        centre_error = math.hypot(gu - ru, gv - rv)
+        area_error = abs(garea / rarea - 1)
+        print("%s lens (%d, %d): tracer centroid (%.3f, %.3f) area %.2f px^2; render (%.3f, %.3f) %.2f px^2: "
+              "%.4f px, %.3f %%" % (side, k, l, ru, rv, rarea, gu, gv, garea, centre_error, 100 * area_error))
+        worst_centre, worst_area = max(worst_centre, centre_error), max(worst_area, area_error)
+        # The microimage truth (centre convention, as the tracer's pixel indices).
+        t = truth[(k, l)]
+        worst_truth_centre = max(worst_truth_centre, math.hypot(t["u"] - ru, t["v"] - rv))
+        worst_truth_area = max(worst_truth_area, abs(t["lit_fraction"] * cell_px / rarea - 1))
+    print("%s: worst centroid %.4f px, worst area %.3f %%; microimages.csv: worst centre %.4f px, area %.3f %%"
+          % (side, worst_centre, 100 * worst_area, worst_truth_centre, 100 * worst_truth_area))
+    assert worst_centre <= 0.05
+    assert worst_area <= 0.01
+    assert worst_truth_centre <= 0.05
+    assert worst_truth_area <= 0.01
+    # No light outside the seven microimages' pixels but that of the partial lenses at the border.
+    assert image[counted].sum() > 0.6 * image.sum()
+
+
+def test_microimage_differs_from_the_paraxial_thin_lens(args):
+    """The test can fail: the same camera with thin microlenses of the paraxial focal length in the
+    array's plane gives a microimage whose area differs from the refracting lens's by far more than 1 %."""
+    side = "scene"
+    name = "refracting_as_thin"
+    text = scene(side).replace(
+        "lens { surface { radius %r } thickness %r ior %r substrate %r curved_side %s }" % (R, CAP, IOR, SUBSTRATE, side),
+        "focal_length %r" % (R / (IOR - 1)))
+    assert "focal_length %r" % (R / (IOR - 1)) in text
+    path = pt.render(args.povray, args.work, name, text, W, H, timeout=600)
+    image = pt.read_linear(path)[..., :3].mean(axis=2)
+    ref = reference_microimage(side, 0, 0)
+    thin = sum(float(image[j, i]) for i, j in ref)
+    refracting = moments(ref)[2]
+    print("lens (0, 0): refracting %.1f px^2, paraxial thin lens %.1f px^2" % (refracting, thin))
+    assert abs(thin / refracting - 1) > 0.05
+
+
+def test_refusals(args):
+    base = scene("scene")
+    cases = [
+        ("radius 0.09", "radius 0.05", "does not cover the lens's cell"),
+        ("thickness 0.025", "thickness 0.01", "more than its thickness"),
+        ("ior 1.5", "ior 1", "greater than 1"),
+        ("substrate 0.05", "substrate 0", "substrate"),
+        ("radius 0.09 }", "radius 0.09 conic 500 }", "conic"),
+        ("curved_side scene", "curved_side up", "curved_side"),
+        ("lens {", "focal_length 0.2 lens {", "not several"),
+        ("thin_lens focal_length 50 f_number 3.5 distance 50", "pinhole distance 50", "pinhole main_lens with refracting"),
+        ("substrate 0.05", "", "needs"),
+    ]
+    for old, new, expected in cases:
+        assert old in base, old
+        status, output = pt.render(args.povray, args.work, "refracting_refused", base.replace(old, new, 1), 40, 30,
+                                   expect_failure=True)
+        assert status != 0, (new, output[-500:])
+        error = pt.parse_error(output)
+        assert error is not None and expected in error[2], (new, output[-1500:])
+        assert error[0].endswith("refracting_refused.pov") and error[1] > 0, (new, error)
