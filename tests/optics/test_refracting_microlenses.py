@@ -214,6 +214,90 @@ def test_microimages_match_an_independent_tracer(args, side):
     assert image[counted].sum() > 0.6 * image.sum()
 
 
+def trace_down(side, point, a):
+    """Light travelling along unit directions a (..., 3) on lines through `point` (lens frame),
+    through the lens: (where it leaves towards the sensor, its direction, whether it passed)."""
+    L = CAP + SUBSTRATE
+    z = np.array([0.0, 0.0, 1.0])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        if side == "scene":
+            start = point + ((L + 1 - point[..., 2]) / a[..., 2])[..., None] * a
+            centre = np.array([0.0, 0.0, L - R])
+            q = sphere_hit(start, a, centre, True)
+            inside = snell(a, q - centre, 1.0, IOR)
+            back = q + (-q[..., 2] / inside[..., 2])[..., None] * inside
+            out = snell(inside, z, IOR, 1.0)
+            ok = in_cell(q) & in_cell(back)
+            leave = back
+        else:
+            front = point + ((L - point[..., 2]) / a[..., 2])[..., None] * a
+            inside = snell(a, z, 1.0, IOR)
+            centre = np.array([0.0, 0.0, R])
+            q = sphere_hit(front, inside, centre, False)
+            out = snell(inside, q - centre, IOR, 1.0)
+            ok = in_cell(front) & in_cell(q)
+            leave = q
+        ok = ok & np.isfinite(out).all(-1) & np.isfinite(leave).all(-1)
+    return leave, out, ok
+
+
+@pytest.mark.parametrize("side", ["scene", "sensor"])
+def test_forward_projection_matches_a_brute_force_trace(args, side):
+    """plenoptic-project on the refracting camera's metadata against the light of the point traced
+    here: rays from a grid over the main lens's aperture towards the point's image, through the
+    caps (this file's tracer), to the sensor; per lens the centroid of the hits the renderer
+    delivers (in the lens's own microimage cell, in the picture)."""
+    name = "refracting_" + side
+    metadata = os.path.join(args.work, name + ".plenoptic.json")
+    if not os.path.exists(metadata):
+        pt.render(args.povray, args.work, name, scene(side), W, H, timeout=600)
+    d = DISTANCE[side]
+    point = (0.0005, -0.0003, 0.6)  # scene units (m): its image lies 4.5 mm behind the array
+    P = np.array(point) * 1000.0
+    b = 1 / (1 / F - 1 / P[2])
+    image = -P * b / P[2]
+    step = F / N / 2 / 420
+    g = (np.arange(-420, 421)) * step
+    mx, my = np.meshgrid(g, g)
+    inside = mx ** 2 + my ** 2 <= (F / N / 2) ** 2
+    m = np.stack([mx[inside], my[inside], np.zeros(inside.sum())], axis=1)
+    a = normalise(image - m)
+    crossing = m + ((-D - m[:, 2]) / a[:, 2])[:, None] * a   # where each line meets the array's plane
+    expected = {}
+    for l in range(-3, 4):
+        for k in range(-3, 4):
+            c = lens_centre(k, l)
+            near = np.hypot(crossing[:, 0] - c[0], crossing[:, 1] - c[1]) <= PITCH / SQRT3 + 2 * (CAP + SUBSTRATE)
+            if not near.any():
+                continue
+            local = crossing[near] - np.array([c[0], c[1], -D])
+            leave, out, ok = trace_down(side, local, a[near])
+            hit = leave + ((-d - leave[:, 2]) / out[:, 2])[:, None] * out
+            x, y = hit[:, 0] + c[0], hit[:, 1] + c[1]
+            kk, ll, _ = pt.nearest_lens_local("hexagonal", PITCH, np.stack([x * D / (D + d), y * D / (D + d)], axis=-1))
+            u = W / 2.0 - 0.5 - x / PIXEL
+            v = H / 2.0 - 0.5 + y / PIXEL
+            keep = ok & (kk == k) & (ll == l) & (u >= -0.5) & (u < W - 0.5) & (v >= -0.5) & (v < H - 0.5)
+            if keep.sum() > 200:
+                expected[(k, l)] = (u[keep].mean(), v[keep].mean(), keep.sum() / len(m))
+    hits = pt.run_project(args.project, metadata, [point], fraction=True)
+    got = {(h[1], h[2]): h[3:] for h in hits}
+    print("%s: brute force %d lenses, plenoptic-project %d" % (side, len(expected), len(got)))
+    assert len(expected) >= 4
+    worst = worst_fraction = 0.0
+    for key, (u, v, fraction) in expected.items():
+        assert key in got, (key, sorted(got))
+        gu, gv, gf = got[key]
+        error = math.hypot(gu - u, gv - v)
+        print("  lens %s: brute force (%.3f, %.3f) %.5f, projected (%.3f, %.3f) %.5f: %.4f px"
+              % (key, u, v, fraction, gu, gv, gf, error))
+        worst = max(worst, error)
+        worst_fraction = max(worst_fraction, abs(gf / fraction - 1))
+    print("%s: worst %.4f px, fraction %.2f %%" % (side, worst, 100 * worst_fraction))
+    assert worst <= 0.1
+    assert worst_fraction <= 0.03
+
+
 def test_microimage_differs_from_the_paraxial_thin_lens(args):
     """The test can fail: the same camera with thin microlenses of the paraxial focal length in the
     array's plane gives a microimage whose area differs from the refracting lens's by far more than 1 %."""

@@ -452,7 +452,7 @@ void add_spot_hit(const PlenopticCamera& m, LensIndex lens, const std::vector<Ve
 // lens, traced to the sensor. The image is the centroid of the passing samples' hits, their share
 // of the cone's footprint its fraction; the centroid is kept when it lands in light the renderer
 // delivers (delivered_point).
-const int kTracedGrid = 48;
+const int kTracedGrid = 64;
 
 void project_through_traced_lens(const PlenopticCamera& m, Homogeneous image, LensIndex lens,
                                  const std::vector<Vec2>& cone_polygon, double cone_area, std::vector<PixelHit>* hits)
