@@ -469,6 +469,8 @@ REAL_LENS_CASES = [
      ["focal_length", "microlens_array lens keyword", "allowed"], "unknown keywords are errors, never ignored"),
     ("refracting with focal_length", camera(array=array_with("focal_length 0.2", *refracting(head="lens {  " + MARK))),
      ["lens { }", "not several"], "one kind of microlens"),
+    ("refracting with a fill factor", camera(array=array_with(*refracting(), "fill_factor 0.8", close=BRACE)),
+     ["fill_factor", "not modelled for refracting microlenses"], "the caps fill their cells"),
     ("refracting behind a pinhole main lens", camera(main=main_with("pinhole", "distance 17"), array=array_with(*refracting()),
                                                      close=CAMERA_BRACE),
      ["pinhole main_lens with refracting microlenses", "not supported"], "no closed form for the one ray through a pinhole"),

@@ -332,6 +332,53 @@ TEST(RefractingMicrolens, TowardsSensorInvertsSampleRay)
     }
 }
 
+TEST(RefractingMicrolens, LensesWithErrorsFocusOnTheirOwnAxis)
+{
+    // Manufacturing errors move, tilt and rescale each lens: light parallel to a lens's own axis,
+    // near it, converges at its back focal point, the back focal distance of the thick lens from
+    // the lensmaker's formula (f - L/n behind the flat back, or f behind the cap's vertex) along
+    // the axis from its centre, with f the lens's own focal length.
+    for (bool scene_side : {true, false}) {
+        ArrayParams params;
+        params.given = true;
+        params.grid = GridType::Hexagonal;
+        params.has_pitch = true;
+        params.pitch_mm = 0.1;
+        params.has_lens = true;
+        params.lens = MicrolensType::Refracting;
+        params.refracting = shape(scene_side, 0.08, 1.5, 0.025, 0.03);
+        params.has_distance = true;
+        params.distance_mm = 0.2;
+        params.has_errors = true;
+        params.errors.position_sd_mm = 0.002;
+        params.errors.position_sd_z_mm = 0.002;
+        params.errors.focal_sd = 0.05;
+        params.errors.rotation_deg = 6;
+        params.errors.seed = 3;
+        const MicrolensArray array = make_microlens_array(params, -10);
+        ASSERT_TRUE(array.errors);
+        const double L = 0.025 + 0.03, n = 1.5;
+        for (int k = -3; k <= 3; ++k) {
+            const LensIndex lens{k, 1 - k};
+            const LensError e = array.error_of(lens);
+            const double f = array.focal_length_mm(lens);
+            EXPECT_NEAR(f, 0.08 / 0.5 * e.focal_factor, 1e-15);
+            const double bfd = scene_side ? f - L / n : f;
+            const Vec3 c = array.centre_mm(lens);
+            const Vec3 focus = c - bfd * e.axis;
+            const Vec3 u = normalized(cross(e.axis, Vec3{1, 0, 0})), v = cross(e.axis, u);
+            for (double a : {-1e-5, 2e-5})
+                for (double b : {1e-5, -3e-5}) {
+                    const Vec3 h = c + a * u + b * v;
+                    const ArrayRay out = array.microlens->towards_sensor(array, lens, h, -1.0 * e.axis);
+                    ASSERT_TRUE(out.passed);
+                    EXPECT_LT(length(cross(focus - out.origin, normalized(out.direction))), 1e-9 * f)
+                        << "lens " << k << ": the ray misses the back focal point";
+                }
+        }
+    }
+}
+
 TEST(RefractingMicrolens, KindMetadataAndDispersion)
 {
     const MicrolensArray array = refracting_array(true);

@@ -26,6 +26,7 @@ using detail::project_to_array;
 const int kCoarseSearch = 24;   // grid points a side when the start point is dark
 const int kMaxDoublings = 8;    // of the bracket, when a boundary lies beyond it
 const int kMaxBisections = 60;
+const int kRefractingAperturePoints = 12;  // a side, for lenses first-order optics does not describe
 
 // Area and first moments of light over the sensor, in pixels (corner convention: pixel (i, j)
 // spans [i, i + 1) x [j, j + 1)).
@@ -295,7 +296,12 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     }
 
     const bool thin = m.array.microlens->forms_image();  // a pinhole has one aperture point
-    const int n = thin ? std::max(1, options.aperture_points) : 1;
+    // A refracting lens's light from different cell points lands in regions of different sizes (its
+    // aberration): the midpoint rule over the cell then needs more points than an ideal lens's,
+    // whose regions are all alike.
+    const int points = m.array.microlens->first_order_exact() ? options.aperture_points
+                                                               : std::max(options.aperture_points, kRefractingAperturePoints);
+    const int n = thin ? std::max(1, points) : 1;
     auto measure = [&](std::size_t index) {
         MicroimageTruth& truth = out[index];
         Moments total{0, 0, 0};
