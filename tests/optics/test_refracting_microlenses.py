@@ -346,7 +346,7 @@ def test_refusals(args):
         ("substrate 0.05", "substrate 0", "substrate"),
         ("radius 0.09 }", "radius 0.09 conic 500 }", "conic"),
         ("curved_side scene", "curved_side up", "curved_side"),
-        ("lens {", "focal_length 0.2 lens {", "not several"),
+        ("\n    lens {", "\n    focal_length 0.2 lens {", "not several"),
         ("thin_lens focal_length 50 f_number 3.5 distance 50", "pinhole distance 50", "pinhole main_lens with refracting"),
         ("substrate 0.05", "", "needs"),
     ]

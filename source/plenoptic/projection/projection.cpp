@@ -449,9 +449,9 @@ void add_spot_hit(const PlenopticCamera& m, LensIndex lens, const std::vector<Ve
 // refracting microlens): the cone's footprint within the lens's cell grown by the glass's
 // thickness (light crossing the array's plane there may still enter and leave this lens), sampled
 // on a grid of kTracedGrid a side over that part's box; each sample's light from X' through the
-// lens, traced to the sensor. The image is the centroid of the passing samples' hits, their share
-// of the cone's footprint its fraction; the centroid is kept when it lands in light the renderer
-// delivers (delivered_point).
+// lens, traced to the sensor. The image is the centroid of the hits the renderer delivers
+// (delivered_point: in the lens's own microimage cell, or a cell within the overlap rings, and in
+// the picture), their share of the cone's footprint its fraction.
 const int kTracedGrid = 64;
 
 void project_through_traced_lens(const PlenopticCamera& m, Homogeneous image, LensIndex lens,
@@ -485,7 +485,7 @@ void project_through_traced_lens(const PlenopticCamera& m, Homogeneous image, Le
             if (dot(towards, m.array.pose.normal) > 0)
                 towards = -towards;
             Vec3 hit;
-            if (!sensor_hit_through_lens(m, lens, h, towards, &hit))
+            if (!sensor_hit_through_lens(m, lens, h, towards, &hit) || !delivered_point(m, lens, Vec2{hit.x, hit.y}))
                 continue;
             passed += 1;
             sx += hit.x;

@@ -26,7 +26,7 @@ using detail::project_to_array;
 const int kCoarseSearch = 24;   // grid points a side when the start point is dark
 const int kMaxDoublings = 8;    // of the bracket, when a boundary lies beyond it
 const int kMaxBisections = 60;
-const int kRefractingAperturePoints = 12;  // a side, for lenses first-order optics does not describe
+const int kRefractingAperturePoints = 24;  // a side, for lenses first-order optics does not describe
 
 // Area and first moments of light over the sensor, in pixels (corner convention: pixel (i, j)
 // spans [i, i + 1) x [j, j + 1)).
