@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <vector>
 
 #include "plenoptic/camera/rays.h"
@@ -448,11 +449,12 @@ void add_spot_hit(const PlenopticCamera& m, LensIndex lens, const std::vector<Ve
 // Light of the point whose image is X' through a lens whose trace is not first-order (a
 // refracting microlens): the cone's footprint within the lens's cell grown by the glass's
 // thickness (light crossing the array's plane there may still enter and leave this lens), sampled
-// on a grid of kTracedGrid a side over that part's box; each sample's light from X' through the
+// on a grid of kTracedGrid a side over the box of what a coarser grid finds passing; each sample's
+// light from X' through the
 // lens, traced to the sensor. The image is the centroid of the hits the renderer delivers
 // (delivered_point: in the lens's own microimage cell, or a cell within the overlap rings, and in
 // the picture), their share of the cone's footprint its fraction.
-const int kTracedGrid = 64;
+const int kTracedCoarseGrid = 24, kTracedGrid = 96;
 
 void project_through_traced_lens(const PlenopticCamera& m, Homogeneous image, LensIndex lens,
                                  const std::vector<Vec2>& cone_polygon, double cone_area, std::vector<PixelHit>* hits)
@@ -467,31 +469,50 @@ void project_through_traced_lens(const PlenopticCamera& m, Homogeneous image, Le
     const std::vector<Vec2> part = clip_polygon(cone_polygon, corners);
     if (part.size() < 3)
         return;
-    const Box region = bounding_box(part);
-    const double dx = (region.x1 - region.x0) / kTracedGrid, dy = (region.y1 - region.y0) / kTracedGrid;
-    if (!(dx > 0) || !(dy > 0))
-        return;
-    double passed = 0, sx = 0, sy = 0;
-    for (int j = 0; j < kTracedGrid; ++j) {
-        for (int i = 0; i < kTracedGrid; ++i) {
-            const Vec2 q{region.x0 + (i + 0.5) * dx, region.y0 + (j + 0.5) * dy};
-            bool inside = true;  // the part is convex (a convex cone's footprint clipped by a convex cell)
-            for (size_t k = 0; k < part.size() && inside; ++k)
-                inside = cross(part[(k + 1) % part.size()] - part[k], q - part[k]) >= 0;
-            if (!inside)
-                continue;
-            const Vec3 h = m.array.to_optics(Vec3{q.x, q.y, 0});
-            Vec3 towards = image.w == 0 ? image.xyz : (1 / image.w) * image.xyz - h;
-            if (dot(towards, m.array.pose.normal) > 0)
-                towards = -towards;
-            Vec3 hit;
-            if (!sensor_hit_through_lens(m, lens, h, towards, &hit) || !delivered_point(m, lens, Vec2{hit.x, hit.y}))
-                continue;
-            passed += 1;
-            sx += hit.x;
-            sy += hit.y;
+    // A coarse grid over the part finds the box of the samples that pass; the fine grid covers that
+    // box (grown by a coarse step), where the light through the lens lies.
+    const Box outer = bounding_box(part);
+    auto sample = [&](const Box& region, int grid, const std::function<void(Vec2, Vec3)>& use) {
+        const double dx = (region.x1 - region.x0) / grid, dy = (region.y1 - region.y0) / grid;
+        for (int j = 0; j < grid; ++j) {
+            for (int i = 0; i < grid; ++i) {
+                const Vec2 q{region.x0 + (i + 0.5) * dx, region.y0 + (j + 0.5) * dy};
+                bool inside = true;  // the part is convex (a convex cone's footprint clipped by a convex cell)
+                for (size_t k = 0; k < part.size() && inside; ++k)
+                    inside = cross(part[(k + 1) % part.size()] - part[k], q - part[k]) >= 0;
+                if (!inside)
+                    continue;
+                const Vec3 h = m.array.to_optics(Vec3{q.x, q.y, 0});
+                Vec3 towards = image.w == 0 ? image.xyz : (1 / image.w) * image.xyz - h;
+                if (dot(towards, m.array.pose.normal) > 0)
+                    towards = -towards;
+                Vec3 hit;
+                if (sensor_hit_through_lens(m, lens, h, towards, &hit) && delivered_point(m, lens, Vec2{hit.x, hit.y}))
+                    use(q, hit);
+            }
         }
-    }
+    };
+    const double coarse_x = (outer.x1 - outer.x0) / kTracedCoarseGrid, coarse_y = (outer.y1 - outer.y0) / kTracedCoarseGrid;
+    if (!(coarse_x > 0) || !(coarse_y > 0))
+        return;
+    Box found{true, INFINITY, -INFINITY, INFINITY, -INFINITY};
+    sample(outer, kTracedCoarseGrid, [&](Vec2 q, Vec3) {
+        found.x0 = std::min(found.x0, q.x);
+        found.x1 = std::max(found.x1, q.x);
+        found.y0 = std::min(found.y0, q.y);
+        found.y1 = std::max(found.y1, q.y);
+    });
+    if (!(found.x1 >= found.x0))
+        return;
+    const Box region{true, std::max(outer.x0, found.x0 - coarse_x), std::min(outer.x1, found.x1 + coarse_x),
+                     std::max(outer.y0, found.y0 - coarse_y), std::min(outer.y1, found.y1 + coarse_y)};
+    const double dx = (region.x1 - region.x0) / kTracedGrid, dy = (region.y1 - region.y0) / kTracedGrid;
+    double passed = 0, sx = 0, sy = 0;
+    sample(region, kTracedGrid, [&](Vec2, Vec3 hit) {
+        passed += 1;
+        sx += hit.x;
+        sy += hit.y;
+    });
     if (!(passed > 0))
         return;
     const double fraction = std::min(1.0, passed * dx * dy / cone_area);
