@@ -84,7 +84,7 @@ public:
             if (!(w.z > 0))
                 return no_ray();
             const Vec3 refracted{w.x / w.z - offset.x / f, w.y / w.z - offset.y / f, 1};
-            return ArrayRay{leave, mul(array.pose.rotation, refracted), true};
+            return ArrayRay{leave, mul(array.pose.rotation, refracted), true, leave};
         }
         const LensFrame frame = array.frame(lens);
         const Vec2 offset = array.cell_point(u, v);
