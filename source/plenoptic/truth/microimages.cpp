@@ -99,40 +99,161 @@ bool start_point(const LensProbe& probe, double gu, double gv, double reach, dou
     return true;
 }
 
-// The lit region star-shaped about a start point: boundary radius per direction by bisection,
-// then area and moments in polar form (trapezoid rule over the periodic angle).
-Moments region_moments(const LensProbe& probe, double gu, double gv, double search, double reach,
-                       const MicroimageOptions& options)
+// The boundary radius along direction (c, s) from the start point (su, sv), from scratch: a
+// bracket near the previous direction's radius when it holds, grown by doubling while its outer end
+// is lit, then bisected until it is tolerance_px narrow. Returns the middle of the last bracket.
+double boundary_from_scratch(const LensProbe& probe, double su, double sv, double c, double s, double previous,
+                             double reach, double tolerance_px)
 {
-    double su, sv;
-    if (!start_point(probe, gu, gv, search, &su, &sv))
-        return Moments{0, 0, 0};
-    const double dtheta = 2 * kPi / options.azimuths;
-    double area = 0, mu = 0, mv = 0, previous = 0;
-    for (int a = 0; a < options.azimuths; ++a) {
-        const double c = std::cos(a * dtheta), s = std::sin(a * dtheta);
-        // Bracket [lo lit, hi dark]: near the previous direction's radius when it holds.
-        double lo = 0, hi = reach;
+    // Bracket [lo lit, hi dark]: near the previous direction's radius when it holds.
+    double lo = 0, hi = reach;
+    if (previous > 0) {
+        const double inner = 0.8 * previous, outer = 1.25 * previous + 0.5;
+        if (probe.lit(su + inner * c, sv + inner * s))
+            lo = inner;
+        if (outer < hi && !probe.lit(su + outer * c, sv + outer * s))
+            hi = outer;
+    }
+    for (int k = 0; k < kMaxDoublings && probe.lit(su + hi * c, sv + hi * s); ++k) {
+        lo = hi;
+        hi *= 2;
+    }
+    for (int k = 0; k < kMaxBisections && hi - lo > tolerance_px; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        if (probe.lit(su + mid * c, sv + mid * s))
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+// The boundary radius along (c, s) on the grid of radii j tolerance_px (j = 0, 1, ...): the middle of
+// the grid step [j, j + 1] whose inner end is lit and outer end dark, sought near a predicted radius
+// when there is one (from the previous lenses of the row: the step there and the next one checked,
+// then walked inwards or outwards in doubling steps until a lit and a dark end hold the boundary),
+// else from the bracket a search from scratch finds, then bisected down to one step. The points
+// between the start point and the boundary are taken lit and those beyond it dark (the region is
+// star-shaped about the start point), so the answer, within half a step of a crossing as the middle
+// of a bisected bracket is, does not depend on the prediction: the lenses' results depend on the
+// lenses alone, not on the order they are measured in.
+double boundary_on_grid(const LensProbe& probe, double su, double sv, double c, double s, bool has_prediction,
+                        double predicted, double previous, double reach, double tolerance_px, bool* as_predicted)
+{
+    *as_predicted = false;
+    const double farthest = reach * (1 << kMaxDoublings);
+    const long long last = (long long)(farthest / tolerance_px) + 1;
+    auto lit = [&](long long j) {
+        if (j <= 0)
+            return true;  // the start point
+        const double r = j * tolerance_px;
+        return probe.lit(su + r * c, sv + r * s);
+    };
+    long long lo = 0, hi = last;  // lit, dark
+    bool bracketed = false;
+    if (has_prediction && predicted > 0 && predicted < farthest) {
+        const long long j = (long long)std::floor(predicted / tolerance_px);
+        const bool inner = lit(j), outer = lit(j + 1);
+        if (inner && !outer) {
+            *as_predicted = true;
+            return (j + 0.5) * tolerance_px;
+        }
+        if (!inner && !outer) {
+            // The boundary lies inside: walk in until lit (the start point itself is lit).
+            long long step = 1;
+            hi = j;
+            for (;;) {
+                lo = hi - step;
+                if (lo <= 0 || lit(lo))
+                    break;
+                hi = lo;
+                step *= 2;
+            }
+            lo = std::max(lo, 0LL);
+            bracketed = true;
+        } else if (inner && outer) {
+            // Outside: walk out until dark, no farther than a search from scratch would go.
+            long long step = 1;
+            lo = j + 1;
+            for (;;) {
+                hi = lo + step;
+                if (hi >= last || !lit(hi))
+                    break;
+                lo = hi;
+                step *= 2;
+            }
+            hi = std::min(hi, last);
+            bracketed = true;
+        }
+        // (A lit outer end beyond a dark inner one: not star-shaped there; search from scratch.)
+    }
+    if (!bracketed) {
+        // As from scratch: near the previous direction's radius when that holds, grown by doubling.
+        double rlo = 0, rhi = reach;
         if (previous > 0) {
             const double inner = 0.8 * previous, outer = 1.25 * previous + 0.5;
             if (probe.lit(su + inner * c, sv + inner * s))
-                lo = inner;
-            if (outer < hi && !probe.lit(su + outer * c, sv + outer * s))
-                hi = outer;
+                rlo = inner;
+            if (outer < rhi && !probe.lit(su + outer * c, sv + outer * s))
+                rhi = outer;
         }
-        for (int k = 0; k < kMaxDoublings && probe.lit(su + hi * c, sv + hi * s); ++k) {
-            lo = hi;
-            hi *= 2;
+        for (int k = 0; k < kMaxDoublings && probe.lit(su + rhi * c, sv + rhi * s); ++k) {
+            rlo = rhi;
+            rhi *= 2;
         }
-        for (int k = 0; k < kMaxBisections && hi - lo > options.tolerance_px; ++k) {
-            const double mid = 0.5 * (lo + hi);
-            if (probe.lit(su + mid * c, sv + mid * s))
-                lo = mid;
-            else
-                hi = mid;
-        }
-        const double r = 0.5 * (lo + hi);
+        lo = (long long)std::floor(rlo / tolerance_px);
+        hi = std::max(lo + 1, (long long)std::ceil(rhi / tolerance_px));
+    }
+    while (hi - lo > 1) {
+        const long long mid = lo + (hi - lo) / 2;
+        if (lit(mid))
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return (lo + 0.5) * tolerance_px;
+}
+
+// The lit region star-shaped about a start point: boundary radius per direction, then area and
+// moments in polar form (trapezoid rule over the periodic angle). With `predicted` (radii per
+// the same region of the previous lens of the row, per direction) each radius is sought near the
+// neighbour's; `radii` (if given) receives this region's radii (empty when there is no region).
+Moments region_moments(const LensProbe& probe, double gu, double gv, double search, double reach,
+                       const MicroimageOptions& options, Vec2 reference, const std::vector<double>* predicted,
+                       std::vector<double>* radii)
+{
+    if (radii)
+        radii->clear();
+    double su, sv;
+    if (!start_point(probe, gu, gv, search, &su, &sv))
+        return Moments{0, 0, 0};
+    const bool near = predicted && int(predicted->size()) == options.azimuths;
+    const double dtheta = 2 * kPi / options.azimuths;
+    double area = 0, mu = 0, mv = 0, previous = 0, moved = 0;
+    for (int a = 0; a < options.azimuths; ++a) {
+        const double c = std::cos(a * dtheta), s = std::sin(a * dtheta);
+        double r;
+        bool as_predicted = false;
+        // The prediction, moved as the previous direction's radius moved from its own when that move
+        // is more than the radii's own uncertainty (a displaced or rescaled microimage).
+        // (Radii are exchanged as seen from `reference`, to first order in the start point's offset
+        // from it: the start point moves from lens to lens, the boundary smoothly.)
+        const double from_start = (su - reference.x) * c + (sv - reference.y) * s;
+        const double guess = near ? (*predicted)[a] - from_start +
+                                        (std::fabs(moved) > 2 * options.tolerance_px ? moved : 0) : 0;
+        if (options.reuse_neighbours)
+            r = boundary_on_grid(probe, su, sv, c, s, near, guess, previous, reach, options.tolerance_px,
+                                 &as_predicted);
+        else
+            r = boundary_from_scratch(probe, su, sv, c, s, previous, reach, options.tolerance_px);
+        // What the next lens is predicted from: the prediction itself where it held (it lies in the
+        // same step as the boundary, and moves smoothly from lens to lens), else the step's middle.
+        const double found = as_predicted ? guess : r;
+        if (near)
+            moved = found + from_start - (*predicted)[a];
         previous = r;
+        if (radii)
+            radii->push_back(found + from_start);
         area += 0.5 * r * r * dtheta;
         mu += r * r * r / 3 * c * dtheta;
         mv += r * r * r / 3 * s * dtheta;
@@ -256,6 +377,7 @@ MicroimageOptions default_microimage_options()
     options.tolerance_px = 1e-3;
     options.aperture_points = 3;
     options.threads = 0;
+    options.reuse_neighbours = true;
     return options;
 }
 
@@ -279,20 +401,31 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     const double k0 = std::floor(box[0] / p) - 3, k1 = std::ceil(box[2] / p) + 3;
     if (!(l1 - l0 < 1e7 && k1 - k0 < 1e7))
         return out;
-    std::vector<Vec2> centres;
-    for (std::int64_t l = std::int64_t(l0); l <= std::int64_t(l1); ++l) {
-        for (std::int64_t k = std::int64_t(k0); k <= std::int64_t(k1); ++k) {
-            const LensIndex lens{k, l};
-            const MicroimageCentre centre = microimage_centre_px(m, lens);
-            const double cu = centre.u, cv = centre.v;
-            if (!centre.valid || !(cu >= -0.5 && cu < W - 0.5) ||
-                !(cv >= -0.5 && cv < H - 0.5))
-                continue;  // the lattice centre is not in the picture
-            MicroimageTruth truth = MicroimageTruth();
-            truth.lens = lens;
-            out.push_back(truth);
-            centres.push_back(Vec2{cu, cv});
+    // The lenses whose lattice centre is in the picture: counted first, so that the list takes no
+    // more memory than it holds (a Lytro-class raw has some 234,000).
+    auto in_picture = [&](LensIndex lens, Vec2* centre_px) {
+        const MicroimageCentre centre = microimage_centre_px(m, lens);
+        *centre_px = Vec2{centre.u, centre.v};
+        return centre.valid && centre.u >= -0.5 && centre.u < W - 0.5 && centre.v >= -0.5 && centre.v < H - 0.5;
+    };
+    for (int pass = 0; pass < 2; ++pass) {
+        std::size_t count = 0;
+        for (std::int64_t l = std::int64_t(l0); l <= std::int64_t(l1); ++l) {
+            for (std::int64_t k = std::int64_t(k0); k <= std::int64_t(k1); ++k) {
+                const LensIndex lens{k, l};
+                Vec2 centre;
+                if (!in_picture(lens, &centre))
+                    continue;  // the lattice centre is not in the picture
+                ++count;
+                if (pass == 1) {
+                    MicroimageTruth truth = MicroimageTruth();
+                    truth.lens = lens;
+                    out.push_back(truth);
+                }
+            }
         }
+        if (pass == 0)
+            out.reserve(count);
     }
 
     const bool thin = m.array.microlens->forms_image();  // a pinhole has one aperture point
@@ -302,19 +435,60 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     const int points = m.array.microlens->first_order_exact() ? options.aperture_points
                                                                : std::max(options.aperture_points, kRefractingAperturePoints);
     const int n = thin ? std::max(1, points) : 1;
-    auto measure = [&](std::size_t index) {
+    // Per aperture point, the radii of its region in the last kHistory lenses of a run, newest
+    // first (fewer at the run's start or after a lens without that region), and a prediction.
+    const std::size_t kHistory = 2;
+    struct Radii {
+        std::vector<std::vector<std::vector<double>>> history;
+        std::vector<double> predicted, now;
+    };
+    auto measure = [&](std::size_t index, Radii* radii) {
         MicroimageTruth& truth = out[index];
+        Vec2 centre;
+        in_picture(truth.lens, &centre);
         Moments total{0, 0, 0};
         for (int j = 0; j < n; ++j) {
             for (int i = 0; i < n; ++i) {
+                const int point = j * n + i;
+                std::vector<double>* now = radii ? &radii->now : nullptr;
+                const std::vector<double>* predicted = nullptr;
+                if (radii) {
+                    // The last radii moved by their mean change per lens over the history.
+                    now->clear();
+                    const std::vector<std::vector<double>>& past = radii->history[point];
+                    if (!past.empty()) {
+                        const std::size_t h = past.size();
+                        radii->predicted = past[0];
+                        for (std::size_t a = 0; h > 1 && a < past[0].size(); ++a)
+                            radii->predicted[a] += (past[0][a] - past[h - 1][a]) / double(h - 1);
+                        predicted = &radii->predicted;
+                    }
+                }
                 const double lens_u = thin ? (i + 0.5) / n : 0.5, lens_v = thin ? (j + 0.5) / n : 0.5;
-                const Guess guess = guess_region(light, truth.lens, lens_u, lens_v, centres[index]);
-                if (!guess.possible)
+                const Guess guess = guess_region(light, truth.lens, lens_u, lens_v, centre);
+                if (!guess.possible) {
+                    if (radii)
+                        radii->history[point].clear();
                     continue;
+                }
                 const LensProbe probe(light, truth.lens, lens_u, lens_v);
                 // A start point anywhere in the disc is at most its diameter from the boundary.
                 const double search = guess.radius_px + 1, reach = 2.1 * guess.radius_px + 1;
-                const Moments region = region_moments(probe, guess.u, guess.v, search, reach, options);
+                const Vec2 reference{centre.x + 0.5, centre.y + 0.5};
+                const Moments region =
+                    region_moments(probe, guess.u, guess.v, search, reach, options, reference, predicted, now);
+                if (radii) {
+                    std::vector<std::vector<double>>& past = radii->history[point];
+                    if (now->empty()) {
+                        past.clear();
+                    } else {
+                        if (past.size() < kHistory)
+                            past.push_back(std::vector<double>());
+                        for (std::size_t age = past.size() - 1; age > 0; --age)
+                            std::swap(past[age], past[age - 1]);
+                        std::swap(past[0], *now);
+                    }
+                }
                 total.area += region.area / (n * n);
                 total.mu += region.mu / (n * n);
                 total.mv += region.mv / (n * n);
@@ -327,34 +501,48 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         truth.lit_fraction = cell > 0 ? total.area / cell : 0;
     };
 
-    // Lenses are handed out one at a time to the threads; each result has its own slot, so the
-    // output does not depend on the thread count. The calling thread works too and reports.
+    // Runs of up to kRun neighbouring lenses of one row (k, k + 1, ...): the first lens of a run is
+    // measured from scratch, each next one near the one before (its boundary moves little from lens
+    // to lens). Runs are fixed by the lenses alone and handed out one at a time to the threads, each
+    // result in its own slot, so the output does not depend on the thread count.
+    const std::size_t kRun = 256;
+    std::vector<std::size_t> runs;  // the first lens of each run, then out.size()
+    for (std::size_t i = 0; i < out.size(); ++i)
+        if (i == 0 || i - runs.back() >= kRun || out[i].lens.l != out[i - 1].lens.l ||
+            out[i].lens.k != out[i - 1].lens.k + 1)
+            runs.push_back(i);
+    runs.push_back(out.size());
+    const bool reuse = options.reuse_neighbours;
     std::atomic<std::size_t> next(0), done(0);
     std::atomic<bool> stop(false);
-    auto work = [&]() {
-        for (std::size_t i = next++; i < out.size() && !stop; i = next++) {
-            measure(i);
-            ++done;
+    std::size_t reported = 0;
+    // The calling thread (`reports`) works too: it polls `cancelled` between lenses and reports.
+    auto work = [&](bool reports) {
+        Radii radii;
+        radii.history.resize(n * n);
+        for (std::size_t r = next++; r + 1 < runs.size() && !stop; r = next++) {
+            for (std::vector<std::vector<double>>& past : radii.history)
+                past.clear();
+            for (std::size_t i = runs[r]; i < runs[r + 1] && !stop; ++i) {
+                if (reports && cancelled && cancelled()) {
+                    stop = true;
+                    break;
+                }
+                measure(i, reuse ? &radii : nullptr);
+                const std::size_t now = ++done;
+                if (reports && progress && now * 10 / out.size() > reported * 10 / out.size()) {
+                    reported = now;
+                    progress(now, out.size());
+                }
+            }
         }
     };
     const unsigned hardware = std::thread::hardware_concurrency();
     const int threads = options.threads > 0 ? options.threads : int(std::max(1u, hardware));
     std::vector<std::thread> workers;
-    for (int t = 1; t < threads && std::size_t(t) < out.size(); ++t)
-        workers.push_back(std::thread(work));
-    std::size_t reported = 0;
-    for (std::size_t i = next++; i < out.size() && !stop; i = next++) {
-        if (cancelled && cancelled()) {
-            stop = true;
-            break;
-        }
-        measure(i);
-        const std::size_t now = ++done;
-        if (progress && now * 10 / out.size() > reported * 10 / out.size()) {
-            reported = now;
-            progress(now, out.size());
-        }
-    }
+    for (int t = 1; t < threads && std::size_t(t) + 1 < runs.size(); ++t)
+        workers.push_back(std::thread(work, false));
+    work(true);
     for (std::thread& worker : workers)
         worker.join();
     if (stop)
@@ -474,15 +662,22 @@ std::string shortest(double value)
 
 } // namespace
 
-std::string microimages_csv(const PlenopticCamera& m, const std::vector<MicroimageTruth>& truth, const LatticeFit& fit,
-                            const std::vector<std::vector<MicroimageTruth>>& channels)
+std::string microimages_csv_header(const PlenopticCamera& m, bool per_channel)
+{
+    std::string out = "k,l,u,v,lit_fraction,residual_u,residual_v";
+    out += per_channel ? ",u_r,v_r,u_g,v_g,u_b,v_b" : "";
+    out += m.array.errors ? ",dx_mm,dy_mm,dz_mm,focal_length_mm,tilt_deg,tilt_azimuth_deg\n" : "\n";
+    return out;
+}
+
+std::string microimages_csv_lines(const PlenopticCamera& m, const std::vector<MicroimageTruth>& truth,
+                                  const LatticeFit& fit, const std::vector<std::vector<MicroimageTruth>>& channels,
+                                  std::size_t begin, std::size_t end)
 {
     const bool per_channel = channels.size() == 3;
     const bool errors = m.array.errors != nullptr;
-    std::string out = "k,l,u,v,lit_fraction,residual_u,residual_v";
-    out += per_channel ? ",u_r,v_r,u_g,v_g,u_b,v_b" : "";
-    out += errors ? ",dx_mm,dy_mm,dz_mm,focal_length_mm,tilt_deg,tilt_azimuth_deg\n" : "\n";
-    for (std::size_t index = 0; index < truth.size(); ++index) {
+    std::string out;
+    for (std::size_t index = begin; index < end && index < truth.size(); ++index) {
         const MicroimageTruth& t = truth[index];
         out += std::to_string(static_cast<long long>(t.lens.k)) + "," + std::to_string(static_cast<long long>(t.lens.l));
         if (t.lit) {
@@ -510,6 +705,13 @@ std::string microimages_csv(const PlenopticCamera& m, const std::vector<Microima
         out += "\n";
     }
     return out;
+}
+
+std::string microimages_csv(const PlenopticCamera& m, const std::vector<MicroimageTruth>& truth, const LatticeFit& fit,
+                            const std::vector<std::vector<MicroimageTruth>>& channels)
+{
+    return microimages_csv_header(m, channels.size() == 3) +
+           microimages_csv_lines(m, truth, fit, channels, 0, truth.size());
 }
 
 } // namespace plenoptic

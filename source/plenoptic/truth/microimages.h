@@ -46,6 +46,10 @@ struct MicroimageOptions {
     int aperture_points;
     // Threads measuring lenses (0: one per hardware thread); the result does not depend on it.
     int threads;
+    // Seek each boundary radius near the same radius of the previous lens of its row (each
+    // prediction checked by the renderer's rays, each answer as close to a crossing as without);
+    // false: every lens from scratch (the reference the unit tests compare against).
+    bool reuse_neighbours;
 };
 
 // Called now and then (about every tenth of the lenses) with the lenses done and their number.
@@ -120,6 +124,12 @@ MicroimageSummary summarise_microimages(const PlenopticCamera& model, const std:
 std::string microimages_csv(const PlenopticCamera& model, const std::vector<MicroimageTruth>& truth, const LatticeFit& fit,
                             const std::vector<std::vector<MicroimageTruth>>& channels =
                                 std::vector<std::vector<MicroimageTruth>>());
+// The same text in pieces, for writing it as it is made (a Lytro-class raw's is some 25 MB): the
+// header line, and the lines of lenses begin .. end - 1.
+std::string microimages_csv_header(const PlenopticCamera& model, bool per_channel);
+std::string microimages_csv_lines(const PlenopticCamera& model, const std::vector<MicroimageTruth>& truth,
+                                  const LatticeFit& fit, const std::vector<std::vector<MicroimageTruth>>& channels,
+                                  std::size_t begin, std::size_t end);
 
 } // namespace plenoptic
 

@@ -192,6 +192,65 @@ TEST(MicroimageTruth, ThinMicrolensesConvergeInApertureAndThreadsDoNotMatter)
     EXPECT_LT(worst_fraction, 0.005);
 }
 
+// Seeking each boundary near the previous lenses' (the default) against measuring every lens from
+// scratch (the reference): the same lenses, the same centres within 0.001 px and lit fractions
+// within 1e-4, behind the vignetting triplet (cat's eyes, thin and pinhole microlenses, rows of
+// many lenses) and behind an ideal lens; and the same bits whatever the thread count.
+TEST(MicroimageTruth, ReusingNeighboursAgreesWithEveryLensFromScratch)
+{
+    const Prescription lens = vignetting_triplet();
+    const ImageDistance focus = paraxial_image_distance(lens, 3000);
+    ASSERT_TRUE(focus.real);
+    CameraParams thin = plenoptic_camera(GridType::Hexagonal, 1.0, 3.4, 3.4, 50, 4, focus.mm);
+    thin.main.type = MainLensType::Prescription;
+    thin.main.has_focal_length = false;
+    thin.main.has_f_number = false;
+    thin.main.has_prescription = true;
+    thin.main.prescription = lens;
+    thin.sensor.pixel_size_mm[0] = thin.sensor.pixel_size_mm[1] = 0.1;
+    CameraParams ideal = plenoptic_camera(GridType::Rectangular, 0.2, 0.8, 0.8, 50, 8, 52);
+    ideal.sensor.pixel_size_mm[0] = ideal.sensor.pixel_size_mm[1] = 0.01;
+    struct Case {
+        const char* name;
+        PlenopticCamera camera;
+    };
+    const Case cases[] = {{"triplet, thin microlenses", with_film(make_camera(thin), 360, 300)},
+                          {"triplet, pinholes", with_film(make_camera(triplet_pinholes_camera()), 120, 120)},
+                          {"ideal lens", with_film(make_camera(ideal), 401, 301)}};
+    for (const Case& c : cases) {
+        MicroimageOptions fast = default_microimage_options(), reference = fast, one_thread = fast;
+        ASSERT_TRUE(fast.reuse_neighbours);
+        reference.reuse_neighbours = false;
+        fast.threads = 3;
+        one_thread.threads = 1;
+        const std::vector<MicroimageTruth> a = microimage_truth(c.camera, fast);
+        const std::vector<MicroimageTruth> b = microimage_truth(c.camera, reference);
+        const std::vector<MicroimageTruth> d = microimage_truth(c.camera, one_thread);
+        ASSERT_EQ(a.size(), b.size()) << c.name;
+        ASSERT_EQ(a.size(), d.size()) << c.name;
+        ASSERT_GT(a.size(), 100u) << c.name;
+        double worst_px = 0, worst_fraction = 0;
+        int lit = 0;
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            ASSERT_TRUE(a[i].lens == b[i].lens && a[i].lit == b[i].lit) << c.name << " " << i;
+            ASSERT_TRUE(a[i].lens == d[i].lens && a[i].lit == d[i].lit) << c.name << " " << i;
+            EXPECT_EQ(a[i].u_px, d[i].u_px);  // bit for bit
+            EXPECT_EQ(a[i].v_px, d[i].v_px);
+            EXPECT_EQ(a[i].lit_fraction, d[i].lit_fraction);
+            worst_fraction = std::max(worst_fraction, std::fabs(a[i].lit_fraction - b[i].lit_fraction));
+            if (!a[i].lit)
+                continue;
+            ++lit;
+            worst_px = std::max(worst_px, std::max(std::fabs(a[i].u_px - b[i].u_px), std::fabs(a[i].v_px - b[i].v_px)));
+        }
+        EXPECT_GT(lit, 100) << c.name;
+        EXPECT_LT(worst_px, 1e-3) << c.name;
+        EXPECT_LT(worst_fraction, 1e-4) << c.name;
+        std::printf("%s: %zu lenses, largest difference %.2g px, lit fraction %.2g\n", c.name, a.size(), worst_px,
+                    worst_fraction);
+    }
+}
+
 TEST(MicroimageTruth, LatticeFitRecoversAGivenLattice)
 {
     const PlenopticCamera m = make_camera(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52));

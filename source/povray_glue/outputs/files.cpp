@@ -68,7 +68,11 @@ std::string base_name(const std::string& path)
     return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
-bool write_file_atomically(const char* what, const std::string& path, const std::string& bytes)
+namespace {
+
+// Opens a temporary file beside `path`, lets write() fill it (false: failed), and renames it onto
+// `path`; on failure reports and removes the temporary file.
+bool write_through_temporary(const char* what, const std::string& path, const std::function<bool(FILE*)>& write)
 {
     const std::string tmp = temporary_beside(path);
     if (tmp.empty()) {
@@ -81,13 +85,34 @@ bool write_file_atomically(const char* what, const std::string& path, const std:
         std::remove(tmp.c_str());
         return false;
     }
-    const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    const bool ok = write(f);
     if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
         report_failure(what, path, errno);
         std::remove(tmp.c_str());
         return false;
     }
     return true;
+}
+
+} // namespace
+
+bool write_file_atomically(const char* what, const std::string& path, const std::string& bytes)
+{
+    return write_through_temporary(what, path, [&](FILE* f) {
+        return std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    });
+}
+
+bool write_file_atomically(const char* what, const std::string& path,
+                           const std::function<bool(std::string* piece)>& next)
+{
+    return write_through_temporary(what, path, [&](FILE* f) {
+        std::string piece;
+        while (next(&piece))
+            if (std::fwrite(piece.data(), 1, piece.size(), f) != piece.size())
+                return false;
+        return true;
+    });
 }
 
 bool write_float_exr(const std::string& path, const char* what, const char* channel, int W, int H,

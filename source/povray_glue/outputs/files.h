@@ -19,6 +19,10 @@ std::string base_name(const std::string& path);
 
 // Writes `bytes` to `path`; `what` names the file in messages.
 bool write_file_atomically(const char* what, const std::string& path, const std::string& bytes);
+// The same, the bytes made piece by piece as they are written (memory: one piece): next(&piece)
+// sets the next piece and returns true, or returns false when there is none left.
+bool write_file_atomically(const char* what, const std::string& path,
+                           const std::function<bool(std::string* piece)>& next);
 
 // Writes a W x H one-channel float EXR (channel `channel`) row by row (memory: one row):
 // fill(j, row) fills row j and returns false to stop (cancelled: nothing is written, no

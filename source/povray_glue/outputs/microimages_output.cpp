@@ -21,7 +21,8 @@ public:
     {
         const PlenopticCamera& model = image.camera;
         const MicroimageOptions options = default_microimage_options();
-        // Seconds for large arrays (about 0.5 ms a lens and thread behind a real lens): say how far.
+        // Seconds for large arrays (a fraction of a millisecond a lens and thread behind a real lens): say
+        // how far.
         const MicroimageProgress progress = [](std::size_t done, std::size_t total) {
             if (total >= 20000)
                 std::fprintf(stderr, "plenoptic camera: microimage centres: %zu of %zu lenses\n", done, total);
@@ -51,7 +52,25 @@ public:
                 return true;
             }
         }
-        if (!write_file_atomically("microimage centres", path, microimages_csv(model, truth, summary.fit, channels)))
+        // Written as it is made, a few thousand lenses at a time (the whole text of a Lytro-class
+        // raw would be some 25 MB held at once).
+        const std::size_t kPiece = 4096;
+        std::size_t written = 0;
+        bool header = false;
+        const bool per_channel = channels.size() == 3;
+        const bool ok = write_file_atomically("microimage centres", path, [&](std::string* piece) {
+            if (!header) {
+                header = true;
+                *piece = microimages_csv_header(model, per_channel);
+                return true;
+            }
+            if (written >= truth.size())
+                return false;
+            *piece = microimages_csv_lines(model, truth, summary.fit, channels, written, written + kPiece);
+            written += kPiece;
+            return true;
+        });
+        if (!ok)
             return false;
         summary_.reset(new MicroimageSummary(summary));
         files.microimages = summary_.get();
