@@ -8,10 +8,12 @@
 //
 //   plenoptic_microimage_truth --lens-file FILE --f-number N --focus-distance Z
 //       --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--offset X_MM Y_MM] [--threads T]
-//       [--csv OUT]
+//       [--errors S F R SEED] [--reference] [--csv OUT]
 //
 // --offset shifts the sensor (sensor { offset }): a crop of a larger raw away from its centre,
-// e.g. its corner.
+// e.g. its corner. --errors gives the array manufacturing errors (errors { position S focal_length F
+// rotation R seed SEED }). --reference measures every lens from scratch (reuse_neighbours false: the
+// integration as it was before the neighbours' radii were reused).
 
 #include <chrono>
 #include <cstdio>
@@ -42,6 +44,10 @@ struct Options {
     double pitch_mm = 0, focal_mm = 0, distance_mm = 0;
     double offset_mm[2] = {0, 0};
     int threads = 0;
+    bool errors = false;
+    bool reference = false;
+    double error_values[3] = {0, 0, 0};
+    long long seed = 0;
     std::string csv;
 };
 
@@ -69,6 +75,13 @@ bool parse(int argc, char** argv, Options* o)
             o->offset_mm[1] = std::atof(argv[++a]);
         } else if (arg == "--threads" && left >= 1)
             o->threads = std::atoi(argv[++a]);
+        else if (arg == "--errors" && left >= 4) {
+            o->errors = true;
+            for (double& value : o->error_values)
+                value = std::atof(argv[++a]);
+            o->seed = std::atoll(argv[++a]);
+        } else if (arg == "--reference")
+            o->reference = true;
         else if (arg == "--csv" && left >= 1)
             o->csv = argv[++a];
         else
@@ -94,7 +107,7 @@ int main(int argc, char** argv)
     if (!parse(argc, argv, &o)) {
         std::fprintf(stderr, "usage: plenoptic_microimage_truth --lens-file FILE --f-number N --focus-distance Z\n"
                              "         --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--offset X_MM Y_MM]\n"
-                             "         [--threads T] [--csv OUT]\n");
+                             "         [--threads T] [--errors S F R SEED] [--reference] [--csv OUT]\n");
         return 2;
     }
     std::ifstream file(o.lens_file);
@@ -133,6 +146,13 @@ int main(int argc, char** argv)
     p.array.focal_lengths_mm[0] = o.focal_mm;
     p.array.has_distance = true;
     p.array.distance_mm = o.distance_mm;
+    if (o.errors) {
+        p.array.has_errors = true;
+        p.array.errors.position_sd_mm = o.error_values[0];
+        p.array.errors.focal_sd = o.error_values[1];
+        p.array.errors.rotation_deg = o.error_values[2];
+        p.array.errors.seed = o.seed;
+    }
     const std::string error = check_camera(p);
     if (!error.empty()) {
         std::fprintf(stderr, "plenoptic_microimage_truth: %s\n", error.c_str());
@@ -141,6 +161,7 @@ int main(int argc, char** argv)
     const PlenopticCamera m = with_film(make_camera(p), o.width, o.height);
     MicroimageOptions options = default_microimage_options();
     options.threads = o.threads;
+    options.reuse_neighbours = !o.reference;
 
     const double cpu0 = cpu_seconds();
     const auto wall0 = std::chrono::steady_clock::now();

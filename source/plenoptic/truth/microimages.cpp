@@ -131,14 +131,16 @@ double boundary_from_scratch(const LensProbe& probe, double su, double sv, doubl
 // The boundary radius along (c, s) on the grid of radii j tolerance_px (j = 0, 1, ...): the middle of
 // the grid step [j, j + 1] whose inner end is lit and outer end dark, sought near a predicted radius
 // when there is one (from the previous lenses of the row: the step there and the next one checked,
-// then walked inwards or outwards in doubling steps until a lit and a dark end hold the boundary),
+// then walked inwards or outwards in doubling steps, the first first_step grid steps long, until a
+// lit and a dark end hold the boundary),
 // else from the bracket a search from scratch finds, then bisected down to one step. The points
 // between the start point and the boundary are taken lit and those beyond it dark (the region is
 // star-shaped about the start point), so the answer, within half a step of a crossing as the middle
 // of a bisected bracket is, does not depend on the prediction: the lenses' results depend on the
 // lenses alone, not on the order they are measured in.
 double boundary_on_grid(const LensProbe& probe, double su, double sv, double c, double s, bool has_prediction,
-                        double predicted, double previous, double reach, double tolerance_px, bool* as_predicted)
+                        double predicted, long long first_step, double previous, double reach, double tolerance_px,
+                        bool* as_predicted)
 {
     *as_predicted = false;
     const double farthest = reach * (1 << kMaxDoublings);
@@ -160,7 +162,7 @@ double boundary_on_grid(const LensProbe& probe, double su, double sv, double c, 
         }
         if (!inner && !outer) {
             // The boundary lies inside: walk in until lit (the start point itself is lit).
-            long long step = 1;
+            long long step = first_step;
             hi = j;
             for (;;) {
                 lo = hi - step;
@@ -173,7 +175,7 @@ double boundary_on_grid(const LensProbe& probe, double su, double sv, double c, 
             bracketed = true;
         } else if (inner && outer) {
             // Outside: walk out until dark, no farther than a search from scratch would go.
-            long long step = 1;
+            long long step = first_step;
             lo = j + 1;
             for (;;) {
                 hi = lo + step;
@@ -214,43 +216,82 @@ double boundary_on_grid(const LensProbe& probe, double su, double sv, double c, 
     return (lo + 0.5) * tolerance_px;
 }
 
+// How a region's radii differ from their prediction (the previous lenses'): a + b cos(theta) +
+// c sin(theta), a change of size and a move of the region, such as a displaced, tilted or rescaled
+// lens gives all of its regions alike.
+struct RadiusChange {
+    double a = 0, b = 0, c = 0;
+    double at(double cosine, double sine) const { return a + b * cosine + c * sine; }
+};
+
 // The lit region star-shaped about a start point: boundary radius per direction, then area and
-// moments in polar form (trapezoid rule over the periodic angle). With `predicted` (radii per
-// the same region of the previous lens of the row, per direction) each radius is sought near the
-// neighbour's; `radii` (if given) receives this region's radii (empty when there is no region).
+// moments in polar form (trapezoid rule over the periodic angle). With `predicted` (the radii of
+// the same region of the previous lenses of the row, per direction, as seen from `reference`) each
+// radius is sought near its prediction, corrected by `change` (in: the lens's previous region's;
+// out: this region's, fitted as the directions are measured); `radii` (if given) receives this
+// region's radii as seen from `reference` (empty when there is no region).
 Moments region_moments(const LensProbe& probe, double gu, double gv, double search, double reach,
                        const MicroimageOptions& options, Vec2 reference, const std::vector<double>* predicted,
-                       std::vector<double>* radii)
+                       RadiusChange* change, std::vector<double>* radii)
 {
     if (radii)
         radii->clear();
     double su, sv;
     if (!start_point(probe, gu, gv, search, &su, &sv))
         return Moments{0, 0, 0};
-    const bool near = predicted && int(predicted->size()) == options.azimuths;
+    const bool near = predicted && int(predicted->size()) == options.azimuths && change;
+    const RadiusChange start = change ? *change : RadiusChange();
+    RadiusChange now = start;
+    // Least squares of the differences from `start` over (1, cos, sin), drawn towards no difference
+    // in its move (a ridge of weight 2: a few neighbouring directions cannot tell a move from a resize).
+    double n11 = 1e-3, n12 = 0, n13 = 0, n22 = 2, n23 = 0, n33 = 2, r1 = 0, r2 = 0, r3 = 0;
     const double dtheta = 2 * kPi / options.azimuths;
-    double area = 0, mu = 0, mv = 0, previous = 0, moved = 0;
+    const double significant = 2 * options.tolerance_px;  // below it a change is the radii's own noise
+    double area = 0, mu = 0, mv = 0, previous = 0;
+    long long first_step = 1;  // of a walk from a failed prediction: about the last miss
     for (int a = 0; a < options.azimuths; ++a) {
         const double c = std::cos(a * dtheta), s = std::sin(a * dtheta);
         double r;
         bool as_predicted = false;
-        // The prediction, moved as the previous direction's radius moved from its own when that move
-        // is more than the radii's own uncertainty (a displaced or rescaled microimage).
         // (Radii are exchanged as seen from `reference`, to first order in the start point's offset
         // from it: the start point moves from lens to lens, the boundary smoothly.)
         const double from_start = (su - reference.x) * c + (sv - reference.y) * s;
-        const double guess = near ? (*predicted)[a] - from_start +
-                                        (std::fabs(moved) > 2 * options.tolerance_px ? moved : 0) : 0;
+        const bool corrected =
+            std::max(std::fabs(now.a), std::max(std::fabs(now.b), std::fabs(now.c))) > significant;
+        const double guess = near ? (*predicted)[a] - from_start + (corrected ? now.at(c, s) : 0) : 0;
         if (options.reuse_neighbours)
-            r = boundary_on_grid(probe, su, sv, c, s, near, guess, previous, reach, options.tolerance_px,
-                                 &as_predicted);
+            r = boundary_on_grid(probe, su, sv, c, s, near, guess, first_step, previous, reach,
+                                 options.tolerance_px, &as_predicted);
         else
             r = boundary_from_scratch(probe, su, sv, c, s, previous, reach, options.tolerance_px);
         // What the next lens is predicted from: the prediction itself where it held (it lies in the
         // same step as the boundary, and moves smoothly from lens to lens), else the step's middle.
         const double found = as_predicted ? guess : r;
         if (near)
-            moved = found + from_start - (*predicted)[a];
+            first_step = std::max(1LL, std::min(1LL << 20, (long long)(0.5 * std::fabs(r - guess) / options.tolerance_px)));
+        if (near) {
+            const double e = found + from_start - (*predicted)[a] - start.at(c, s);
+            n12 += c;
+            n13 += s;
+            n22 += c * c;
+            n23 += c * s;
+            n33 += s * s;
+            n11 += 1;
+            r1 += e;
+            r2 += e * c;
+            r3 += e * s;
+            // Cramer's rule on the symmetric 3 x 3 system.
+            const double det = n11 * (n22 * n33 - n23 * n23) - n12 * (n12 * n33 - n23 * n13) +
+                               n13 * (n12 * n23 - n22 * n13);
+            if (det > 0) {
+                now.a = start.a + (r1 * (n22 * n33 - n23 * n23) - n12 * (r2 * n33 - n23 * r3) +
+                                   n13 * (r2 * n23 - n22 * r3)) / det;
+                now.b = start.b + (n11 * (r2 * n33 - n23 * r3) - r1 * (n12 * n33 - n23 * n13) +
+                                   n13 * (n12 * r3 - r2 * n13)) / det;
+                now.c = start.c + (n11 * (n22 * r3 - r2 * n23) - n12 * (n12 * r3 - r2 * n13) +
+                                   r1 * (n12 * n23 - n22 * n13)) / det;
+            }
+        }
         previous = r;
         if (radii)
             radii->push_back(found + from_start);
@@ -258,6 +299,8 @@ Moments region_moments(const LensProbe& probe, double gu, double gv, double sear
         mu += r * r * r / 3 * c * dtheta;
         mv += r * r * r / 3 * s * dtheta;
     }
+    if (change && near)
+        *change = now;
     return Moments{area, area * su + mu, area * sv + mv};
 }
 
@@ -447,6 +490,7 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         Vec2 centre;
         in_picture(truth.lens, &centre);
         Moments total{0, 0, 0};
+        RadiusChange change;  // of this lens's regions from their predictions
         for (int j = 0; j < n; ++j) {
             for (int i = 0; i < n; ++i) {
                 const int point = j * n + i;
@@ -476,7 +520,7 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
                 const double search = guess.radius_px + 1, reach = 2.1 * guess.radius_px + 1;
                 const Vec2 reference{centre.x + 0.5, centre.y + 0.5};
                 const Moments region =
-                    region_moments(probe, guess.u, guess.v, search, reach, options, reference, predicted, now);
+                    region_moments(probe, guess.u, guess.v, search, reach, options, reference, predicted, &change, now);
                 if (radii) {
                     std::vector<std::vector<double>>& past = radii->history[point];
                     if (now->empty()) {

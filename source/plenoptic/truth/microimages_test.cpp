@@ -195,7 +195,8 @@ TEST(MicroimageTruth, ThinMicrolensesConvergeInApertureAndThreadsDoNotMatter)
 // Seeking each boundary near the previous lenses' (the default) against measuring every lens from
 // scratch (the reference): the same lenses, the same centres within 0.001 px and lit fractions
 // within 1e-4, behind the vignetting triplet (cat's eyes, thin and pinhole microlenses, rows of
-// many lenses) and behind an ideal lens; and the same bits whatever the thread count.
+// many lenses; an array with manufacturing errors) and behind an ideal lens; and the same bits
+// whatever the thread count.
 TEST(MicroimageTruth, ReusingNeighboursAgreesWithEveryLensFromScratch)
 {
     const Prescription lens = vignetting_triplet();
@@ -214,7 +215,16 @@ TEST(MicroimageTruth, ReusingNeighboursAgreesWithEveryLensFromScratch)
         const char* name;
         PlenopticCamera camera;
     };
+    // The same with manufacturing errors: each lens displaced (0.01 mm, a tenth of a pixel), its
+    // focal length scaled (2 %) and tilted (up to 1 degree), so neighbours' boundaries differ.
+    CameraParams jittered = thin;
+    jittered.array.has_errors = true;
+    jittered.array.errors.position_sd_mm = 0.01;
+    jittered.array.errors.focal_sd = 0.02;
+    jittered.array.errors.rotation_deg = 1;
+    jittered.array.errors.seed = 7;
     const Case cases[] = {{"triplet, thin microlenses", with_film(make_camera(thin), 360, 300)},
+                          {"triplet, thin microlenses with errors", with_film(make_camera(jittered), 360, 300)},
                           {"triplet, pinholes", with_film(make_camera(triplet_pinholes_camera()), 120, 120)},
                           {"ideal lens", with_film(make_camera(ideal), 401, 301)}};
     for (const Case& c : cases) {
