@@ -37,7 +37,9 @@ struct MicroimageOptions {
     // (area = 1/2 sum r^2 dtheta, moments = 1/3 sum r^3 (cos, sin) dtheta), which the trapezoid
     // rule integrates spectrally for smooth boundaries.
     int azimuths;
-    // Bisection on each boundary radius stops when its bracket is this narrow (pixels).
+    // Each boundary radius is found to within a bracket this narrow (pixels): with
+    // reuse_neighbours the step of the grid 0, tolerance_px, 2 tolerance_px, ... that holds the
+    // boundary, else a bisected bracket; the radius is the bracket's middle.
     double tolerance_px;
     // Thin microlenses: aperture points of the lens, aperture_points x aperture_points on the
     // renderer's own uniform map of the cell (pairs symmetric about the centre, so terms linear in
@@ -67,7 +69,8 @@ MicroimageOptions default_microimage_options();
 // cut at the picture's edge. Each microimage is taken star-shaped about its start point (the
 // lattice centre, or the centroid of a coarse search when that point is dark): the region
 // between that point and the first boundary crossing along each direction. Needs a main lens and
-// an array (empty otherwise). Deterministic.
+// an array (empty otherwise). Deterministic: each lens's result depends on that lens alone (not on the
+// thread count nor on which lenses are measured with it) wherever each direction crosses its boundary once.
 // With `through` (the same camera at another wavelength: at_wavelength), the lenses and their
 // start points are still this camera's, and the light is traced through `through`: the same lenses
 // in the same order, their microimages at that wavelength.
