@@ -22,8 +22,9 @@ PANELS = [
     ("ideal", BASE),
     ("jittered (position 0.4 um, focal 2 %, tilt 1 deg)",
      BASE + " errors { position 0.0004 focal_length 0.02 rotation 1 seed 4 }"),
-    ("refracting (R 0.032 mm, n 1.46)",
-     "hexagonal pitch 0.02 lens { surface { radius 0.032 } thickness 0.004 ior 1.46 substrate 0.2 } distance 0.0696"),
+    ("refracting (R 0.032 mm, n 1.46, caps towards the scene)",
+     "hexagonal pitch 0.02 lens { surface { radius 0.032 } thickness 0.004 ior 1.46 substrate 0.01 }"
+     " distance 0.06"),
     ("masked (fill factor 0.7)", BASE + " fill_factor 0.7 mask on"),
 ]
 
