@@ -11,19 +11,14 @@
 
 #include "plenoptic/core/format.h"
 #include "plenoptic/core/json.h"
+#include "plenoptic/core/sampling.h"
 
 namespace plenoptic {
 
 namespace {
 
-// SplitMix64's finaliser: a bijection of 64-bit words that mixes every bit into every other.
-std::uint64_t mix(std::uint64_t x)
-{
-    x += 0x9e3779b97f4a7c15ull;
-    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-    return x ^ (x >> 31);
-}
+// mix64 (core/sampling.h): SplitMix64's step and finaliser.
+std::uint64_t mix(std::uint64_t x) { return mix64(x); }
 
 std::uint64_t lens_key(LensIndex lens)
 {

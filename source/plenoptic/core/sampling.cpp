@@ -15,15 +15,6 @@ namespace plenoptic {
 
 namespace {
 
-// splitmix64's finaliser: a well-mixed 64-bit hash.
-std::uint64_t mix64(std::uint64_t z)
-{
-    z += 0x9E3779B97F4A7C15ull;
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
 // Top 53 bits as a double in [0, 1).
 double to_unit(std::uint64_t bits) { return double(bits >> 11) * (1.0 / 9007199254740992.0); }
 

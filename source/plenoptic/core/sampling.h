@@ -4,11 +4,23 @@
 #ifndef PLENOPTIC_SAMPLING_H
 #define PLENOPTIC_SAMPLING_H
 
+#include <cstdint>
 #include <vector>
 
 #include "plenoptic/core/vec.h"
 
 namespace plenoptic {
+
+// SplitMix64's step and finaliser: a bijection of 64-bit words that mixes every bit into every
+// other (sample rotations, the arrays' manufacturing errors).
+inline std::uint64_t mix64(std::uint64_t z)
+{
+    z += 0x9E3779B97F4A7C15ull;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
 
 // One sample of a pixel: a point on the pixel and a point on the aperture being sampled
 // (a microlens cell, or the main-lens disc when there is no array).
