@@ -88,6 +88,8 @@ set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)  # povray-plenoptic_<version>_<arch>.deb
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
     "python3 (>= 3.11), python3-numpy, python3-scipy, python3-pil, python3-openimageio, python3-jsonschema")
+# plenoptic_lf.calibration (the calibration loop, docs/calibration-loop.md) calibrates with OpenCV.
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "python3-opencv")
 # Installed with the prefix /usr into a staging DESTDIR, so the configuration lands in /etc.
 set(CPACK_SET_DESTDIR ON)
 set(CPACK_INSTALL_PREFIX /usr)

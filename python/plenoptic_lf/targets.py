@@ -10,6 +10,7 @@ plenoptic-project):
     plenoptic-targets CAMERA.inc --out DIR [--count N] [--seed S] [--distance MIN MAX]
                       [--tilt DEG] [--target checkerboard:ROWSxCOLS:SQUARE | circles:ROWSxCOLS:SPACING:RADIUS]
                       [--width W --height H] [--povray PATH] [--project PATH] [-- POVRAY OPTIONS]
+    plenoptic-targets CAMERA.inc --out DIR --poses POSES.json [--target ...] ...
 
 CAMERA.inc holds the camera, `camera { plenoptic ... }`, placed anywhere (location, look_at,
 transforms). A pose is relative to the camera, in its frame (x right, y up, z the viewing
@@ -19,6 +20,9 @@ uniformly from [-DEG, DEG] and a roll about z from [-180, 180); the target is ro
 y, then z, POV-Ray's order), then moved, then carried into the world by the camera's placement,
 which the first view's metadata gives (when the camera is not at POV-Ray's default placement,
 the first view is rendered again, placed). A camera that is not plenoptic is refused.
+--poses POSES.json gives the poses instead of the draw: a JSON list of {"rotate_deg": [rx, ry, rz],
+"translate": [x, y, z]} in the same frame and units (the calibration loop gives the R12-A data
+set's, calibration.py).
 
 For view k, DIR holds target_<k>.png (and what the camera writes beside it: the metadata, white
 image, raw...), target_<k>.pov, and target_<k>.points.csv: one line per image of a feature point,
@@ -102,6 +106,30 @@ def draw_pose(rng, distance, tilt, lateral):
             "translate": [rng.uniform(-lateral, lateral) * z, rng.uniform(-lateral, lateral) * z, z]}
 
 
+def read_poses(path):
+    """--poses: a non-empty JSON list of {"rotate_deg": [3 numbers], "translate": [3 numbers]},
+    the translation's z > 0 (in front of the camera). ValueError naming the file and the pose."""
+    with open(path) as f:
+        try:
+            data = json.load(f)
+        except json.JSONDecodeError as e:
+            raise ValueError("%s: not JSON (%s)" % (path, e))
+    if not isinstance(data, list) or not data:
+        raise ValueError("%s: a non-empty JSON list of poses is needed" % path)
+    poses = []
+    for k, pose in enumerate(data):
+        try:
+            r = [float(v) for v in pose["rotate_deg"]]
+            t = [float(v) for v in pose["translate"]]
+        except (TypeError, KeyError, ValueError):
+            raise ValueError("%s: pose %d: needs rotate_deg and translate, three numbers each" % (path, k))
+        if len(r) != 3 or len(t) != 3 or not all(math.isfinite(v) for v in r + t) or t[2] <= 0:
+            raise ValueError("%s: pose %d: rotate_deg and translate must be three finite numbers each, translate's "
+                             "z > 0 (in front of the camera), not %r, %r" % (path, k, r, t))
+        poses.append({"rotate_deg": r, "translate": t})
+    return poses
+
+
 def posed_points(target, pose):
     """[(row, col, point)]: the feature points posed, in the camera's frame."""
     r = rotation_xyz(pose["rotate_deg"])
@@ -171,6 +199,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--lateral", type=float, default=0.02,
                    help="largest offset across the axis, as a fraction of the distance (default 0.02)")
     p.add_argument("--target", default="checkerboard:7x10:0.03")
+    p.add_argument("--poses", default=None, metavar="JSON",
+                   help="the poses, a JSON list of {rotate_deg: [3], translate: [3]}, instead of the seeded draw")
     p.add_argument("--width", type=int, default=640)
     p.add_argument("--height", type=int, default=480)
     p.add_argument("--povray", default=None)
@@ -197,9 +227,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         include = _include_dir()
     except FileNotFoundError as e:
         return fail(str(e))
+    if args.poses is not None:
+        try:
+            poses = read_poses(args.poses)
+        except (OSError, ValueError) as e:
+            return fail(str(e))
+        args.count = len(poses)
+    else:
+        rng = random.Random(args.seed)
+        poses = [draw_pose(rng, args.distance, args.tilt, args.lateral) for _ in range(args.count)]
     os.makedirs(args.out, exist_ok=True)
-    rng = random.Random(args.seed)
-    poses = [draw_pose(rng, args.distance, args.tilt, args.lateral) for _ in range(args.count)]
     views = []
     placement = None  # the camera's, from the first view's metadata
     try:
@@ -260,10 +297,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         if views:  # the views made (all of them, or those before a failure or an interruption)
             with open(os.path.join(args.out, "targets.json"), "w") as f:
-                json.dump({"target": target, "seed": args.seed, "distance": args.distance, "tilt_deg": args.tilt,
-                           "lateral": args.lateral, "size": [args.width, args.height],
-                           "camera": os.path.abspath(args.camera), "camera_placement": placement, "views": views},
-                          f, indent=1)
+                record = {"target": target, "seed": args.seed, "distance": args.distance, "tilt_deg": args.tilt,
+                          "lateral": args.lateral, "size": [args.width, args.height],
+                          "camera": os.path.abspath(args.camera), "camera_placement": placement, "views": views}
+                if args.poses is not None:  # the poses were given, not drawn
+                    record["poses_file"] = os.path.abspath(args.poses)
+                json.dump(record, f, indent=1)
     return 0
 
 
