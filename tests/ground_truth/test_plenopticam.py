@@ -231,3 +231,96 @@ def test_plenopticam_on_a_jittered_array(args, venv_python):
     # truth's 0.44 px mean from the lattice; docs/camera.md, "Real microlens arrays").
     assert to_truth.mean() < 0.5, to_truth.mean()
     assert to_lattice.mean() < truth_from_lattice.mean(), (to_lattice.mean(), truth_from_lattice.mean())
+
+
+# A real main lens: the wide-angle of lenses/ (Laikin's 22 mm) at f/4, focused at 1 m, on a sensor of
+# 19.2 x 14.4 mm (30 um pixels) that reaches 24 degrees off the axis, hexagonal f-number-matched
+# microlenses with 14-pixel microimages. Behind it the microimage centres leave the lattice (the exit
+# pupil's image through each lens, vignetted and aberrated off the axis); the truth per lens is the
+# render's <image>.microimages.csv (docs/real-lenses.md).
+REAL_LENS = "wide_angle_22mm_laikin_f3.5.dat"
+REAL_PIXEL, REAL_FOCUS_M, REAL_N, REAL_WORKING_N = 0.03, 1.0, 4.0, 4.05
+
+
+def real_lens_camera():
+    pitch = 14 * REAL_PIXEL * 0.965  # about 14-pixel microimages (the lattice is p (D' + d) / D' apart)
+    d = REAL_WORKING_N * pitch
+    return ("camera { plenoptic location <0, 0, -%r> look_at <0, 0, 0>\n"
+            "  main_lens { lens_file \"%s\" f_number %r focus_distance %r }\n"
+            "  microlens_array { hexagonal pitch %r focal_length %r distance %r }\n"
+            "  sensor { pixel_size %r angular_response 32 }\n"
+            "  samples 16 radiometry irradiance white_image }\n"
+            % (REAL_FOCUS_M, REAL_LENS, REAL_N, REAL_FOCUS_M, pitch, d, d, REAL_PIXEL))
+
+
+_REAL_LENS_RUN = {}
+
+
+def real_lens_centres(args, venv_python):
+    """Renders the real-lens camera and runs PlenoptiCam's calibration on its white image once per
+    session: (metadata, PlenoptiCam's centres (u, v), the CSV's true centres (u, v))."""
+    if "centroids" in _REAL_LENS_RUN:
+        return _REAL_LENS_RUN["meta"], _REAL_LENS_RUN["centroids"], _REAL_LENS_RUN["truth"]
+    name = "real_lens_hexagonal_14px"
+    work = os.path.join(args.work, name)
+    out = os.path.join(work, "plenopticam")
+    lenses = os.path.join(pt.SOURCE_DIR, "lenses")
+    png = pt.render(args.povray, work, name, CHART + real_lens_camera(), W, H, extra=["+L" + lenses], timeout=600)
+    white_png = os.path.splitext(png)[0] + ".white.png"
+    os.makedirs(out, exist_ok=True)
+    # Without diffraction the white image is grey (one channel): given to PlenoptiCam as R = G = B.
+    white = pt.load(white_png)
+    white_npy = os.path.join(work, "white.npy")
+    np.save(white_npy, np.repeat(white[..., :1], 3, axis=2).astype(np.float64) if white.shape[2] < 3
+            else white[..., :3].astype(np.float64))
+    run = subprocess.run([venv_python, RUNNER, to_npy(png, os.path.join(work, "raw.npy")), white_npy, out],
+                         capture_output=True, text=True, timeout=600, cwd=out)
+    assert run.returncode == 0, "PlenoptiCam failed on %s:\n%s" % (name, (run.stdout + run.stderr)[-3000:])
+    rows = np.genfromtxt(os.path.splitext(png)[0] + ".microimages.csv", delimiter=",", names=True)
+    rows = rows[np.isfinite(rows["u"])]
+    _REAL_LENS_RUN.update(meta=pt.metadata_of(png), centroids=np.load(os.path.join(out, "centroids.npy"))[:, [1, 0]],
+                          truth=np.stack([rows["u"], rows["v"]], axis=1))
+    return real_lens_centres(args, venv_python)
+
+
+def test_plenopticam_centres_behind_a_real_lens(args, venv_python):
+    """PlenoptiCam's centre of every microimage against the nearest true centre of the CSV: the
+    numbers (mean and largest error) are printed and in docs/sensor.md; held here: it finds the
+    lit microimages, the true centres leave the lattice, and its error is a radial contraction
+    (its centres lie inside the true ones, on a regular grid), within 2.5 px on average."""
+    meta, centroids, truth = real_lens_centres(args, venv_python)
+    assert meta["main_lens"]["type"] == "prescription"
+    lattice, spacing = lattice_points(meta)
+    distance = np.sqrt(((centroids[:, None, :] - truth[None, :, :]) ** 2).sum(axis=2))
+    nearest = distance.argmin(axis=1)
+    to_truth = distance.min(axis=1)
+    truth_from_lattice = np.sqrt(((truth[:, None, :] - lattice[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
+    centroid_from_lattice = np.sqrt(((centroids[:, None, :] - lattice[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
+    axis = np.array([(W - 1) / 2.0, (H - 1) / 2.0])
+    outwards = truth[nearest] - axis
+    radius = np.hypot(outwards[:, 0], outwards[:, 1])
+    error = centroids - truth[nearest]
+    radial = (error * outwards).sum(axis=1) / np.maximum(radius, 1e-9)
+    tangential = (error[:, 0] * outwards[:, 1] - error[:, 1] * outwards[:, 0]) / np.maximum(radius, 1e-9)
+    mid = (radius > 100) & (radius < 300)
+    print("real lens: PlenoptiCam found %d microimages (the CSV has %d lit); the true centres lie up to %.3f px (mean "
+          "%.3f) from the regular lattice; PlenoptiCam's centres against the CSV: mean %.3f px, largest %.3f px "
+          "(within 100 px of the axis: mean %.3f); radial error %.3f px, tangential %.3f px (mean, 100 to 300 px "
+          "from the axis); PlenoptiCam's centres from the lattice: mean %.3f px"
+          % (len(centroids), len(truth), truth_from_lattice.max(), truth_from_lattice.mean(), to_truth.mean(),
+             to_truth.max(), to_truth[radius < 100].mean(), radial[mid].mean(), np.abs(tangential[mid]).mean(),
+             centroid_from_lattice.mean()))
+    assert len(centroids) >= 0.9 * len(truth)
+    # Behind the real lens the true centres leave the lattice (by several pixels at the border).
+    assert truth_from_lattice.max() > 0.5, truth_from_lattice.max()
+    # PlenoptiCam 0.9.3's centres lie inside the true ones (a grid of too short a pitch), not beside them.
+    assert radial[mid].mean() < -0.5 and np.abs(tangential[mid]).mean() < 0.5 * abs(radial[mid].mean())
+    assert to_truth.mean() < 2.5, to_truth.mean()
+
+
+@pytest.mark.xfail(strict=True, reason="PlenoptiCam 0.9.3 behind a real lens: its centres lie 1 to 2 px inside the true "
+                   "ones (a regular grid of about 1 % too short a pitch), mean error 1.9 px")
+def test_plenopticam_centres_behind_a_real_lens_within_half_a_pixel(args, venv_python):
+    meta, centroids, truth = real_lens_centres(args, venv_python)
+    to_truth = np.sqrt(((centroids[:, None, :] - truth[None, :, :]) ** 2).sum(axis=2)).min(axis=1)
+    assert to_truth.mean() < 0.5, to_truth.mean()
