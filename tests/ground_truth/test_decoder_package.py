@@ -33,11 +33,14 @@ import plenoptic_testing as pt
 
 # Import name -> distribution name on PyPI, for every third-party module the package may import.
 DISTRIBUTIONS = {"numpy": "numpy", "scipy": "scipy", "PIL": "Pillow", "OpenImageIO": "OpenImageIO",
-                 "jsonschema": "jsonschema"}
+                 "jsonschema": "jsonschema", "cv2": "opencv-python"}
+# Imported only by the modules named, declared in [project.optional-dependencies] (extra: name).
+OPTIONAL_IMPORTS = {"cv2": ("calibration", {"calibration.py"})}
 # The table of tools (python/pyproject.toml).
 SCRIPTS = {"plenoptic-decode": "plenoptic_lf.cli:main", "plenoptic-dataset": "plenoptic_lf.dataset.cli:main",
            "plenoptic-targets": "plenoptic_lf.targets:main", "plenoptic-lens": "plenoptic_lf.lens_tool:main"}
-SOURCE_TREE_SCRIPTS = {"bench": "plenoptic_bench.cli:main", "report2018-figures": "plenoptic_report2018.figures:main"}
+SOURCE_TREE_SCRIPTS = {"bench": "plenoptic_bench.cli:main", "report2018-figures": "plenoptic_report2018.figures:main",
+                       "calibration-loop": "plenoptic_lf.calibration:main"}
 # A python3 that lacks numpy (site-packages off), first on PATH.
 NO_NUMPY_PYTHON = '#!/bin/sh\n# Written by tests/ground_truth/test_decoder_package.py: a python3 without numpy.\n' \
                   'exec /usr/bin/python3 -S "$@"\n'
@@ -98,6 +101,12 @@ def test_decoder_package(args):
     assert pyproject.get("build-system", {}).get("build-backend") == "setuptools.build_meta", "pyproject.toml: build backend %r" % pyproject.get("build-system", {}).get("build-backend")
 
     imports = third_party_imports(package_dir)
+    for module, (extra, where) in OPTIONAL_IMPORTS.items():
+        if module in imports:
+            assert imports[module] <= where, "%s is imported by %s, only %s may" % (module, sorted(imports[module]), where)
+            wanted = [requirement_name(r).lower() for r in project.get("optional-dependencies", {}).get(extra, [])]
+            assert DISTRIBUTIONS[module].lower() in wanted, "[project.optional-dependencies] %s: %r" % (extra, wanted)
+            del imports[module]
     unknown = sorted(set(imports) - set(DISTRIBUTIONS))
     declared = sorted(requirement_name(r).lower() for r in project.get("dependencies", []))
     imported = sorted(DISTRIBUTIONS[m].lower() for m in imports if m in DISTRIBUTIONS)
