@@ -11,8 +11,10 @@
 //     sensor at 9.888004 mm behind the main lens), a camera modelled on the Illum;
 //   - main lens: PRISM's, f 9.98445 mm at f/2 (the Illum's zoom at its wide end; Lytro
 //     published a constant f/2.0);
-//   - read-out: Lytro's raws are 10-bit GRBG mosaics (the Illum's raw files; the black level 64
-//     and the noise figures are those of scenes/realistic_raw.pov, not measured on an Illum).
+//   - the raw: imageio's reader of Illum raw files (imageio, imageio/plugins/lytro.py) reads
+//     5368 x 7728 pixels (LYTRO_ILLUM_IMAGE_SIZE) of 10 bits (four packed in five bytes); the
+//     mosaic is GRBG (as Lytro's raws; the black level 64 and the noise figures are those of
+//     scenes/realistic_raw.pov, not measured on an Illum).
 // The lens is an ideal thin lens (a real Illum's 13-element zoom is not published).
 //
 // Declarations (a data-set spec sets them; defaults in brackets):
