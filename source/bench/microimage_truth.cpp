@@ -8,12 +8,14 @@
 //
 //   plenoptic_microimage_truth --lens-file FILE --f-number N --focus-distance Z
 //       --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--offset X_MM Y_MM] [--threads T]
-//       [--errors S F R SEED] [--reference] [--csv OUT]
+//       [--errors S F R SEED] [--refracting R CAP SUBSTRATE IOR] [--reference] [--csv OUT]
 //
 // --offset shifts the sensor (sensor { offset }): a crop of a larger raw away from its centre,
 // e.g. its corner. --errors gives the array manufacturing errors (errors { position S focal_length F
 // rotation R seed SEED }). --reference measures every lens from scratch (reuse_neighbours false: the
-// integration as it was before the neighbours' radii were reused).
+// integration as it was before the neighbours' radii were reused). --refracting replaces the thin
+// microlenses by plano-convex caps (lens { surface { radius R } thickness CAP ior IOR substrate
+// SUBSTRATE }, the curved side towards the scene; F_MM of --array is then unused).
 
 #include <chrono>
 #include <cstdio>
@@ -46,6 +48,8 @@ struct Options {
     int threads = 0;
     bool errors = false;
     bool reference = false;
+    bool refracting = false;
+    double refracting_values[4] = {0, 0, 0, 0};  // radius, cap, substrate, ior
     double error_values[3] = {0, 0, 0};
     long long seed = 0;
     std::string csv;
@@ -80,6 +84,10 @@ bool parse(int argc, char** argv, Options* o)
             for (double& value : o->error_values)
                 value = std::atof(argv[++a]);
             o->seed = std::atoll(argv[++a]);
+        } else if (arg == "--refracting" && left >= 4) {
+            o->refracting = true;
+            for (double& value : o->refracting_values)
+                value = std::atof(argv[++a]);
         } else if (arg == "--reference")
             o->reference = true;
         else if (arg == "--csv" && left >= 1)
@@ -107,7 +115,8 @@ int main(int argc, char** argv)
     if (!parse(argc, argv, &o)) {
         std::fprintf(stderr, "usage: plenoptic_microimage_truth --lens-file FILE --f-number N --focus-distance Z\n"
                              "         --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--offset X_MM Y_MM]\n"
-                             "         [--threads T] [--errors S F R SEED] [--reference] [--csv OUT]\n");
+                             "         [--threads T] [--errors S F R SEED] [--refracting R CAP SUBSTRATE IOR]\n"
+                             "         [--reference] [--csv OUT]\n");
         return 2;
     }
     std::ifstream file(o.lens_file);
@@ -144,6 +153,15 @@ int main(int argc, char** argv)
     p.array.lens = MicrolensType::ThinLens;
     p.array.focal_length_count = 1;
     p.array.focal_lengths_mm[0] = o.focal_mm;
+    if (o.refracting) {
+        p.array.lens = MicrolensType::Refracting;
+        p.array.focal_length_count = 0;
+        p.array.refracting.radius_mm = o.refracting_values[0];
+        p.array.refracting.cap_mm = o.refracting_values[1];
+        p.array.refracting.substrate_mm = o.refracting_values[2];
+        p.array.refracting.ior = o.refracting_values[3];
+        p.array.refracting.curved_towards_scene = true;
+    }
     p.array.has_distance = true;
     p.array.distance_mm = o.distance_mm;
     if (o.errors) {

@@ -99,25 +99,34 @@ bool start_point(const LensProbe& probe, double gu, double gv, double reach, dou
     return true;
 }
 
-// The boundary radius along direction (c, s) from the start point (su, sv), from scratch: a
-// bracket near the previous direction's radius when it holds, grown by doubling while its outer end
-// is lit, then bisected until it is tolerance_px narrow. Returns the middle of the last bracket.
-double boundary_from_scratch(const LensProbe& probe, double su, double sv, double c, double s, double previous,
-                             double reach, double tolerance_px)
+// A bracket [lo lit, hi dark] of the boundary radius along direction (c, s) from the start point
+// (su, sv), from scratch: near the previous direction's radius when that holds, grown by doubling
+// while its outer end is lit (at most kMaxDoublings times).
+void bracket_from_scratch(const LensProbe& probe, double su, double sv, double c, double s, double previous,
+                          double reach, double* lo, double* hi)
 {
-    // Bracket [lo lit, hi dark]: near the previous direction's radius when it holds.
-    double lo = 0, hi = reach;
+    *lo = 0;
+    *hi = reach;
     if (previous > 0) {
         const double inner = 0.8 * previous, outer = 1.25 * previous + 0.5;
         if (probe.lit(su + inner * c, sv + inner * s))
-            lo = inner;
-        if (outer < hi && !probe.lit(su + outer * c, sv + outer * s))
-            hi = outer;
+            *lo = inner;
+        if (outer < *hi && !probe.lit(su + outer * c, sv + outer * s))
+            *hi = outer;
     }
-    for (int k = 0; k < kMaxDoublings && probe.lit(su + hi * c, sv + hi * s); ++k) {
-        lo = hi;
-        hi *= 2;
+    for (int k = 0; k < kMaxDoublings && probe.lit(su + *hi * c, sv + *hi * s); ++k) {
+        *lo = *hi;
+        *hi *= 2;
     }
+}
+
+// The boundary radius along (c, s) from scratch: that bracket bisected until it is tolerance_px
+// narrow; its middle.
+double boundary_from_scratch(const LensProbe& probe, double su, double sv, double c, double s, double previous,
+                             double reach, double tolerance_px)
+{
+    double lo, hi;
+    bracket_from_scratch(probe, su, sv, c, s, previous, reach, &lo, &hi);
     for (int k = 0; k < kMaxBisections && hi - lo > tolerance_px; ++k) {
         const double mid = 0.5 * (lo + hi);
         if (probe.lit(su + mid * c, sv + mid * s))
@@ -190,19 +199,9 @@ double boundary_on_grid(const LensProbe& probe, double su, double sv, double c, 
         // (A lit outer end beyond a dark inner one: not star-shaped there; search from scratch.)
     }
     if (!bracketed) {
-        // As from scratch: near the previous direction's radius when that holds, grown by doubling.
-        double rlo = 0, rhi = reach;
-        if (previous > 0) {
-            const double inner = 0.8 * previous, outer = 1.25 * previous + 0.5;
-            if (probe.lit(su + inner * c, sv + inner * s))
-                rlo = inner;
-            if (outer < rhi && !probe.lit(su + outer * c, sv + outer * s))
-                rhi = outer;
-        }
-        for (int k = 0; k < kMaxDoublings && probe.lit(su + rhi * c, sv + rhi * s); ++k) {
-            rlo = rhi;
-            rhi *= 2;
-        }
+        // The bracket a search from scratch finds, widened to grid steps.
+        double rlo, rhi;
+        bracket_from_scratch(probe, su, sv, c, s, previous, reach, &rlo, &rhi);
         lo = (long long)std::floor(rlo / tolerance_px);
         hi = std::max(lo + 1, (long long)std::ceil(rhi / tolerance_px));
     }
@@ -338,6 +337,14 @@ double microimage_cell_area_px(const PlenopticCamera& m, LensIndex lens)
 struct Guess {
     bool possible;
     double u, v, radius_px;
+    // Where the light towards the disc's centre lands through the lens as it is (a thin lens with a
+    // manufacturing error along its axis or a tilt; (u, v) otherwise): the point the region moves
+    // with from lens to lens, so that its radii are handed on as seen from it.
+    double frame_u, frame_v;
+    // How the lens as it is stretches its region about that point against an untilted lens at its
+    // place in the array's plane (the derivatives of where light lands, taken through both):
+    // sensor offsets map as (stretch[0] stretch[1]; stretch[2] stretch[3]); the identity otherwise.
+    double stretch[4];
 };
 
 // The disc of the exit pupil's plane through which light from the aperture point h can pass
@@ -361,13 +368,13 @@ Guess guess_region(const PlenopticCamera& m, LensIndex lens, double lens_u, doub
     if (!m.lens->forms_image() || !(disc.radius >= 0)) {
         const double main = effective_main_distance_mm(m);
         const double cell = m.array.cell_circumradius_mm * (main > 0 ? (main + behind) / main : 1);
-        return Guess{true, lattice_px.x + 0.5, lattice_px.y + 0.5, 2 * cell / pixel + 2};
+        return Guess{true, lattice_px.x + 0.5, lattice_px.y + 0.5, 2 * cell / pixel + 2, lattice_px.x + 0.5, lattice_px.y + 0.5, {1, 0, 0, 1}};
     }
     if (disc.radius == 0)
-        return Guess{false, 0, 0, 0};
+        return Guess{false, 0, 0, 0, 0, 0, {1, 0, 0, 1}};
     const double along = disc.centre.z - h.z, drop = h.z - m.sensor.z_mm;
     if (!(along > 0) || !(drop > 0))
-        return Guess{false, 0, 0, 0};
+        return Guess{false, 0, 0, 0, 0, 0, {1, 0, 0, 1}};
     double wx = (disc.centre.x - h.x) / along, wy = (disc.centre.y - h.y) / along;
     if (thin) {
         const double f = m.array.focal_length_mm(lens);
@@ -375,7 +382,7 @@ Guess guess_region(const PlenopticCamera& m, LensIndex lens, double lens_u, doub
         wx += shift.x;
         wy += shift.y;
     }
-    Guess guess{true, 0, 0, disc.radius * drop / along / pixel};
+    Guess guess{true, 0, 0, disc.radius * drop / along / pixel, 0, 0, {1, 0, 0, 1}};
     if (thin && !m.array.microlens->first_order_exact()) {
         // A refracting lens: the paraxial guess, with a bracket wider by as far as the lens bends
         // light from the cell's corner (its thickness and spherical aberration move the region by
@@ -387,8 +394,62 @@ Guess guess_region(const PlenopticCamera& m, LensIndex lens, double lens_u, doub
     guess.v = centre.v;
     guess.u += 0.5;
     guess.v += 0.5;
+    guess.frame_u = guess.u;
+    guess.frame_v = guess.v;
+    const LensFrame frame = m.array.frame(lens);
+    if (thin && m.array.microlens->first_order_exact() && (frame.tilted || frame.centre.z != 0)) {
+        // The renderer's thin lens run backwards (array/microlens.cpp): the ray leaving the lens's
+        // cell point towards `target`, its slopes in the lens's frame less the lens's bend
+        // offset / f, is the ray that came from the sensor; where it came from, in pixels.
+        auto landing = [&](const LensFrame& lens_frame, Vec3 target, Vec2* px) {
+            const Vec3 in_plane{offset.x, offset.y, 0};
+            const Vec3 leave =
+                m.array.to_optics(lens_frame.centre + (lens_frame.tilted ? mul(lens_frame.axes, in_plane) : in_plane));
+            Vec3 out = mul_transposed(m.array.pose.rotation, target - leave);
+            if (lens_frame.tilted)
+                out = mul_transposed(lens_frame.axes, out);
+            if (!(out.z > 0))
+                return false;
+            Vec3 in{out.x / out.z + offset.x / lens_frame.focal_mm, out.y / out.z + offset.y / lens_frame.focal_mm, 1};
+            if (lens_frame.tilted)
+                in = mul(lens_frame.axes, in);
+            in = mul(m.array.pose.rotation, in);
+            if (!(in.z > 0))
+                return false;
+            const double t = (leave.z - m.sensor.z_mm) / in.z;
+            const PixelPoint from = m.sensor.to_pixel(leave.x - t * in.x, leave.y - t * in.y);
+            *px = Vec2{from.u + 0.5, from.v + 0.5};
+            return std::isfinite(px->x) && std::isfinite(px->y);
+        };
+        // The same lens untilted in the array's plane.
+        LensFrame flat = frame;
+        flat.centre.z = 0;
+        flat.tilted = false;
+        // Targets a fifth of the disc's radius aside, across the light's direction (x, y in the
+        // optics frame suffice: the disc lies across the axis).
+        const double aside = 0.2 * disc.radius;
+        const Vec3 targets[3] = {disc.centre, disc.centre + Vec3{aside, 0, 0}, disc.centre + Vec3{0, aside, 0}};
+        Vec2 at[3], ideal[3];
+        bool ok = true;
+        for (int i = 0; i < 3 && ok; ++i)
+            ok = landing(frame, targets[i], &at[i]) && landing(flat, targets[i], &ideal[i]);
+        const double j0[4] = {ideal[1].x - ideal[0].x, ideal[2].x - ideal[0].x, ideal[1].y - ideal[0].y,
+                              ideal[2].y - ideal[0].y};
+        const double det = j0[0] * j0[3] - j0[1] * j0[2];
+        if (ok && det != 0) {
+            guess.frame_u = at[0].x;
+            guess.frame_v = at[0].y;
+            // stretch = J J0^-1 (J, J0: the landing points' derivatives through the lens and the flat one).
+            const double j[4] = {at[1].x - at[0].x, at[2].x - at[0].x, at[1].y - at[0].y, at[2].y - at[0].y};
+            const double inverse[4] = {j0[3] / det, -j0[1] / det, -j0[2] / det, j0[0] / det};
+            guess.stretch[0] = j[0] * inverse[0] + j[1] * inverse[2];
+            guess.stretch[1] = j[0] * inverse[1] + j[1] * inverse[3];
+            guess.stretch[2] = j[2] * inverse[0] + j[3] * inverse[2];
+            guess.stretch[3] = j[2] * inverse[1] + j[3] * inverse[3];
+        }
+    }
     if (!(std::isfinite(guess.u) && std::isfinite(guess.v) && std::isfinite(guess.radius_px)))
-        return Guess{false, 0, 0, 0};
+        return Guess{false, 0, 0, 0, 0, 0, {1, 0, 0, 1}};
     return guess;
 }
 
@@ -409,6 +470,31 @@ bool picture_on_array(const PlenopticCamera& m, double box[4])
         box[3] = std::max(box[3], q.y);
     }
     return true;
+}
+
+// A point of the lens's cell at which its light is measured, as the renderer's aperture sample
+// (lens_u, lens_v), and the share of the cell it stands for (1 / divisor).
+struct CellNode {
+    double lens_u, lens_v, divisor;
+};
+
+// The cell points at which a lens's light is measured: the midpoint rule on the renderer's own
+// uniform map of the cell, aperture_points a side (refracting lenses: at least
+// kRefractingAperturePoints, as their regions differ from point to point); pinholes: the centre.
+std::vector<CellNode> cell_nodes(const PlenopticCamera& m, const MicroimageOptions& options)
+{
+    std::vector<CellNode> nodes;
+    if (!m.array.microlens->forms_image()) {
+        nodes.push_back(CellNode{0.5, 0.5, 1});
+        return nodes;
+    }
+    const int n = std::max(1, m.array.microlens->first_order_exact()
+                                  ? options.aperture_points
+                                  : std::max(options.aperture_points, kRefractingAperturePoints));
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i)
+            nodes.push_back(CellNode{(i + 0.5) / n, (j + 0.5) / n, double(n * n)});
+    return nodes;
 }
 
 } // namespace
@@ -471,15 +557,9 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
             out.reserve(count);
     }
 
-    const bool thin = m.array.microlens->forms_image();  // a pinhole has one aperture point
-    // A refracting lens's light from different cell points lands in regions of different sizes (its
-    // aberration): the midpoint rule over the cell then needs more points than an ideal lens's,
-    // whose regions are all alike.
-    const int points = m.array.microlens->first_order_exact() ? options.aperture_points
-                                                               : std::max(options.aperture_points, kRefractingAperturePoints);
-    const int n = thin ? std::max(1, points) : 1;
-    // Per aperture point, the radii of its region in the last kHistory lenses of a run, newest
-    // first (fewer at the run's start or after a lens without that region), and a prediction.
+    const std::vector<CellNode> nodes = cell_nodes(m, options);
+    // Per cell point, the radii of its region in the last kHistory lenses of a run, newest first
+    // (fewer at the run's start or after a lens without that region), and a prediction.
     const std::size_t kHistory = 2;
     struct Radii {
         std::vector<std::vector<std::vector<double>>> history;
@@ -491,52 +571,67 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         in_picture(truth.lens, &centre);
         Moments total{0, 0, 0};
         RadiusChange change;  // of this lens's regions from their predictions
-        for (int j = 0; j < n; ++j) {
-            for (int i = 0; i < n; ++i) {
-                const int point = j * n + i;
-                std::vector<double>* now = radii ? &radii->now : nullptr;
-                const std::vector<double>* predicted = nullptr;
-                if (radii) {
-                    // The last radii moved by their mean change per lens over the history.
-                    now->clear();
-                    const std::vector<std::vector<double>>& past = radii->history[point];
-                    if (!past.empty()) {
-                        const std::size_t h = past.size();
-                        radii->predicted = past[0];
-                        for (std::size_t a = 0; h > 1 && a < past[0].size(); ++a)
-                            radii->predicted[a] += (past[0][a] - past[h - 1][a]) / double(h - 1);
-                        predicted = &radii->predicted;
-                    }
+        for (std::size_t point = 0; point < nodes.size(); ++point) {
+            const CellNode& node = nodes[point];
+            std::vector<double>* now = radii ? &radii->now : nullptr;
+            const std::vector<double>* predicted = nullptr;
+            if (radii) {
+                // The last radii moved by their mean change per lens over the history.
+                now->clear();
+                const std::vector<std::vector<double>>& past = radii->history[point];
+                if (!past.empty()) {
+                    const std::size_t h = past.size();
+                    radii->predicted = past[0];
+                    for (std::size_t a = 0; h > 1 && a < past[0].size(); ++a)
+                        radii->predicted[a] += (past[0][a] - past[h - 1][a]) / double(h - 1);
+                    predicted = &radii->predicted;
                 }
-                const double lens_u = thin ? (i + 0.5) / n : 0.5, lens_v = thin ? (j + 0.5) / n : 0.5;
-                const Guess guess = guess_region(light, truth.lens, lens_u, lens_v, centre);
-                if (!guess.possible) {
-                    if (radii)
-                        radii->history[point].clear();
-                    continue;
-                }
-                const LensProbe probe(light, truth.lens, lens_u, lens_v);
-                // A start point anywhere in the disc is at most its diameter from the boundary.
-                const double search = guess.radius_px + 1, reach = 2.1 * guess.radius_px + 1;
-                const Vec2 reference{centre.x + 0.5, centre.y + 0.5};
-                const Moments region =
-                    region_moments(probe, guess.u, guess.v, search, reach, options, reference, predicted, &change, now);
-                if (radii) {
-                    std::vector<std::vector<double>>& past = radii->history[point];
-                    if (now->empty()) {
-                        past.clear();
-                    } else {
-                        if (past.size() < kHistory)
-                            past.push_back(std::vector<double>());
-                        for (std::size_t age = past.size() - 1; age > 0; --age)
-                            std::swap(past[age], past[age - 1]);
-                        std::swap(past[0], *now);
-                    }
-                }
-                total.area += region.area / (n * n);
-                total.mu += region.mu / (n * n);
-                total.mv += region.mv / (n * n);
             }
+            const Guess guess = guess_region(light, truth.lens, node.lens_u, node.lens_v, centre);
+            if (!guess.possible) {
+                if (radii)
+                    radii->history[point].clear();
+                continue;
+            }
+            const LensProbe probe(light, truth.lens, node.lens_u, node.lens_v);
+            // A start point anywhere in the disc is at most its diameter from the boundary.
+            const double search = guess.radius_px + 1, reach = 2.1 * guess.radius_px + 1;
+            // Radii are handed from lens to lens as seen from where the guess's central ray lands: it
+            // moves with the lens's own position, focal length and tilt (manufacturing errors), so that
+            // what is left to predict from the neighbours is how the main lens's light changes across
+            // the field.
+            const Vec2 reference{guess.frame_u, guess.frame_v};
+            // Radii are handed on as an untilted lens in the array's plane would give them: a radius
+            // along u = (cos, sin) of this lens is that one's times u . stretch u.
+            const double* st = guess.stretch;
+            const bool stretched = st[0] != 1 || st[1] != 0 || st[2] != 0 || st[3] != 1;
+            auto stretch_along = [&](int a) {
+                const double theta = 2 * kPi * a / options.azimuths, c = std::cos(theta), s = std::sin(theta);
+                return c * (st[0] * c + st[1] * s) + s * (st[2] * c + st[3] * s);
+            };
+            if (predicted && stretched)
+                for (std::size_t a = 0; a < radii->predicted.size(); ++a)
+                    radii->predicted[a] *= stretch_along(int(a));
+            const Moments region =
+                region_moments(probe, guess.u, guess.v, search, reach, options, reference, predicted, &change, now);
+            if (radii && stretched)
+                for (std::size_t a = 0; a < now->size(); ++a)
+                    (*now)[a] /= stretch_along(int(a));
+            if (radii) {
+                std::vector<std::vector<double>>& past = radii->history[point];
+                if (now->empty()) {
+                    past.clear();
+                } else {
+                    if (past.size() < kHistory)
+                        past.push_back(std::vector<double>());
+                    for (std::size_t age = past.size() - 1; age > 0; --age)
+                        std::swap(past[age], past[age - 1]);
+                    std::swap(past[0], *now);
+                }
+            }
+            total.area += region.area / node.divisor;
+            total.mu += region.mu / node.divisor;
+            total.mv += region.mv / node.divisor;
         }
         truth.lit = total.area > 0;
         truth.u_px = truth.lit ? total.mu / total.area - 0.5 : 0;
@@ -563,7 +658,7 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     // The calling thread (`reports`) works too: it polls `cancelled` between lenses and reports.
     auto work = [&](bool reports) {
         Radii radii;
-        radii.history.resize(n * n);
+        radii.history.resize(nodes.size());
         for (std::size_t r = next++; r + 1 < runs.size() && !stop; r = next++) {
             for (std::vector<std::vector<double>>& past : radii.history)
                 past.clear();
