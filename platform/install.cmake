@@ -11,6 +11,7 @@
 #   P/bin/plenoptic-targets                      calibration targets with ground truth (the same)
 #   P/bin/plenoptic-dataset                      data sets, here or on Slurm (the same)
 #   P/bin/plenoptic-lens                         lens import, info and drawing (the same)
+#   P/bin/plenoptic-export                       a render in other tools' formats (the same)
 #   P/bin/plenoptic-lens-data                    a lens file's optics as JSON, for plenoptic-lens (source/tools/)
 #   P/lib/python3/dist-packages/plenoptic_lf/    the Python tools' package (python/plenoptic_lf/)
 #   P/share/povray-plenoptic/include/, ini/      POV-Ray's own include and ini files
@@ -18,7 +19,7 @@
 #   P/share/povray-plenoptic/lenses/             the repository's lenses/ (main-lens prescriptions)
 #   P/share/povray-plenoptic/docs/               docs/*.md, docs/metadata.schema.json, README.md, LICENSE
 #   P/share/man/man1/*.1                         povray-plenoptic, plenoptic-project, plenoptic-decode, plenoptic-targets,
-#                                                plenoptic-dataset, plenoptic-lens
+#                                                plenoptic-dataset, plenoptic-lens, plenoptic-export
 #   P/share/doc/povray-plenoptic/copyright       the licence (Debian's place for it)
 #   P/etc/povray-plenoptic/povray.ini, .conf     /etc/povray-plenoptic when P is /usr (GNU rule)
 
@@ -50,6 +51,7 @@ install(FILES "${CMAKE_SOURCE_DIR}/platform/man/povray-plenoptic.1"
               "${CMAKE_SOURCE_DIR}/platform/man/plenoptic-targets.1"
               "${CMAKE_SOURCE_DIR}/platform/man/plenoptic-dataset.1"
               "${CMAKE_SOURCE_DIR}/platform/man/plenoptic-lens.1"
+              "${CMAKE_SOURCE_DIR}/platform/man/plenoptic-export.1"
         DESTINATION share/man/man1)
 
 # Configuration: the build tree's povray.ini and povray.conf (no path in them names a prefix).

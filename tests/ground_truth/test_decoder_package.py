@@ -38,7 +38,8 @@ DISTRIBUTIONS = {"numpy": "numpy", "scipy": "scipy", "PIL": "Pillow", "OpenImage
 OPTIONAL_IMPORTS = {"cv2": ("calibration", {"calibration.py"})}
 # The table of tools (python/pyproject.toml).
 SCRIPTS = {"plenoptic-decode": "plenoptic_lf.cli:main", "plenoptic-dataset": "plenoptic_lf.dataset.cli:main",
-           "plenoptic-targets": "plenoptic_lf.targets:main", "plenoptic-lens": "plenoptic_lf.lens_tool:main"}
+           "plenoptic-targets": "plenoptic_lf.targets:main", "plenoptic-lens": "plenoptic_lf.lens_tool:main",
+           "plenoptic-export": "plenoptic_lf.export.cli:main"}
 SOURCE_TREE_SCRIPTS = {"bench": "plenoptic_bench.cli:main", "report2018-figures": "plenoptic_report2018.figures:main",
                        "calibration-loop": "plenoptic_lf.calibration:main"}
 # A python3 that lacks numpy (site-packages off), first on PATH.
