@@ -116,7 +116,12 @@ class Render:
 
 # The registry: one import and one entry per format, each on its own line (formats are added
 # independently), sorted by name.
+from . import eslf  # noqa: E402
+from . import views  # noqa: E402
+
 FORMATS: dict[str, ModuleType] = {
+    "eslf": eslf,
+    "views": views,
 }
 
 __all__ = ["FORMATS", "ExportError", "Render"]
