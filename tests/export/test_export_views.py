@@ -21,7 +21,8 @@ looks along +z at one textured, self-lit plane at z = 0.8 m.
   round-trips float32 bit-exactly (NaN, infinities, -0, subnormals), and an exported disparity
   file rewritten from its read values is the same bytes.
 - views.json and README.md state units, sign, offset and reference view.
-- A render without a depth map is refused, and nothing is written.
+- A render without a depth map is refused, and so is a focused (2.0) camera (by eslf too);
+  nothing is written.
 """
 import json
 import os
@@ -205,3 +206,16 @@ def test_same_numbers_as_the_hci_export(args, export):
     theirs = read_pfm(os.path.join(hci, "gt_disp_lowres.pfm"))
     assert ours.shape == theirs.shape and np.array_equal(ours, theirs), \
         "largest difference %.3g px" % float(np.abs(ours - theirs).max())
+
+
+def test_a_focused_camera_is_refused(args):
+    """Microlenses at d != f (plenoptic 2.0): the microimages are not sub-aperture samples; both
+    view-based formats refuse and say why."""
+    scene = (SCENE % "depth_map").replace("distance %r" % MICRO_F, "distance %r" % (MICRO_F * 0.6))
+    assert scene != SCENE % "depth_map"
+    png, _, _ = pt.render_ground_truth(args.povray, args.work, "views_focused", scene, 96, 72)
+    for fmt in ("views", "eslf"):
+        folder = os.path.join(args.work, "views_focused_" + fmt)
+        run = run_export(args, png, "--to", fmt, folder, "-q")
+        assert run.returncode == 2 and "focused (2.0)" in run.stderr and "d = 0.084 mm" in run.stderr, run.stderr
+        assert not [e for e in os.listdir(args.work) if os.path.basename(folder) in e], "nothing is written"

@@ -176,9 +176,27 @@ def _scale_option(value: Any, largest: float) -> float:
     return scale
 
 
+def check_eslf_camera(meta: Any) -> None:
+    """ExportError unless the decoder's tiles are sub-aperture samples, the 4-D light field an ESLF
+    holds: microlenses focused at infinity (d = f, plenoptic 1.0) or pinholes. A focused (2.0)
+    camera's microimages are small pictures of the scene, not a lens's directions."""
+    array = meta.array
+    if array.lens == "pinhole":
+        return
+    wrong = [f for f in array.focal_lengths_mm if not math.isclose(meta.array_distance_mm, f, rel_tol=1e-6)]
+    if wrong:
+        raise ExportError("eslf holds a 4-D light field of sub-aperture samples (plenoptic 1.0: array to sensor "
+                          "distance d = microlens focal length f); this camera has d = %g mm and microlens focal "
+                          "length%s %s mm, a focused (2.0) camera whose microimages are pictures of the scene, not "
+                          "directions: its tiles would not be a light field LFToolbox can use"
+                          % (meta.array_distance_mm, "s" if len(array.focal_lengths_mm) > 1 else "",
+                             ", ".join("%g" % f for f in array.focal_lengths_mm)))
+
+
 def export(render: Render, out_dir: Path, angular: int | None = None, step: float = 1.0,
            scale: Any = None) -> list[Path]:
     meta = render.meta
+    check_eslf_camera(meta)
     lf = render.light_field(angular, step)
     T, S, n_v, n_u, C = lf.data.shape
     if C != 3:

@@ -18,8 +18,8 @@ between the files as stored; nothing is added to it or is to be added. The refer
 centre view (its row and column in views.json).
 
 The geometry is plenoptic_lf.hci's (HciGeometry, planar_depth_mm): behind a thin_lens or
-thick_lens main lens the views are pinhole cameras on the entrance pupil's plane looking at the
-plane in focus, whatever the microlenses' focal lengths (a view samples every microimage at one
+thick_lens main lens and microlenses at d = f (plenoptic 1.0) the views are pinhole cameras on
+the entrance pupil's plane looking at the plane in focus (a view samples every microimage at one
 offset from its centre, so its chief rays all pass one point of the pupil). Hexagonal lens rows
 are resampled to square view pixels one lens pitch apart, as for --hci: colours linearly between
 rows, depths at the nearest row.
@@ -78,8 +78,9 @@ def read_pfm(path: str | os.PathLike[str]) -> np.ndarray:
 
 
 def check_views_camera(meta: Any) -> None:
-    """ExportError unless every view is a pinhole camera on one grid with square pixels: a
-    thin_lens or thick_lens main lens without distortion, an array aligned with the sensor, square
+    """ExportError unless every view is a pinhole camera on one grid with square pixels (what
+    plenoptic-decode --hci asks too): a thin_lens or thick_lens main lens without distortion, one
+    kind of thin microlens at d = f (plenoptic 1.0), an array aligned with the sensor, square
     pixels, the array beyond the focal length."""
     if meta.main_lens_type == "prescription":
         raise ExportError("views: a traced prescription's distortion and pupil aberration bend each view's rays "
@@ -91,7 +92,16 @@ def check_views_camera(meta: Any) -> None:
     if meta.main_lens.distorted:
         raise ExportError("views: a distorted lens's views are not pinhole cameras, so no single disparity per "
                           "pixel exists; render without distortion")
-    rotate = meta.array.rotate_deg
+    array = meta.array
+    focal = array.focal_lengths_mm
+    if array.lens != "thin_lens" or len(focal) != 1:
+        raise ExportError("views needs one kind of thin microlens (plenoptic 1.0); this array has %s"
+                          % ("pinholes" if array.lens == "pinhole" else "%d lens types" % len(focal)))
+    if not math.isclose(meta.array_distance_mm, focal[0], rel_tol=1e-6):
+        raise ExportError("views decodes plenoptic 1.0 cameras (array to sensor distance d = microlens focal length "
+                          "f); this one has d = %g mm and f = %g mm, a focused (2.0) camera whose microimages are "
+                          "not sub-aperture samples" % (array.distance_mm, focal[0]))
+    rotate = array.rotate_deg
     if any(abs(x) > 0 for x in rotate):
         raise ExportError("views needs an array aligned with the sensor (rotate <0, 0, 0>); this one is turned "
                           "(rotate <%g, %g, %g>): its views' pixel axes are not the camera grid's" % tuple(rotate))
