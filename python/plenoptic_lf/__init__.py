@@ -21,9 +21,9 @@ way to run POV-Ray), lightfield (raw + metadata -> LightField, views, EPI, refoc
 refocus sweep), projection (forward projection through plenoptic-project), hci (the HCI
 benchmark's layout with ground truth), total_focus (a focused raw's all-in-focus image),
 contact_sheet, outputs (the decoder's output folder), progress, errors, cli (the plenoptic-decode
-command), targets (plenoptic-targets), dataset (plenoptic-dataset), calibration (the source tree's
-calibration-loop: OpenCV on the central views, docs/calibration-loop.md; imported on its own, not
-here). The public API carries type
+command), targets (plenoptic-targets), dataset (plenoptic-dataset), export (plenoptic-export: other
+tools' formats, docs/export/README.md), calibration (the source tree's calibration-loop: OpenCV
+on the central views, docs/calibration-loop.md; imported on its own, not here). The public API carries type
 hints (checked with mypy by the tests; py.typed marks the package as typed).
 
 Importable with only its parent directory on sys.path: nothing here is generated at build time.

@@ -138,7 +138,9 @@ Convention
   (i', j'). d > 0 for points in front of the plane the main lens images onto the microlens array
   ({z0_m:.6g} m from the {pupil}), d = 0 on it, d < 0 behind it.
 - Offset: none. d is the shift between the views as stored; no constant is added or is to be
-  added (the views already share the plane of zero disparity the optics give them).
+  added. The views share the plane of zero disparity the optics give them (their sensors are, in
+  the HCI benchmark's words, shifted); a method that wants the disparity of parallel cameras,
+  baseline x focal / Z, adds {parallel:.6g} px (`geometry.parallel_cameras_add_px`).
 - Reference view: the centre view, row {centre}, column {centre} (`view_{centre:02d}_{centre:02d}.pfm`).
   Every view has its own disparity map; each is the disparity of what that view sees.
 - Geometry: the views are pinhole cameras {baseline_mm:.6g} mm apart on the {pupil}'s plane,
@@ -207,6 +209,7 @@ def export(render: Render, out_dir: Path, angular: int | None = None, step: floa
             "focus_distance_mm": geometry.z0,
             "depth_from": pupil,
             "formula": "d = baseline_mm * focal_length_px * (1/Z - 1/focus_distance_mm), Z along the axis in mm",
+            "parallel_cameras_add_px": geometry.baseline * geometry.focal_px / geometry.z0,
             "rows": "hexagonal rows resampled to square pixels one pitch apart" if meta.grid == "hexagonal"
                     else "one lens row per view row",
         },
@@ -220,5 +223,6 @@ def export(render: Render, out_dir: Path, angular: int | None = None, step: floa
     with open(readme, "w", encoding="utf-8") as f:
         f.write(README.format(image=os.path.basename(render.image_path), count=len(usable), width=S, height=height,
                               step="%g" % lf.step, z0_m=geometry.z0 / 1000.0, pupil=pupil, centre=centre,
-                              baseline_mm=geometry.baseline, focal_px=geometry.focal_px, rows=row_note))
+                              baseline_mm=geometry.baseline, focal_px=geometry.focal_px, rows=row_note,
+                              parallel=geometry.baseline * geometry.focal_px / geometry.z0))
     return written + [json_path, readme]
