@@ -22,7 +22,8 @@ looks along +z at one textured, self-lit plane at z = 0.8 m.
   file rewritten from its read values is the same bytes.
 - views.json and README.md state units, sign, offset and reference view.
 - A render without a depth map is refused, and so is a focused (2.0) camera (by eslf too);
-  nothing is written.
+  nothing is written. Ctrl-C while views are written stops the command within seconds (status
+  130) and leaves nothing.
 """
 import json
 import os
@@ -219,3 +220,33 @@ def test_a_focused_camera_is_refused(args):
         run = run_export(args, png, "--to", fmt, folder, "-q")
         assert run.returncode == 2 and "focused (2.0)" in run.stderr and "d = 0.084 mm" in run.stderr, run.stderr
         assert not [e for e in os.listdir(args.work) if os.path.basename(folder) in e], "nothing is written"
+
+
+def test_ctrl_c_stops_promptly_and_leaves_nothing(args, export):
+    """SIGINT (Ctrl-C) while the views are being written (many views: --step 0.25): the command
+    stops within a few seconds with status 130, and neither the folder nor a staging folder is
+    left."""
+    import signal
+    import time
+    png = export[0]
+    folder = os.path.join(args.work, "views_interrupted")
+    process = subprocess.Popen([sys.executable, os.path.join(args.tools, "plenoptic-export"), png, "--to", "views",
+                                folder, "--step", "0.25"], stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        seen = []
+        for line in process.stderr:
+            seen.append(line)
+            if line.startswith("plenoptic-export: views:"):
+                break
+        assert process.poll() is None, "still writing views when interrupted: %s" % "".join(seen)
+        process.send_signal(signal.SIGINT)
+        start = time.monotonic()
+        rest = process.stderr.read()
+        status = process.wait(timeout=30)
+        took = time.monotonic() - start
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert status == 130 and "interrupted: nothing written" in rest, (status, rest[-1000:])
+    assert took < 5, "stopped %.1f s after Ctrl-C" % took
+    assert not [e for e in os.listdir(args.work) if "views_interrupted" in e], "nothing is left"
