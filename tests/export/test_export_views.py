@@ -2,8 +2,8 @@
 """plenoptic-export RENDER --to views DIR against the thin-lens geometry and its own stated
 convention (docs/export/views.md).
 
-Scene: a plenoptic 1.0 camera (F = 50 mm f/2 focused at 1 m, rectangular microlenses at d = f)
-looks along +z at one textured, self-lit plane at z = 0.8 m.
+Scene: a plenoptic 1.0 camera (F = 50 mm f/2 focused at 1 m, microlenses at d = f, a
+rectangular and a hexagonal array) looks along +z at one textured, self-lit plane at z = 0.8 m.
 
 - Disparity of the plane, worked out here from the thin lens and the virtual depth: the main lens
   images the plane at b = F Z / (Z - F) behind it, a = D - b in front of the array (a < 0: behind
@@ -48,7 +48,7 @@ camera {
   plenoptic
   location <0, 0, 0> look_at <0, 0, 1>
   main_lens { thin_lens focal_length %r f_number %r focus_distance %r }
-  microlens_array { rectangular pitch %r focal_length %r distance %r }
+  microlens_array { %%s pitch %r focal_length %r distance %r }
   sensor { pixel_size %r }
   samples 16
   %%s
@@ -83,10 +83,11 @@ def expected_disparity(z_mm, step=1.0):
     return -(a / MICRO_F) * (D / b) * (PIXEL * step / PITCH)
 
 
-@pytest.fixture(scope="module")
-def export(args):
-    png, _, _ = pt.render_ground_truth(args.povray, args.work, "views_plane", SCENE % "depth_map", W, H)
-    folder = os.path.join(args.work, "views_plane_out")
+@pytest.fixture(scope="module", params=["rectangular", "hexagonal"])
+def export(args, request):
+    grid = request.param
+    png, _, _ = pt.render_ground_truth(args.povray, args.work, "views_" + grid, SCENE % (grid, "depth_map"), W, H)
+    folder = os.path.join(args.work, "views_%s_out" % grid)
     run = run_export(args, png, "--to", "views", folder, "-q")
     assert run.returncode == 0, "plenoptic-export --to views exits 0: %s" % run.stderr[-2000:]
     with open(os.path.join(folder, "views.json"), encoding="utf-8") as f:
@@ -186,7 +187,7 @@ def test_pfm_round_trip_is_bit_exact(args, export):
 
 
 def test_without_a_depth_map_it_is_refused(args):
-    png, _, _ = pt.render_ground_truth(args.povray, args.work, "views_nodepth", SCENE % "", 96, 72)
+    png, _, _ = pt.render_ground_truth(args.povray, args.work, "views_nodepth", SCENE % ("rectangular", ""), 96, 72)
     folder = os.path.join(args.work, "views_nodepth_out")
     run = run_export(args, png, "--to", "views", folder, "-q")
     assert run.returncode == 2 and "depth map" in run.stderr and len(run.stderr.strip().splitlines()) == 1, \
@@ -198,7 +199,7 @@ def test_same_numbers_as_the_hci_export(args, export):
     """The centre view's disparity is the HCI export's gt_disp_lowres.pfm of the same render
     (docs/hci-export.md): the same convention, without that layout's PNG views."""
     png, folder, doc, _ = export
-    hci = os.path.join(args.work, "views_plane_hci")
+    hci = folder + "_hci"
     run = subprocess.run([sys.executable, os.path.join(args.tools, "plenoptic-decode"), png, "-q", "--hci", hci],
                          capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr[-2000:]
@@ -212,8 +213,8 @@ def test_same_numbers_as_the_hci_export(args, export):
 def test_a_focused_camera_is_refused(args):
     """Microlenses at d != f (plenoptic 2.0): the microimages are not sub-aperture samples; both
     view-based formats refuse and say why."""
-    scene = (SCENE % "depth_map").replace("distance %r" % MICRO_F, "distance %r" % (MICRO_F * 0.6))
-    assert scene != SCENE % "depth_map"
+    scene = (SCENE % ("rectangular", "depth_map")).replace("distance %r" % MICRO_F, "distance %r" % (MICRO_F * 0.6))
+    assert scene != SCENE % ("rectangular", "depth_map")
     png, _, _ = pt.render_ground_truth(args.povray, args.work, "views_focused", scene, 96, 72)
     for fmt in ("views", "eslf"):
         folder = os.path.join(args.work, "views_focused_" + fmt)
@@ -229,7 +230,7 @@ def test_ctrl_c_stops_promptly_and_leaves_nothing(args, export):
     import signal
     import time
     png = export[0]
-    folder = os.path.join(args.work, "views_interrupted")
+    folder = export[1] + "_interrupted"
     process = subprocess.Popen([sys.executable, os.path.join(args.tools, "plenoptic-export"), png, "--to", "views",
                                 folder, "--step", "0.25"], stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
     try:
@@ -249,4 +250,4 @@ def test_ctrl_c_stops_promptly_and_leaves_nothing(args, export):
             process.kill()
     assert status == 130 and "interrupted: nothing written" in rest, (status, rest[-1000:])
     assert took < 5, "stopped %.1f s after Ctrl-C" % took
-    assert not [e for e in os.listdir(args.work) if "views_interrupted" in e], "nothing is left"
+    assert not [e for e in os.listdir(args.work) if os.path.basename(folder) in e], "nothing is left"
