@@ -28,7 +28,7 @@ import os
 import struct
 import zlib
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable, Iterator
 
 import numpy as np
 
@@ -56,22 +56,28 @@ def _chunk(kind: bytes, data: bytes) -> bytes:
     return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
 
 
-def write_png16(path: str | os.PathLike[str], pixels: np.ndarray, progress: Any = None) -> None:
-    """A 16-bit PNG (RGB or RGBA by the last axis) of uint16 pixels (H, W, C), with gAMA 1.0
-    (linear values), written by this function (PNG's own rules: big-endian samples, filter 0 on
-    every row, one zlib stream)."""
-    height, width, channels = pixels.shape
+def write_png16(path: str | os.PathLike[str], width: int, height: int, channels: int,
+                bands: Iterable[np.ndarray], progress: Any = None) -> None:
+    """A 16-bit PNG (RGB or RGBA) of `height` rows of `width` uint16 pixels, given as bands of
+    whole rows (each (rows, width, channels)) so that the image need not exist whole in memory;
+    with gAMA 1.0 (linear values). Written here by PNG's own rules: big-endian samples, filter 0
+    on every row, one zlib stream in one IDAT chunk."""
     colour_type = {3: 2, 4: 6}[channels]
-    rows = np.ascontiguousarray(pixels.astype(">u2")).view(np.uint8).reshape(height, width * channels * 2)
-    body = np.zeros((height, rows.shape[1] + 1), np.uint8)
-    body[:, 1:] = rows
     compressor = zlib.compressobj(6)
     parts = []
-    band = max(1, (1 << 22) // max(body.shape[1], 1))
-    for r in range(0, height, band):
-        parts.append(compressor.compress(body[r:r + band].tobytes()))
+    done = 0
+    for band in bands:
+        rows = band.shape[0]
+        if band.shape[1:] != (width, channels):
+            raise ValueError("a band of %s pixels in a %d x %d x %d PNG" % (band.shape, width, height, channels))
+        body = np.zeros((rows, width * channels * 2 + 1), np.uint8)
+        body[:, 1:] = np.ascontiguousarray(band.astype(">u2")).view(np.uint8).reshape(rows, -1)
+        parts.append(compressor.compress(body.tobytes()))
+        done += rows
         if progress is not None:
-            progress.update(min(r + band, height), height)
+            progress.update(done, height)
+    if done != height:
+        raise ValueError("%d rows given for a PNG of %d" % (done, height))
     parts.append(compressor.flush())
     with open(path, "wb") as f:
         f.write(b"\x89PNG\r\n\x1a\n")
@@ -205,13 +211,18 @@ def export(render: Render, out_dir: Path, angular: int | None = None, step: floa
     factor = _scale_option(scale, largest)
     render.progress.stage("ESLF: %d x %d lenslets of %d x %d samples -> %d x %d px, 16-bit RGBA"
                           % (S, T, n_u, n_v, S * n_u, T * n_v))
-    tiles = np.empty((T, n_v, S, n_u, 4), np.uint16)
-    tiles[..., :3] = quantise(lf.data, factor).transpose(0, 2, 1, 3, 4)
-    weight = lf.mask[None, None, :, :] & ~lf.dark[:, :, None, None]  # [t, s, v, u]
-    tiles[..., 3] = np.where(weight, FULL, 0).transpose(0, 2, 1, 3)
-    image = tiles.reshape(T * n_v, S * n_u, 4)
+
+    def lens_rows() -> Iterator[np.ndarray]:
+        """The image one lens row (n_v pixel rows) at a time: tiles [v, s, u, c] side by side."""
+        for t in range(T):
+            band = np.empty((n_v, S, n_u, 4), np.uint16)
+            band[..., :3] = quantise(lf.data[t], factor).transpose(1, 0, 2, 3)
+            weight = lf.mask[None, :, :] & ~lf.dark[t][:, None, None]  # [s, v, u]
+            band[..., 3] = np.where(weight, FULL, 0).transpose(1, 0, 2)
+            yield band.reshape(n_v, S * n_u, 4)
+
     png = out_dir / ("%s.eslf.png" % render.stem)
-    write_png16(png, image, render.progress)
+    write_png16(png, S * n_u, T * n_v, 4, lens_rows(), render.progress)
 
     model, model_note = lenslet_grid_model(meta)
     s0, t0 = lf.origin_st
