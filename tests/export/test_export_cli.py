@@ -140,3 +140,15 @@ def test_output_is_all_or_nothing(args, monkeypatch, capsys, behaviour, status):
             assert "interrupted: nothing written" in captured.err, captured.err
         else:
             assert "the fake format cannot express this render" in captured.err, captured.err
+
+
+def test_broken_metadata_is_named(args):
+    from plenoptic_lf.export import FORMATS
+    image = os.path.join(args.work, "broken.png")
+    small_png(image)
+    with open(os.path.join(args.work, "broken.plenoptic.json"), "w") as f:
+        f.write('{"format": "povray-plenoptic", ')
+    out = os.path.join(args.work, "broken_out")
+    line = one_error_line(run_export(args, image, "--to", sorted(FORMATS)[0], out))
+    assert "broken.plenoptic.json: " in line, line
+    assert not leftovers(out), leftovers(out)

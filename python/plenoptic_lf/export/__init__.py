@@ -59,9 +59,9 @@ class Render:
             raise DecodeError("%s: the rendered image does not exist" % image_path)
         self.info = inspect_raw(image_path, encoding)
         if not os.path.exists(self.metadata_path):
-            from ..errors import MetadataError
-            raise MetadataError("no metadata beside the image: %s does not exist (every plenoptic render writes "
-                                "<stem>.plenoptic.json; name another with --metadata)" % self.metadata_path)
+            raise ExportError("%s: the render's metadata does not exist (every plenoptic render writes "
+                              "<stem>.plenoptic.json beside its image; name another with --metadata)"
+                              % self.metadata_path)
         self.meta = load_metadata(self.metadata_path, (self.info.width, self.info.height))
         self._picture: np.ndarray | None = None
         self._light_fields: dict[tuple[Any, float], Any] = {}

@@ -25,6 +25,7 @@ from typing import Any, Sequence
 
 from ..errors import DecodeError, DependencyError, MetadataError
 from ..images import check_encoding, require_openimageio
+from ..metadata import metadata_path_for
 from ..progress import Progress
 from . import FORMATS, ExportError, Render
 
@@ -151,10 +152,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     previous = signal.signal(signal.SIGTERM, _interrupt) if hasattr(signal, "SIGTERM") else None
     progress = Progress(not args.quiet, PROG)
     staging = None
-    meta_path = args.metadata
+    meta_path = args.metadata or metadata_path_for(args.render)
     try:
-        render = Render(args.render, args.metadata, encoding, progress)
-        meta_path = render.metadata_path
+        render = Render(args.render, meta_path, encoding, progress)
         staging = _staging_dir(args.out_dir)
         written = module.export(render, Path(staging), **options)
         files = _publish(staging, args.out_dir, written)
@@ -162,7 +162,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("%s: interrupted: nothing written to %s" % (PROG, args.out_dir), file=sys.stderr)
         return 130
     except MetadataError as e:
-        return fail("%s: %s" % (meta_path or "the metadata", e))
+        return fail("%s: %s" % (meta_path, e))
     except DecodeError as e:  # ExportError too
         return fail(str(e))
     except DependencyError as e:
