@@ -116,11 +116,17 @@ class Render:
 
 # The registry: one import and one entry per format, each on its own line (formats are added
 # independently), sorted by name.
+from . import compote  # noqa: E402
 from . import eslf  # noqa: E402
+from . import kiel  # noqa: E402
+from . import raytrix  # noqa: E402
 from . import views  # noqa: E402
 
 FORMATS: dict[str, ModuleType] = {
+    "compote": compote,
     "eslf": eslf,
+    "kiel": kiel,
+    "raytrix": raytrix,
     "views": views,
 }
 
