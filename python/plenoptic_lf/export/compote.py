@@ -51,7 +51,7 @@ from . import ExportError, Render
 from .lenses import check_camera, lens_types, lenses_in_picture, row_direction
 
 SUMMARY = "COMPOTE / libpleno: camera, intrinsics, params and scene configs, micro-image centre and BAP CSVs"
-OPTIONS: dict[str, str] = {}
+OPTIONS = {"project": "the plenoptic-project program (default: $PLENOPTIC_PROJECT, the build tree's or the install's)"}
 
 SIN60 = math.sqrt(3.0) / 2.0
 
@@ -269,7 +269,13 @@ def export(render: Render, out_dir: Path, **options: Any) -> list[Path]:
     from ..metadata import load_metadata
     from ..projection import project_points
     meta = render.meta
+    from ..locate import find_project
     targets, folder = _views(render)
+    try:
+        tool = find_project(options.get("project") or os.environ.get("PLENOPTIC_PROJECT"))
+    except FileNotFoundError:
+        raise ExportError("compote: the blur radii come from plenoptic-project, which was not found: give its path "
+                          "with -O project=PATH")
     n = camera_numbers(render)
     files = config_files(n, targets["target"], meta.mm_per_unit)
     for name in ("camera", "intrinsics"):
@@ -314,7 +320,10 @@ def export(render: Render, out_dir: Path, **options: Any) -> list[Path]:
                         corners.append((key, (float(row["x"]), float(row["y"]), float(row["z"]))))
             if not corners:
                 continue
-            hits = project_points(view_meta_path, [c[1] for c in corners], blur=True)
+            try:
+                hits = project_points(view_meta_path, [c[1] for c in corners], tool=tool, blur=True)
+            except (OSError, RuntimeError) as e:
+                raise ExportError("compote: plenoptic-project (%s) failed on %s: %s" % (tool, view_meta_path, e))
             for point, k, l, u, v, rho in hits:
                 ks = int(k) - (int(l) // 2)
                 if (ks, int(l)) not in index:
