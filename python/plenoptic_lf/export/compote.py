@@ -128,7 +128,7 @@ def camera_numbers(render: Render) -> dict[str, Any]:
     focal = lens_types(render)
     types = len(focal)
     d, big_d, s = meta.array_distance_mm, meta.main_distance_mm, float(meta.pixel_size_mm[0])
-    big_f = float(meta.focal_length_mm)
+    big_f = float(meta.focal_length_mm or math.nan)
     if all(f > d for f in focal):
         mode = 2
     elif all(f < d for f in focal):
@@ -175,13 +175,13 @@ def camera_numbers(render: Render) -> dict[str, Any]:
     worst = float(np.max(np.hypot(*(uv - mia["centres"]).T)))
     if worst > 1e-6:
         raise ExportError("compote: the micro-lens array and sensor poses put a micro-image %.3g px off" % worst)
-    aperture = float(meta.aperture_mm)
+    aperture = float(meta.aperture_mm or math.nan)
     f_number = big_f / aperture
     sign = 1.0 if mode == 1 else -1.0  # preprocess.cpp: radii are negated except for Keplerian cameras
     dc = mia["pitch_px"] * s
     q = [sign * (p / 2.0) * abs(1.0 - d / f + d / big_d) for f in focal]
     principal = (meta.width - 1 + sensor_t[0] / s, meta.height - 1 + sensor_t[1] / s)
-    focal_planes = []
+    focal_planes: list[float | None] = []
     for f in focal:
         if f == d:
             focal_planes.append(None)
@@ -312,7 +312,7 @@ def export(render: Render, out_dir: Path, **options: Any) -> list[Path]:
             if (not np.allclose(view_meta.origin, meta.origin, atol=1e-9) or not np.allclose(view_meta.a, meta.a, atol=1e-9)
                     or not np.allclose(view_meta.b, meta.b, atol=1e-9)):
                 raise ExportError("compote: view %s has another camera than %s" % (view["image"], render.image_path))
-            corners = []
+            corners: list[tuple[tuple[int, int], tuple[float, float, float]]] = []
             with open(os.path.join(folder, view["points"]), encoding="utf-8") as pf:
                 for row in csv.DictReader(pf):
                     key = (int(row["row"]), int(row["col"]))
@@ -329,9 +329,9 @@ def export(render: Render, out_dir: Path, **options: Any) -> list[Path]:
                 if (ks, int(l)) not in index:
                     dropped += 1  # a lens whose centre lies over a diameter outside the picture
                     continue
-                (row, col), _ = corners[int(point)]
+                (corner_row, corner_col), _ = corners[int(point)]
                 w.writerow([*index[(ks, int(l))], repr(float(u)), repr(float(v)), repr(float(rho)),
-                            row * x_grid + col, view["view"]])
+                            corner_row * x_grid + corner_col, view["view"]])
     written.append(bap_path)
     render.progress.stage("compote: %d views, mesh %d x %d, %d lens type%s%s" % (
         len(targets["views"]), mia["width"], mia["height"], n["I"], "" if n["I"] == 1 else "s",

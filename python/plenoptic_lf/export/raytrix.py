@@ -85,7 +85,7 @@ def total_covering_plane(render: Render, types: int) -> float:
     one type, p / sqrt(3) for one type and p for three. inf when the cone never does."""
     meta = render.meta
     reach = meta.pitch_mm / SQRT3 if types == 1 else meta.pitch_mm
-    k = 2.0 * reach / meta.exit_pupil_mm
+    k = 2.0 * reach / float(meta.exit_pupil_mm or math.nan)
     if k >= 1:
         return math.inf
     return meta.pupil_distance_mm * k / (1.0 - k) / meta.array_distance_mm
@@ -135,7 +135,7 @@ def calibration(render: Render, blur_px: float = 1.0, cap: float = 100.0, fmt: s
     focal = lens_types(render)
     d = meta.array_distance_mm
     pixel = float(meta.pixel_size_mm[0])
-    types = []
+    types: list[dict[str, Any]] = []
     reader_type = hex_focal_type(alpha, beta)
     for t, f in enumerate(focal):
         members = np.nonzero(lenses.type == t)[0]
