@@ -39,7 +39,7 @@ FOCAL = (0.58267, 0.52402, 0.56057)
 SIN60 = math.sqrt(3.0) / 2.0
 CAMERA = ("camera { plenoptic\n"
           "  main_lens { thin_lens focal_length %g f_number %g distance %g }\n"
-          "  microlens_array { hexagonal pitch %g focal_lengths <%g, %g, %g> distance %g }\n"
+          "  microlens_array { hexagonal pitch %g focal_lengths <%g, %g, %g> distance %g rotate <0, 0, 3> translate <0.011, 0.007, 0> }\n"
           "  sensor { pixel_size %g } samples 4 microimage_centres }\n" % (F, N, D, PITCH, *FOCAL, D_MLA, S))
 
 

@@ -142,6 +142,7 @@ def test_xml_places_every_microimage_centre(turned):
     assert os.path.exists(os.path.join(out["raytrix"], "turned.png")), "the image beside the XML"
     expected_diameter = PITCH * (D + D_MLA) / D / S  # the lens centres projected from the main lens's centre
     assert abs(cal["diameter"] - expected_diameter) < 1e-9, (cal["diameter"], expected_diameter)
+    assert abs(cal["rotation"] - math.radians(7)) < 1e-9, "the array's rotate <0, 0, 7>: %r rad" % cal["rotation"]
     centres = read_csv_centres(stem + ".microimages.csv")
     lattice = toolbox_lattice(cal, W, H)
     points = np.array(list(lattice.values()))
