@@ -108,12 +108,14 @@ def mia_mesh(render: Render) -> dict[str, Any]:
             "rotation": rotation, "translation": t, "centres": centres}
 
 
-def _dist_focus_mm(meta: Any) -> float:
+def _dist_focus_mm(meta: Any) -> float | None:
+    """The distance (mm, from the main lens) the camera is focused at: the scene's focus_distance,
+    else the thin-lens object of the array's plane; None when that lies at or beyond infinity."""
     focus = meta.raw["main_lens"].get("focus_distance")
     if isinstance(focus, (int, float)):
         return float(focus) * meta.mm_per_unit
     f, big_d = meta.focal_length_mm, meta.main_distance_mm
-    return f * big_d / (big_d - f) if big_d > f else math.inf
+    return f * big_d / (big_d - f) if big_d > f else None
 
 
 def camera_numbers(render: Render) -> dict[str, Any]:

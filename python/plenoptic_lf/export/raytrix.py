@@ -67,14 +67,14 @@ def depth_range(f_mm: float, d_mm: float, pitch_mm: float, pixel_mm: float, blur
     blur_px pixels: |(A/2)(d/f + 1/v - 1)| <= blur_px * pixel, A the pitch (libpleno's blur
     model, docs/ground-truth.md '--blur'); 1/v then lies in [c - e, c + e], c = 1 - d/f,
     e = 2 blur_px pixel / A. None when no v >= 1 qualifies; the upper end is `cap` when the range
-    reaches infinity."""
+    reaches infinity (1/v down to 0 or below)."""
     c = 1.0 - d_mm / f_mm
     e = 2.0 * blur_px * pixel_mm / pitch_mm
     low, high = c - e, min(c + e, 1.0)  # bounds on 1/v; v >= 1 means 1/v <= 1
     if high <= 0 or low > high:
         return None
     v_min = 1.0 / high
-    v_max = cap if low <= 0 else min(1.0 / low, cap)
+    v_max = cap if low <= 0 else 1.0 / low
     return v_min, v_max
 
 
