@@ -217,6 +217,7 @@ def test_per_lens_json(turned, args):
     picture = read_image(image)
     b = F * PLANE_MM / (PLANE_MM - F)
     v = (b - D) / D_MLA
+    checked = 0
     for lens in lenses:
         k, l = lens["row_form_index"]
         u, vv = centres[(k, l)]
@@ -230,19 +231,25 @@ def test_per_lens_json(turned, args):
         colour = read_image(os.path.join(out["kiel"], lens["relative_color_filename"]))
         depth = read_image(os.path.join(out["kiel"], lens["relative_depth_filename"]))[..., 0]
         assert colour.shape == (n, n, 3) and depth.shape == (n, n)
-        # The lens grid's middle sample is the centre: the picture there (bilinear), to 16 bits.
-        if n % 2 == 1:
-            r, c = lens["pixel_coord"]
+        # Sample (i, j) of the lens grid lies at offsets linspace(-r, r, n)[i, j] from the centre:
+        # the picture there (bilinear), to 16 bits.
+        offsets = np.linspace(-1, 1, n) * lens["diameter"] / 2
+        for i, j in ((n // 2, n // 2), (n // 3, 2 * n // 3)):
+            r, c = lens["pixel_coord"][0] + offsets[i], lens["pixel_coord"][1] + offsets[j]
+            if not (0 <= r < H - 1 and 0 <= c < W - 1):
+                continue
             r0, c0 = int(math.floor(r)), int(math.floor(c))
             fr, fc = r - r0, c - c0
             want = ((1 - fr) * (1 - fc) * picture[r0, c0] + (1 - fr) * fc * picture[r0, c0 + 1] +
                     fr * (1 - fc) * picture[r0 + 1, c0] + fr * fc * picture[r0 + 1, c0 + 1])
-            assert np.max(np.abs(colour[n // 2, n // 2] - want)) < 2e-5
+            assert np.max(np.abs(colour[i, j] - want)) < 2e-5, (lens["axial_coord"], i, j, colour[i, j], want)
+            checked += 1
         z = depth * (lens["clip_end"] - lens["clip_start"]) + lens["clip_start"]
         hit = z > 0
         assert hit.any()
         assert np.max(np.abs(z[hit] / lens["focal_length"] - v)) < v * 2e-4, "the plane's virtual depth"
     assert len(seen) == len(lenses), "axial coordinates unique"
+    assert checked > len(lenses), checked
 
 
 def test_manufacturing_errors_refused_by_raytrix_written_by_kiel(args):
