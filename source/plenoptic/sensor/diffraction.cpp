@@ -6,9 +6,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <memory>
+#include <mutex>
 #include <thread>
 
 #include <boost/math/special_functions/bessel.hpp>
+#include <fftw3.h>
 
 #include "plenoptic/camera/rays.h"
 
@@ -142,46 +145,192 @@ std::vector<AiryKernel> channel_kernels(const PlenopticCamera& m, const Diffract
     return kernels;
 }
 
+namespace {
+
+// FFTW's planner is not thread-safe (its plans' execution is): plans are made and destroyed under
+// this lock.
+std::mutex& fftw_planner()
+{
+    static std::mutex lock;
+    return lock;
+}
+
+// The smallest size from n whose only prime factors are 2, 3, 5 and 7 (FFTW's fast sizes).
+int fast_fft_size(int n)
+{
+    for (int m = std::max(1, n);; ++m) {
+        int rest = m;
+        for (int f : {2, 3, 5, 7})
+            while (rest % f == 0)
+                rest /= f;
+        if (rest == 1)
+            return m;
+    }
+}
+
+// Memory FFTW aligns for its vector code; freed by fftw_free.
+struct FftwDeleter {
+    void operator()(void* p) const { fftw_free(p); }
+};
+using RealBuffer = std::unique_ptr<double, FftwDeleter>;
+using SpectrumBuffer = std::unique_ptr<fftw_complex, FftwDeleter>;
+RealBuffer real_buffer(size_t n) { return RealBuffer(static_cast<double*>(fftw_malloc(sizeof(double) * n))); }
+SpectrumBuffer spectrum_buffer(size_t n) { return SpectrumBuffer(static_cast<fftw_complex*>(fftw_malloc(sizeof(fftw_complex) * n))); }
+
+// One transform size's forward and inverse plans (FFTW_ESTIMATE: the same plan, so the same
+// arithmetic, on every run), executed on any buffers from real_buffer / spectrum_buffer.
+class TilePlans {
+public:
+    TilePlans(int nx, int ny) : nx_(nx), ny_(ny)
+    {
+        RealBuffer real = real_buffer(size_t(nx) * ny);
+        SpectrumBuffer spectrum = spectrum_buffer(spectrum_size());
+        std::lock_guard<std::mutex> lock(fftw_planner());
+        forward_ = fftw_plan_dft_r2c_2d(ny, nx, real.get(), spectrum.get(), FFTW_ESTIMATE);
+        inverse_ = fftw_plan_dft_c2r_2d(ny, nx, spectrum.get(), real.get(), FFTW_ESTIMATE);
+    }
+    ~TilePlans()
+    {
+        std::lock_guard<std::mutex> lock(fftw_planner());
+        fftw_destroy_plan(forward_);
+        fftw_destroy_plan(inverse_);
+    }
+    TilePlans(const TilePlans&) = delete;
+    TilePlans& operator=(const TilePlans&) = delete;
+
+    size_t spectrum_size() const { return size_t(ny_) * (nx_ / 2 + 1); }
+    void forward(double* real, fftw_complex* spectrum) const { fftw_execute_dft_r2c(forward_, real, spectrum); }
+    // Destroys `spectrum`.
+    void inverse(fftw_complex* spectrum, double* real) const { fftw_execute_dft_c2r(inverse_, spectrum, real); }
+
+private:
+    int nx_, ny_;
+    fftw_plan forward_ = nullptr, inverse_ = nullptr;
+};
+
+// The spectrum of `kernel` laid out for a circular convolution of size nx x ny, divided by nx ny
+// (FFTW's transforms are unnormalised). The sum's row offset dy is a correlation (the source row
+// j + dy), so the kernel's rows are mirrored: convolving with w(dx, -dy).
+SpectrumBuffer kernel_spectrum(const AiryKernel& kernel, int nx, int ny, const TilePlans& plans)
+{
+    RealBuffer real = real_buffer(size_t(nx) * ny);
+    std::fill(real.get(), real.get() + size_t(nx) * ny, 0.0);
+    const double norm = 1.0 / (double(nx) * ny);
+    for (int dy = -kernel.ky; dy <= kernel.ky; ++dy)
+        for (int dx = -kernel.kx; dx <= kernel.kx; ++dx)
+            real.get()[size_t((-dy + ny) % ny) * nx + size_t((dx + nx) % nx)] = kernel.at(dx, dy) * norm;
+    SpectrumBuffer spectrum = spectrum_buffer(plans.spectrum_size());
+    plans.forward(real.get(), spectrum.get());
+    return spectrum;
+}
+
+} // namespace
+
 bool convolve_channels(std::vector<float>& picture, int W, int H, int channels, const AiryKernel* kernels,
                        const std::function<bool()>& cancelled, int threads)
 {
-    const std::vector<float> source(picture);
-    std::atomic<int> next_row(0);
-    std::atomic<bool> stop(false);
-    auto work = [&]() {
-        for (int j = next_row++; j < H && !stop; j = next_row++) {
-            if (cancelled && cancelled()) {
-                stop = true;
-                return;
-            }
-            for (int c = 0; c < channels; ++c) {
-                const AiryKernel& k = kernels[c];
-                const int w = 2 * k.kx + 1;
-                for (int i = 0; i < W; ++i) {
-                    double sum = 0;
-                    for (int dy = std::max(-k.ky, -j); dy <= std::min(k.ky, H - 1 - j); ++dy) {
-                        const float* row = &source[(size_t(j + dy) * W) * channels + c];
-                        const double* weights = &k.weights[size_t((dy + k.ky) * w + k.kx)];
-                        // The source pixel i - dx sends light to i through weight(dx).
-                        for (int dx = std::max(-k.kx, i - (W - 1)); dx <= std::min(k.kx, i); ++dx)
-                            sum += weights[dx] * row[size_t(i - dx) * channels];
-                    }
-                    picture[(size_t(j) * W + i) * channels + c] = float(sum);
-                }
-            }
+    if (W <= 0 || H <= 0 || channels <= 0)
+        return true;
+    // The margin every tile reads beyond its output: the widest kernel's half-width.
+    int KX = 0, KY = 0;
+    for (int c = 0; c < channels; ++c) {
+        KX = std::max(KX, kernels[c].kx);
+        KY = std::max(KY, kernels[c].ky);
+    }
+    const int nx = fast_fft_size(std::min(W, kConvolutionTile) + 2 * KX);
+    const int ny = fast_fft_size(std::min(H, kConvolutionTile) + 2 * KY);
+    const int tx = nx - 2 * KX, ty = ny - 2 * KY;  // a tile's output
+    const TilePlans plans(nx, ny);
+    std::vector<SpectrumBuffer> spectra;
+    for (int c = 0; c < channels; ++c)
+        spectra.push_back(kernel_spectrum(kernels[c], nx, ny, plans));
+
+    // The source rows a band of ty output rows from j0 reads, j0 - KY to j0 + ty + KY (black
+    // beyond the picture), and the band's output, written back once the band is done: the rows
+    // the next band reads above its own are the last 2 KY of this band's source.
+    const size_t row = size_t(W) * channels;
+    std::vector<float> source(size_t(ny) * row, 0.0f), output(size_t(ty) * row, 0.0f);
+    auto load_rows = [&](int first_local, int first_row, int count) {
+        for (int r = 0; r < count; ++r) {
+            const int j = first_row + r;
+            float* to = &source[size_t(first_local + r) * row];
+            if (j >= 0 && j < H)
+                std::copy(&picture[size_t(j) * row], &picture[size_t(j) * row] + row, to);
+            else
+                std::fill(to, to + row, 0.0f);
         }
     };
+
+    const int tiles = (W + tx - 1) / tx;
+    const int tasks = tiles * channels;
     const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
-    const int count = std::max(1, std::min(threads > 0 ? threads : int(hardware), H));
-    std::vector<std::thread> pool;
-    for (int t = 1; t < count; ++t)
-        pool.emplace_back(work);
-    work();
-    for (std::thread& t : pool)
-        t.join();
-    if (stop) {
-        picture = source;
-        return false;
+    const int count = std::max(1, std::min(threads > 0 ? threads : int(hardware), tasks));
+    // Each thread's own transform buffers.
+    struct Scratch {
+        RealBuffer real;
+        SpectrumBuffer spectrum;
+    };
+    std::vector<Scratch> scratch;
+    for (int t = 0; t < count; ++t)
+        scratch.push_back(Scratch{real_buffer(size_t(nx) * ny), spectrum_buffer(plans.spectrum_size())});
+
+    auto convolve_tile = [&](int task, Scratch& s) {
+        const int tile = task / channels, c = task % channels;
+        const int i0 = tile * tx;
+        double* real = s.real.get();
+        for (int y = 0; y < ny; ++y)
+            for (int x = 0; x < nx; ++x) {
+                const int i = i0 - KX + x;
+                real[size_t(y) * nx + x] = (i >= 0 && i < W) ? double(source[size_t(y) * row + size_t(i) * channels + c]) : 0.0;
+            }
+        plans.forward(real, s.spectrum.get());
+        const fftw_complex* k = spectra[size_t(c)].get();
+        fftw_complex* f = s.spectrum.get();
+        for (size_t n = 0; n < plans.spectrum_size(); ++n) {
+            const double re = f[n][0] * k[n][0] - f[n][1] * k[n][1];
+            const double im = f[n][0] * k[n][1] + f[n][1] * k[n][0];
+            f[n][0] = re;
+            f[n][1] = im;
+        }
+        plans.inverse(f, real);
+        const int width = std::min(tx, W - i0);
+        for (int r = 0; r < ty; ++r)
+            for (int q = 0; q < width; ++q)
+                // Light is never negative: what the transforms' rounding leaves below 0 is 0.
+                output[size_t(r) * row + size_t(i0 + q) * channels + c] =
+                    float(std::max(0.0, real[size_t(r + KY) * nx + size_t(q + KX)]));
+    };
+
+    for (int j0 = 0; j0 < H; j0 += ty) {
+        if (j0 == 0) {
+            load_rows(0, -KY, ny);
+        } else {
+            std::copy(&source[size_t(ty) * row], &source[size_t(ny) * row], &source[0]);
+            load_rows(2 * KY, j0 + KY, ty);
+        }
+        std::atomic<int> next(0);
+        std::atomic<bool> stop(false);
+        auto work = [&](Scratch& s) {
+            for (int task = next++; task < tasks && !stop; task = next++)
+                convolve_tile(task, s);
+        };
+        std::vector<std::thread> pool;
+        for (int t = 1; t < count; ++t)
+            pool.emplace_back(work, std::ref(scratch[size_t(t)]));
+        // The calling thread works too, and looks at `cancelled` between its tiles.
+        for (int task = next++; task < tasks && !stop; task = next++) {
+            if (cancelled && cancelled()) {
+                stop = true;
+                break;
+            }
+            convolve_tile(task, scratch[0]);
+        }
+        for (std::thread& t : pool)
+            t.join();
+        if (stop)
+            return false;
+        const int rows = std::min(ty, H - j0);
+        std::copy(&output[0], &output[0] + size_t(rows) * row, &picture[size_t(j0) * row]);
     }
     return true;
 }

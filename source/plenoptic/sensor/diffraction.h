@@ -68,11 +68,20 @@ struct AiryKernel {
 AiryKernel airy_kernel(double rx_px, double ry_px);
 
 // Convolves channel c of the interleaved W x H x `channels` picture with `kernels[c]` (outside
-// the picture counts as black: light from beyond its edge is not known). Rows are shared among
-// `threads` threads (0: every hardware thread); the result does not depend on their number.
-// Returns false, the picture unchanged, when `cancelled` says so.
+// the picture counts as black: light from beyond its edge is not known), in place: out(i, j) =
+// sum over the window of weight(dx, dy) x picture(i - dx, j + dy). The convolution is done by
+// FFTW's discrete Fourier transforms in double precision, tile by tile (tiles of a few hundred
+// pixels with a margin of the kernel's half-width, bands of one tile's height): the result is the
+// direct sum's within float rounding, negative rounding noise set to 0, and the memory beyond
+// the picture is two bands, not a copy of it. Tiles are shared among `threads` threads (0: every
+// hardware thread); the result does not depend on their number. Returns false when `cancelled`
+// says so; the picture is then partly convolved and must be discarded.
 bool convolve_channels(std::vector<float>& picture, int W, int H, int channels, const AiryKernel* kernels,
                        const std::function<bool()>& cancelled, int threads = 0);
+
+// The output tile's side the convolution aims at (pixels; the transforms are this plus twice the
+// kernel's half-width, rounded up to a size with factors 2, 3, 5 and 7 only).
+const int kConvolutionTile = 448;
 
 // The kernels of the model's three channels for its pixel size.
 std::vector<AiryKernel> channel_kernels(const PlenopticCamera& model, const Diffraction& diffraction);
