@@ -2,7 +2,9 @@
 // The white images output (`white_image`): the camera alone in front of a white diffuser
 // (sensor/white_image.h), at its own aperture (<image>.white.png) or at each f-number asked for
 // (<image>.white.f<N>.png); with the camera's diffraction; through the read-out when there is one
-// (each its own frame of noise), unless noise_free. Listed in the metadata, written or not.
+// (each its own frame of noise), unless noise_free. Listed in the metadata, written or not. Taken
+// from the white images' cache when PLENOPTIC_WHITE_IMAGE_CACHE names one and it holds this
+// camera's (white_image_cache.h), and stored there when computed.
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +17,7 @@
 #include "povray_glue/outputs/files.h"
 #include "povray_glue/outputs/raw_png.h"
 #include "povray_glue/outputs/render.h"
+#include "povray_glue/outputs/white_image_cache.h"
 
 namespace plenoptic {
 
@@ -69,7 +72,7 @@ bool white_png(const PlenopticCamera& optics, const std::vector<float>& values, 
 
 class WhiteImagesOutput : public Output {
 public:
-    explicit WhiteImagesOutput(const Render& render) : render_(render) {}
+    explicit WhiteImagesOutput(const Render& render) : render_(render), cache_(WhiteImageCache::from_environment()) {}
 
     bool write(const WrittenImage& image, SidecarFiles& files) override
     {
@@ -87,15 +90,32 @@ public:
             if (!own)
                 other.reset(new PlenopticCamera(camera_at_f_number(model, f_number)));
             const PlenopticCamera& optics = own ? model : *other;
-            const std::vector<float> values = white_image(optics, image.cancelled);
-            if (values.empty())
-                break;  // cancelled
             const bool raw = params.sensor.chain.given && !white.noise_free;
+            const std::string path = image.beside(white_image_suffix(white, k));
             std::string png;
             double scale = 1;
-            if (!white_png(optics, values, params, raw, k, image.cancelled, png, scale))
-                break;  // cancelled
-            const std::string path = image.beside(white_image_suffix(white, k));
+            const std::string description =
+                cache_.enabled() ? white_image_description(optics, params, f_number, k, raw, cache_.executable()) : "";
+            CachedWhiteImage cached;
+            if (cache_.enabled() && cache_.find(description, &cached)) {
+                std::fprintf(stderr, "plenoptic camera: white image %s: the cached one, %s\n", base_name(path).c_str(),
+                             cache_.png_path(description).c_str());
+                png = cached.png;
+                scale = cached.scale;
+            } else {
+                const std::vector<float> values = white_image(optics, image.cancelled);
+                if (values.empty())
+                    break;  // cancelled
+                if (!white_png(optics, values, params, raw, k, image.cancelled, png, scale))
+                    break;  // cancelled
+                if (cache_.enabled() && !png.empty()) {
+                    cached.png = png;
+                    cached.scale = scale;
+                    if (cache_.store(description, cached))
+                        std::fprintf(stderr, "plenoptic camera: white image %s: computed, and cached as %s\n",
+                                     base_name(path).c_str(), cache_.png_path(description).c_str());
+                }
+            }
             if (!png.empty() && write_file_atomically("white image", path, png)) {
                 WhiteImageFile file;
                 file.file = base_name(path);
@@ -114,6 +134,7 @@ public:
 
 private:
     const Render& render_;
+    const WhiteImageCache cache_;  // PLENOPTIC_WHITE_IMAGE_CACHE's folder, or disabled
     std::vector<WhiteImageFile> written_;  // what the metadata lists
 };
 
