@@ -28,19 +28,17 @@ public:
     int width() const override { return int(image_.GetWidth()); }
     int height() const override { return int(image_.GetHeight()); }
 
-    std::vector<float> linear_rgb() const override
+    void read_rows(int first, int count, float* rgb) const override
     {
-        const int W = width(), H = height();
-        std::vector<float> linear(size_t(W) * H * 3);
-        for (int j = 0; j < H; ++j)
+        const int W = width();
+        for (int r = 0; r < count; ++r)
             for (int i = 0; i < W; ++i) {
-                float* rgb = &linear[(size_t(j) * W + i) * 3];
-                image_.GetRGBValue(unsigned(i), unsigned(j), rgb[0], rgb[1], rgb[2]);
+                float* pixel = rgb + (size_t(r) * W + i) * 3;
+                image_.GetRGBValue(unsigned(i), unsigned(first + r), pixel[0], pixel[1], pixel[2]);
                 if (working_gamma_ != nullptr)
                     for (int c = 0; c < 3; ++c)
-                        rgb[c] = working_gamma_->Decode(rgb[c]);
+                        pixel[c] = working_gamma_->Decode(pixel[c]);
             }
-        return linear;
     }
 
 private:
@@ -56,22 +54,23 @@ public:
 
     int width() const override { return reader_.width(); }
     int height() const override { return reader_.height(); }
-    std::vector<float> linear_rgb() const override { return reader_.linear_rgb(); }
+    void read_rows(int first, int count, float* rgb) const override { reader_.read_rows(first, count, rgb); }
 
-    void set_linear_rgb(const std::vector<float>& rgb) override
+    void write_rows(int first, int count, const float* rgb) override
     {
-        const int W = width(), H = height();
-        for (int j = 0; j < H; ++j)
+        const int W = width();
+        for (int r = 0; r < count; ++r)
             for (int i = 0; i < W; ++i) {
-                float r, g, b, f, t;
-                image_.GetRGBFTValue(unsigned(i), unsigned(j), r, g, b, f, t);
+                const unsigned x = unsigned(i), y = unsigned(first + r);
+                float red, green, blue, f, t;
+                image_.GetRGBFTValue(x, y, red, green, blue, f, t);
                 float value[3];
                 for (int c = 0; c < 3; ++c) {
-                    value[c] = rgb[(size_t(j) * W + i) * 3 + c];
+                    value[c] = rgb[(size_t(r) * W + i) * 3 + c];
                     if (working_gamma_ != nullptr)
                         value[c] = working_gamma_->Encode(value[c]);
                 }
-                image_.SetRGBFTValue(unsigned(i), unsigned(j), value[0], value[1], value[2], f, t);
+                image_.SetRGBFTValue(x, y, value[0], value[1], value[2], f, t);
             }
     }
 

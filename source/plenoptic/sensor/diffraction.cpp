@@ -229,6 +229,23 @@ SpectrumBuffer kernel_spectrum(const AiryKernel& kernel, int nx, int ny, const T
 bool convolve_channels(std::vector<float>& picture, int W, int H, int channels, const AiryKernel* kernels,
                        const std::function<bool()>& cancelled, int threads)
 {
+    const size_t row = size_t(std::max(0, W)) * std::max(0, channels);
+    return convolve_rows(
+        W, H, channels, kernels,
+        [&](int first, int count, float* to) {
+            std::copy(picture.data() + size_t(first) * row, picture.data() + size_t(first + count) * row, to);
+            return true;
+        },
+        [&](int first, int count, const float* from) {
+            std::copy(from, from + size_t(count) * row, picture.data() + size_t(first) * row);
+            return true;
+        },
+        cancelled, threads);
+}
+
+bool convolve_rows(int W, int H, int channels, const AiryKernel* kernels, const RowReader& read, const RowWriter& write,
+                   const std::function<bool()>& cancelled, int threads)
+{
     if (W <= 0 || H <= 0 || channels <= 0)
         return true;
     // The margin every tile reads beyond its output: the widest kernel's half-width.
@@ -250,15 +267,13 @@ bool convolve_channels(std::vector<float>& picture, int W, int H, int channels, 
     // the next band reads above its own are the last 2 KY of this band's source.
     const size_t row = size_t(W) * channels;
     std::vector<float> source(size_t(ny) * row, 0.0f), output(size_t(ty) * row, 0.0f);
+    // Rows first_row .. first_row + count - 1 into the source from its row first_local: the
+    // picture's through `read` (each once, from the top down), black beyond it.
     auto load_rows = [&](int first_local, int first_row, int count) {
-        for (int r = 0; r < count; ++r) {
-            const int j = first_row + r;
-            float* to = &source[size_t(first_local + r) * row];
-            if (j >= 0 && j < H)
-                std::copy(&picture[size_t(j) * row], &picture[size_t(j) * row] + row, to);
-            else
-                std::fill(to, to + row, 0.0f);
-        }
+        const int lo = std::max(0, first_row), hi = std::min(H, first_row + count);
+        float* to = &source[size_t(first_local) * row];
+        std::fill(to, to + size_t(count) * row, 0.0f);
+        return hi <= lo || read(lo, hi - lo, to + size_t(lo - first_row) * row);
     };
 
     const int tiles = (W + tx - 1) / tx;
@@ -303,10 +318,12 @@ bool convolve_channels(std::vector<float>& picture, int W, int H, int channels, 
 
     for (int j0 = 0; j0 < H; j0 += ty) {
         if (j0 == 0) {
-            load_rows(0, -KY, ny);
+            if (!load_rows(0, -KY, ny))
+                return false;
         } else {
             std::copy(&source[size_t(ty) * row], &source[size_t(ny) * row], &source[0]);
-            load_rows(2 * KY, j0 + KY, ty);
+            if (!load_rows(2 * KY, j0 + KY, ty))
+                return false;
         }
         std::atomic<int> next(0);
         std::atomic<bool> stop(false);
@@ -329,8 +346,8 @@ bool convolve_channels(std::vector<float>& picture, int W, int H, int channels, 
             t.join();
         if (stop)
             return false;
-        const int rows = std::min(ty, H - j0);
-        std::copy(&output[0], &output[0] + size_t(rows) * row, &picture[size_t(j0) * row]);
+        if (!write(j0, std::min(ty, H - j0), output.data()))
+            return false;
     }
     return true;
 }

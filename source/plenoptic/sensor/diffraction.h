@@ -79,6 +79,18 @@ AiryKernel airy_kernel(double rx_px, double ry_px);
 bool convolve_channels(std::vector<float>& picture, int W, int H, int channels, const AiryKernel* kernels,
                        const std::function<bool()>& cancelled, int threads = 0);
 
+// The same convolution with the picture's rows read and written through callbacks, so that the
+// picture need not be in memory as a whole (memory: two bands of a tile's height and the
+// kernel's margin). read(first, count, to) puts rows first .. first + count - 1 (W `channels`
+// values each) at `to`; every row is read once, from the top down. write(first, count, from)
+// takes the convolved rows, from the top down, each row after every row it depends on has been
+// read (so the picture may be convolved in place). Either returning false stops the convolution
+// (false is returned; what was written is partly convolved).
+typedef std::function<bool(int first, int count, float* to)> RowReader;
+typedef std::function<bool(int first, int count, const float* from)> RowWriter;
+bool convolve_rows(int W, int H, int channels, const AiryKernel* kernels, const RowReader& read, const RowWriter& write,
+                   const std::function<bool()>& cancelled, int threads = 0);
+
 // The output tile's side the convolution aims at (pixels; the transforms are this plus twice the
 // kernel's half-width, rounded up to a size with factors 2, 3, 5 and 7 only).
 const int kConvolutionTile = 448;

@@ -3,7 +3,9 @@
 // first dark ring, and the encircled energy 1 - J0(x)^2 - J1(x)^2, Rayleigh's result), the Airy
 // radius of a Lytro-class camera written out from 1.22 lambda N, and the convolution's bookkeeping.
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <limits>
@@ -254,6 +256,64 @@ TEST(Diffraction, ConvolutionByTilesEqualsTheDirectSumWithinFloatRounding)
     for (size_t n = 0; n < want.size(); ++n)
         equal += one[n] == want[n];
     std::printf("convolution by tiles: %zu of %zu values equal to the direct sum's float\n", equal, want.size());
+}
+
+TEST(Diffraction, ConvolutionByRowsReadsEachRowOnceAndWritesOnlyWhatItHasRead)
+{
+    // The picture streamed through the callbacks, never held by the convolution: each source row
+    // read once from the top down, each output row written once from the top down and only after
+    // every row its kernel reaches has been read (so it may be written in place), and the result
+    // the direct sum's within float rounding, in a separate buffer.
+    const int W = kConvolutionTile + 31, H = 2 * kConvolutionTile + 75, channels = 3;
+    const AiryKernel kernels[3] = {airy_kernel(2.2, 2.2), airy_kernel(1.4, 0.9), airy_kernel(0.6, 0.6)};
+    const int KY = kernels[0].ky;
+    const std::vector<float> picture = test_picture(W, H, channels);
+    const std::vector<float> want = direct_convolution(picture, W, H, channels, kernels);
+    const size_t row = size_t(W) * channels;
+    std::vector<float> got(picture.size(), -1.0f);
+    int next_read = 0, next_write = 0, reads = 0, writes = 0;
+    const RowReader read = [&](int first, int count, float* to) {
+        EXPECT_EQ(first, next_read);
+        EXPECT_GT(count, 0);
+        EXPECT_LE(first + count, H);
+        next_read = first + count;
+        ++reads;
+        std::copy(picture.begin() + ptrdiff_t(first * row), picture.begin() + ptrdiff_t((first + count) * row), to);
+        return true;
+    };
+    const RowWriter write = [&](int first, int count, const float* from) {
+        EXPECT_EQ(first, next_write);
+        EXPECT_GE(next_read, std::min(H, first + count + KY)) << "rows " << first << " + " << count << " written before read";
+        next_write = first + count;
+        ++writes;
+        std::copy(from, from + size_t(count) * row, got.begin() + ptrdiff_t(first * row));
+        return true;
+    };
+    ASSERT_TRUE(convolve_rows(W, H, channels, kernels, read, write, nullptr, 2));
+    EXPECT_EQ(next_read, H);
+    EXPECT_EQ(next_write, H);
+    EXPECT_GE(writes, 3);  // several bands
+    // Against the direct sum: within float rounding of the values (the transforms also leave
+    // noise of order 1e-17 where the direct sum is exactly 0 beside a 1e5 spot of the tile).
+    double largest = 0, worst = 0;
+    for (size_t n = 0; n < want.size(); ++n) {
+        largest = std::max(largest, double(picture[n]));
+        worst = std::max(worst, std::fabs(double(got[n]) - want[n]) / std::max(1.0, double(want[n])));
+    }
+    EXPECT_LT(worst, 8 * std::numeric_limits<float>::epsilon()) << "largest value " << largest;
+    std::vector<float> in_place = picture;
+    ASSERT_TRUE(convolve_channels(in_place, W, H, channels, kernels, nullptr, 1));
+    EXPECT_EQ(in_place, got);
+
+    // A reader or a writer that stops the convolution stops it.
+    int calls = 0;
+    const RowWriter refuse = [&](int, int, const float*) { return ++calls > 1 ? false : true; };
+    next_read = 0;
+    EXPECT_FALSE(convolve_rows(W, H, channels, kernels, read, refuse, nullptr, 2));
+    EXPECT_EQ(calls, 2);
+    const RowReader fail = [&](int, int, float*) { return false; };
+    EXPECT_FALSE(convolve_rows(W, H, channels, kernels, fail, write, nullptr, 2));
+    std::printf("convolution by rows: %d reads, %d writes of bands\n", reads, writes);
 }
 
 TEST(Diffraction, ConvolutionWithTheWidestKernelAcceptedEqualsTheDirectSum)

@@ -6,8 +6,11 @@
 #include "plenoptic/sensor/sensor_chain.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
+#include <thread>
+#include <vector>
 
 #include <boost/random/normal_distribution.hpp>
 #include <boost/random/poisson_distribution.hpp>
@@ -161,23 +164,46 @@ std::uint16_t sensor_dn(const SensorChainParams& c, double value, std::uint64_t 
     return std::uint16_t(std::min(maximum_dn, std::max(0.0, dn)));
 }
 
+void sensor_raw_rows(const SensorChainParams& c, const float* linear, int W, int first_row, int rows, std::uint16_t* raw,
+                     int threads)
+{
+    const bool mosaic = c.bayer != BayerPattern::None;
+    auto read_row = [&](int r) {
+        const int j = first_row + r;
+        const float* from = linear + size_t(r) * W * 3;
+        std::uint16_t* to = raw + size_t(r) * W * (mosaic ? 1 : 3);
+        for (int i = 0; i < W; ++i) {
+            const std::uint64_t pixel = std::uint64_t(j) * W + i;
+            const float* rgb = from + size_t(i) * 3;
+            if (mosaic) {
+                const int ch = bayer_channel(c.bayer, i, j);
+                to[i] = sensor_dn(c, rgb[ch], pixel, ch);
+            } else {
+                for (int ch = 0; ch < 3; ++ch)
+                    to[size_t(i) * 3 + ch] = sensor_dn(c, rgb[ch], pixel, ch);
+            }
+        }
+    };
+    std::atomic<int> next(0);
+    auto work = [&]() {
+        for (int r = next++; r < rows; r = next++)
+            read_row(r);
+    };
+    const int count = std::min(rows, threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency())));
+    std::vector<std::thread> workers;
+    for (int t = 1; t < count; ++t)
+        workers.emplace_back(work);
+    work();
+    for (std::thread& worker : workers)
+        worker.join();
+}
+
 std::vector<std::uint16_t> sensor_raw(const SensorChainParams& c, const std::vector<float>& linear, int W, int H)
 {
     const bool mosaic = c.bayer != BayerPattern::None;
     std::vector<std::uint16_t> raw(size_t(W) * H * (mosaic ? 1 : 3));
-    for (int j = 0; j < H; ++j) {
-        for (int i = 0; i < W; ++i) {
-            const std::uint64_t pixel = std::uint64_t(j) * W + i;
-            const float* rgb = &linear[pixel * 3];
-            if (mosaic) {
-                const int ch = bayer_channel(c.bayer, i, j);
-                raw[pixel] = sensor_dn(c, rgb[ch], pixel, ch);
-            } else {
-                for (int ch = 0; ch < 3; ++ch)
-                    raw[pixel * 3 + ch] = sensor_dn(c, rgb[ch], pixel, ch);
-            }
-        }
-    }
+    if (W > 0 && H > 0)
+        sensor_raw_rows(c, linear.data(), W, 0, H, raw.data());
     return raw;
 }
 

@@ -84,6 +84,12 @@ std::uint16_t sensor_dn(const SensorChainParams& chain, double value, std::uint6
 // mosaic) with a Bayer pattern, else W H 3 (every channel read out at every pixel).
 std::vector<std::uint16_t> sensor_raw(const SensorChainParams& chain, const std::vector<float>& linear, int W, int H);
 
+// The same for `rows` rows of the picture from row `first_row` (`linear`: rows W 3 values; `raw`:
+// room for rows W values with a Bayer pattern, else rows W 3): the raw's values for those rows,
+// equal to sensor_raw's. Rows are shared among `threads` threads (0: every hardware thread).
+void sensor_raw_rows(const SensorChainParams& chain, const float* linear, int W, int first_row, int rows, std::uint16_t* raw,
+                     int threads = 0);
+
 } // namespace plenoptic
 
 #endif

@@ -190,6 +190,40 @@ TEST(SensorChain, MosaicHasOneValueAPixel)
             EXPECT_EQ(raw[size_t(j) * 4 + i] > 0, j == 0 && i % 2 == 1) << i << "," << j;
 }
 
+TEST(SensorChain, RowsReadOutBandByBandAreEachSitesOwnValue)
+{
+    // A band of rows read out on its own, on any number of threads, gives every site the value the
+    // site's own read-out gives (sensor_dn with the pixel's index in the whole picture), with and
+    // without a mosaic: the raw may be made band by band.
+    SensorChainParams c = unit_gain();
+    c.read_noise_e = 3;
+    c.prnu = 0.01;
+    const int W = 37, first = 9, rows = 7;  // rows 9 to 15 of a larger picture
+    std::vector<float> band(size_t(rows) * W * 3);
+    for (size_t k = 0; k < band.size(); ++k)
+        band[k] = float((k * 7919) % 1000) / 1000.0f;
+    for (BayerPattern pattern : {BayerPattern::None, BayerPattern::GRBG}) {
+        c.bayer = pattern;
+        const size_t per_pixel = pattern == BayerPattern::None ? 3 : 1;
+        for (int threads : {1, 3}) {
+            std::vector<std::uint16_t> raw(size_t(rows) * W * per_pixel, 0xffff);
+            sensor_raw_rows(c, band.data(), W, first, rows, raw.data(), threads);
+            for (int r = 0; r < rows; ++r)
+                for (int i = 0; i < W; ++i) {
+                    const std::uint64_t pixel = std::uint64_t(first + r) * W + i;
+                    const float* rgb = &band[(size_t(r) * W + i) * 3];
+                    if (pattern == BayerPattern::None) {
+                        for (int ch = 0; ch < 3; ++ch)
+                            ASSERT_EQ(raw[(size_t(r) * W + i) * 3 + ch], sensor_dn(c, rgb[ch], pixel, ch));
+                    } else {
+                        const int ch = bayer_channel(pattern, i, first + r);
+                        ASSERT_EQ(raw[size_t(r) * W + i], sensor_dn(c, rgb[ch], pixel, ch)) << i << "," << r;
+                    }
+                }
+        }
+    }
+}
+
 TEST(SensorChain, RefusesWhatNoSensorHas)
 {
     EXPECT_NE(check_bit_depth("bit_depth", 17), "");

@@ -53,37 +53,44 @@ std::string repeated_white_f_number(const WhiteImageRequest& request)
     return "";
 }
 
-std::vector<float> white_image(const PlenopticCamera& model, const std::function<bool()>& cancelled, int threads)
+bool white_image_rows(const PlenopticCamera& model, int first_row, int rows, float* out, const std::function<bool()>& cancelled,
+                      int threads)
 {
-    const int W = model.sensor.film.width, H = model.sensor.film.height;
-    std::vector<float> out(size_t(std::max(0, W)) * std::max(0, H), 0.0f);
+    const int W = model.sensor.film.width;
     std::atomic<int> next_row(0);
     std::atomic<bool> stop(false);
-    auto shade_row = [&](int j) {
+    auto shade_row = [&](int r) {
         for (int i = 0; i < W; ++i)
-            out[size_t(j) * W + i] =
-                float(shade_pixel(model, i, j, [](const OpticsRay&) { return Rgbt{1, 1, 1, 1}; }).r);
+            out[size_t(r) * W + i] =
+                float(shade_pixel(model, i, first_row + r, [](const OpticsRay&) { return Rgbt{1, 1, 1, 1}; }).r);
     };
     auto work = [&]() {
-        for (int j = next_row++; j < H && !stop; j = next_row++)
-            shade_row(j);
+        for (int r = next_row++; r < rows && !stop; r = next_row++)
+            shade_row(r);
     };
     const unsigned hardware = std::thread::hardware_concurrency();
     const int count = threads > 0 ? threads : int(std::max(1u, hardware));
     std::vector<std::thread> workers;
-    for (int t = 1; t < count && t < H; ++t)
+    for (int t = 1; t < count && t < rows; ++t)
         workers.push_back(std::thread(work));
     // The calling thread works too, and looks at `cancelled` between rows.
-    for (int j = next_row++; j < H && !stop; j = next_row++) {
+    for (int r = next_row++; r < rows && !stop; r = next_row++) {
         if (cancelled && cancelled()) {
             stop = true;
             break;
         }
-        shade_row(j);
+        shade_row(r);
     }
     for (std::thread& worker : workers)
         worker.join();
-    if (stop)
+    return !stop;
+}
+
+std::vector<float> white_image(const PlenopticCamera& model, const std::function<bool()>& cancelled, int threads)
+{
+    const int W = model.sensor.film.width, H = model.sensor.film.height;
+    std::vector<float> out(size_t(std::max(0, W)) * std::max(0, H), 0.0f);
+    if (W > 0 && H > 0 && !white_image_rows(model, 0, H, out.data(), cancelled, threads))
         out.clear();
     return out;
 }

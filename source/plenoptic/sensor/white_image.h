@@ -43,6 +43,11 @@ std::string repeated_white_f_number(const WhiteImageRequest& request);
 // result does not depend on their number. Returns an empty vector when `cancelled` says so.
 std::vector<float> white_image(const PlenopticCamera& model, const std::function<bool()>& cancelled, int threads = 0);
 
+// Rows first_row .. first_row + rows - 1 of the same white image into `out` (rows W values), equal
+// to white_image's; false (the rows unfinished) when `cancelled` says so.
+bool white_image_rows(const PlenopticCamera& model, int first_row, int rows, float* out, const std::function<bool()>& cancelled,
+                      int threads = 0);
+
 // What replaces the image's extension for f-number index k of a request: ".white.png" for the
 // camera's own aperture, ".white.f<N>.png" for f_numbers (N shortest: f2, f5.6).
 std::string white_image_suffix(const WhiteImageRequest& request, int k);

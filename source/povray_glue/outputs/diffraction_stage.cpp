@@ -1,8 +1,7 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// Diffraction as a stage of the outputs: before the image is written, the picture as a whole is
-// convolved with the camera's Airy patterns (sensor/diffraction.h), in linear light, so the
-// image, its raw and everything read from it carry it. Wanted when the camera's diffraction is
-// applied.
+// Diffraction as a stage of the outputs: before the image is written, the picture is convolved
+// with the camera's Airy patterns (sensor/diffraction.h), in linear light, so the image, its raw
+// and everything read from it carry it. Wanted when the camera's diffraction is applied.
 
 #include <cstdio>
 
@@ -30,17 +29,25 @@ public:
                                  "before was diffracted already; render the image again without +C. No image written.\n");
             return false;
         }
-        std::vector<float> linear = picture.linear_rgb();
         const std::vector<AiryKernel> kernels = channel_kernels(render_.model(), diffraction_);
         if (size_t(W) * H >= 4000000)
             std::fprintf(stderr, "plenoptic camera: diffraction: convolving %d x %d pixels with Airy kernels of %d x %d "
                                  "pixels (red)\n", W, H, 2 * kernels[0].kx + 1, 2 * kernels[0].ky + 1);
-        if (!convolve_channels(linear, W, H, 3, kernels.data(), cancelled)) {
+        // In place, band by band: the picture's rows are read and written back as the convolution
+        // goes (sensor/diffraction.h), never copied as a whole.
+        const RowReader read = [&](int first, int count, float* to) {
+            picture.read_rows(first, count, to);
+            return true;
+        };
+        const RowWriter write = [&](int first, int count, const float* from) {
+            picture.write_rows(first, count, from);
+            return true;
+        };
+        if (!convolve_rows(W, H, 3, kernels.data(), read, write, cancelled)) {
             std::fprintf(stderr, "plenoptic camera: cancelled while applying diffraction: the image is not written "
                                  "(it would not be what the camera records).\n");
             return false;
         }
-        picture.set_linear_rgb(linear);
         return true;
     }
 

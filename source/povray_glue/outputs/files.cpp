@@ -74,6 +74,13 @@ namespace {
 // `path`; on failure reports and removes the temporary file.
 bool write_through_temporary(const char* what, const std::string& path, const std::function<bool(FILE*)>& write)
 {
+    return write_file_streamed(what, path, [&](FILE* f) { return write(f) ? Fill::Complete : Fill::Failed; });
+}
+
+} // namespace
+
+bool write_file_streamed(const char* what, const std::string& path, const std::function<Fill(std::FILE* file)>& fill)
+{
     const std::string tmp = temporary_beside(path);
     if (tmp.empty()) {
         report_failure(what, path, errno);
@@ -85,16 +92,19 @@ bool write_through_temporary(const char* what, const std::string& path, const st
         std::remove(tmp.c_str());
         return false;
     }
-    const bool ok = write(f);
-    if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const Fill filled = fill(f);
+    const bool closed = std::fclose(f) == 0;
+    if (filled == Fill::Abandoned) {
+        std::remove(tmp.c_str());
+        return false;
+    }
+    if (!closed || filled != Fill::Complete || std::rename(tmp.c_str(), path.c_str()) != 0) {
         report_failure(what, path, errno);
         std::remove(tmp.c_str());
         return false;
     }
     return true;
 }
-
-} // namespace
 
 bool write_file_atomically(const char* what, const std::string& path, const std::string& bytes)
 {

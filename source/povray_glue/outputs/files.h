@@ -6,6 +6,7 @@
 #ifndef POVRAY_GLUE_OUTPUTS_FILES_H
 #define POVRAY_GLUE_OUTPUTS_FILES_H
 
+#include <cstdio>
 #include <functional>
 #include <string>
 
@@ -23,6 +24,13 @@ bool write_file_atomically(const char* what, const std::string& path, const std:
 // sets the next piece and returns true, or returns false when there is none left.
 bool write_file_atomically(const char* what, const std::string& path,
                            const std::function<bool(std::string* piece)>& next);
+
+// The general form: fill(file) writes the temporary file, which becomes `path` when it returns
+// Fill::Complete. Fill::Failed reports the failure (with errno's reason); Fill::Abandoned
+// (cancelled, or a source found wanting) removes the temporary file silently. Either way
+// `path` is untouched and false is returned.
+enum class Fill { Complete, Failed, Abandoned };
+bool write_file_streamed(const char* what, const std::string& path, const std::function<Fill(std::FILE* file)>& fill);
 
 // Writes a W x H one-channel float EXR (channel `channel`) row by row (memory: one row):
 // fill(j, row) fills row j and returns false to stop (cancelled: nothing is written, no

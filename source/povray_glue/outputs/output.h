@@ -38,21 +38,31 @@ struct RenderArea {
     std::vector<PixelRect> untraced;
 };
 
-// The picture the front end writes, in linear light (its working gamma undone).
+// The picture the front end writes, in linear light (its working gamma undone), read by rows so
+// that no output needs a copy of a large picture as a whole.
 class Picture {
 public:
     virtual ~Picture() {}
     virtual int width() const = 0;
     virtual int height() const = 0;
-    // R, G, B interleaved, rows from the top.
-    virtual std::vector<float> linear_rgb() const = 0;
+    // Rows first .. first + count - 1 (from the top), R, G, B interleaved: count W 3 values at `rgb`.
+    virtual void read_rows(int first, int count, float* rgb) const = 0;
+    // The whole picture the same way (small pictures: tests).
+    std::vector<float> linear_rgb() const
+    {
+        std::vector<float> rgb(size_t(width()) * height() * 3);
+        if (!rgb.empty())
+            read_rows(0, height(), rgb.data());
+        return rgb;
+    }
 };
 
 // The picture before it is written, which a stage may change.
 class EditablePicture : public Picture {
 public:
-    // Replaces R, G and B (interleaved, linear, rows from the top); the opacity stays.
-    virtual void set_linear_rgb(const std::vector<float>& rgb) = 0;
+    // Replaces R, G and B of rows first .. first + count - 1 (interleaved, linear, count W 3
+    // values); the opacity stays.
+    virtual void write_rows(int first, int count, const float* rgb) = 0;
 };
 
 // The scene as an output sees it during the render, on the thread that traces the pixel.

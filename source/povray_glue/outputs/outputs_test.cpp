@@ -4,7 +4,9 @@
 // all-run / stop-at-refusal rules with test-only outputs, the depth map's per-pixel hook (and a
 // continued render's backfill) through a made-up scene, and the hand-over keyed by the view.
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -193,8 +195,14 @@ public:
     TestPicture(int W, int H) : W_(W), H_(H), rgb_(size_t(W) * H * 3, 0.25f) {}
     int width() const override { return W_; }
     int height() const override { return H_; }
-    std::vector<float> linear_rgb() const override { return rgb_; }
-    void set_linear_rgb(const std::vector<float>& rgb) override { rgb_ = rgb; }
+    void read_rows(int first, int count, float* rgb) const override
+    {
+        std::copy(rgb_.begin() + ptrdiff_t(first) * W_ * 3, rgb_.begin() + ptrdiff_t(first + count) * W_ * 3, rgb);
+    }
+    void write_rows(int first, int count, const float* rgb) override
+    {
+        std::copy(rgb, rgb + size_t(count) * W_ * 3, rgb_.begin() + ptrdiff_t(first) * W_ * 3);
+    }
 
 private:
     int W_, H_;

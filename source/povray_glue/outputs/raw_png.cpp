@@ -1,59 +1,72 @@
 // SPDX-License-Identifier: AGPL-3.0-or-later
-// The sensor's raw as a 16-bit PNG (see the header), encoded in memory with libpng.
+// 16-bit PNGs written row by row with libpng (see the header).
 
 #include "povray_glue/outputs/raw_png.h"
 
 #include <csetjmp>
 
-#include <png.h>
-
 namespace plenoptic {
 
-namespace {
+// libpng reports its errors by longjmp to the setjmp of the call that failed: each method sets
+// its own, and nothing with a destructor lives between it and libpng's calls.
 
-void append_bytes(png_structp png, png_bytep data, png_size_t length)
+PngRowWriter::PngRowWriter(std::FILE* file, int W, int H, int channels, int bit_depth)
+    : W_(W), H_(H), channels_(channels), row_(size_t(W > 0 ? W : 0) * (channels > 0 ? channels : 0) * 2)
 {
-    static_cast<std::string*>(png_get_io_ptr(png))->append(reinterpret_cast<const char*>(data), length);
-}
-
-void no_flush(png_structp) {}
-
-} // namespace
-
-std::string raw_png(const std::vector<std::uint16_t>& values, int W, int H, int channels, int bit_depth)
-{
-    if (W <= 0 || H <= 0 || (channels != 1 && channels != 3) || values.size() != size_t(W) * H * channels)
-        return "";
-    // Everything with a destructor is made before setjmp: libpng's errors longjmp back here.
-    std::string bytes;
-    std::vector<png_byte> row(size_t(W) * channels * 2);
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-    if (png == nullptr)
-        return "";
-    png_infop info = png_create_info_struct(png);
-    if (info == nullptr || setjmp(png_jmpbuf(png))) {
-        png_destroy_write_struct(&png, info != nullptr ? &info : nullptr);
-        return "";
+    if (file == nullptr || W <= 0 || H <= 0 || (channels != 1 && channels != 3)) {
+        failed_ = true;
+        return;
     }
-    png_set_write_fn(png, &bytes, append_bytes, no_flush);
-    png_set_IHDR(png, info, png_uint_32(W), png_uint_32(H), 16, channels == 1 ? PNG_COLOR_TYPE_GRAY : PNG_COLOR_TYPE_RGB,
+    png_ = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    if (png_ != nullptr)
+        info_ = png_create_info_struct(png_);
+    if (png_ == nullptr || info_ == nullptr || setjmp(png_jmpbuf(png_))) {
+        failed_ = true;
+        return;
+    }
+    png_init_io(png_, file);
+    png_set_IHDR(png_, info_, png_uint_32(W), png_uint_32(H), 16, channels == 1 ? PNG_COLOR_TYPE_GRAY : PNG_COLOR_TYPE_RGB,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_color_8 significant;
     significant.red = significant.green = significant.blue = significant.gray = png_byte(bit_depth);
     significant.alpha = 0;
-    png_set_sBIT(png, info, &significant);
-    png_write_info(png, info);
-    for (int j = 0; j < H; ++j) {
-        const std::uint16_t* source = &values[size_t(j) * W * channels];
-        for (size_t k = 0; k < size_t(W) * channels; ++k) {
-            row[2 * k] = png_byte(source[k] >> 8);  // PNG is big-endian
-            row[2 * k + 1] = png_byte(source[k] & 0xff);
-        }
-        png_write_row(png, row.data());
+    png_set_sBIT(png_, info_, &significant);
+    png_write_info(png_, info_);
+}
+
+PngRowWriter::~PngRowWriter()
+{
+    if (png_ != nullptr)
+        png_destroy_write_struct(&png_, info_ != nullptr ? &info_ : nullptr);
+}
+
+bool PngRowWriter::write_row(const std::uint16_t* values)
+{
+    if (failed_ || rows_ >= H_)
+        return false;
+    for (size_t k = 0; k < size_t(W_) * channels_; ++k) {
+        row_[2 * k] = png_byte(values[k] >> 8);  // PNG is big-endian
+        row_[2 * k + 1] = png_byte(values[k] & 0xff);
     }
-    png_write_end(png, nullptr);
-    png_destroy_write_struct(&png, &info);
-    return bytes;
+    if (setjmp(png_jmpbuf(png_))) {
+        failed_ = true;
+        return false;
+    }
+    png_write_row(png_, row_.data());
+    ++rows_;
+    return true;
+}
+
+bool PngRowWriter::finish()
+{
+    if (failed_ || rows_ != H_)
+        return false;
+    if (setjmp(png_jmpbuf(png_))) {
+        failed_ = true;
+        return false;
+    }
+    png_write_end(png_, nullptr);
+    return true;
 }
 
 } // namespace plenoptic

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include <sys/stat.h>
 
@@ -63,6 +64,24 @@ bool read_file(const std::string& path, std::string* bytes)
     return bool(in) || in.eof();
 }
 
+// Copies what is left of `in` to `out`, a megabyte at a time, hashing it and counting its bytes;
+// false when a read or a write fails.
+bool copy_file(std::FILE* in, std::FILE* out, Hash128* hash, std::uint64_t* bytes)
+{
+    std::vector<char> buffer(1 << 20);
+    for (;;) {
+        const size_t n = std::fread(buffer.data(), 1, buffer.size(), in);
+        if (n > 0) {
+            hash->add(buffer.data(), n);
+            *bytes += n;
+            if (std::fwrite(buffer.data(), 1, n, out) != n)
+                return false;
+        }
+        if (n < buffer.size())
+            return !std::ferror(in);
+    }
+}
+
 } // namespace
 
 std::string white_image_description(const PlenopticCamera& optics, const CameraParams& params, double f_number, int index,
@@ -95,12 +114,22 @@ std::string white_image_key(const std::string& description)
 
 std::string executable_identity()
 {
-    std::string bytes;
-    if (!read_file("/proc/self/exe", &bytes) || bytes.empty())
+    std::FILE* exe = std::fopen("/proc/self/exe", "rb");
+    if (exe == nullptr)
         return "";
     Hash128 hash;
-    hash.add(bytes.data(), bytes.size());
-    return hash.hex() + " (" + std::to_string(bytes.size()) + " bytes)";
+    std::uint64_t bytes = 0;
+    std::vector<char> buffer(1 << 20);
+    size_t n;
+    while ((n = std::fread(buffer.data(), 1, buffer.size(), exe)) > 0) {
+        hash.add(buffer.data(), n);
+        bytes += n;
+    }
+    const bool read = !std::ferror(exe);
+    std::fclose(exe);
+    if (!read || bytes == 0)
+        return "";
+    return hash.hex() + " (" + std::to_string(bytes) + " bytes)";
 }
 
 WhiteImageCache WhiteImageCache::from_environment()
@@ -137,13 +166,13 @@ std::string WhiteImageCache::png_path(const std::string& description) const
     return folder_ + "/" + white_image_key(description) + ".png";
 }
 
-bool WhiteImageCache::find(const std::string& description, CachedWhiteImage* found) const
+bool WhiteImageCache::copy_out(const std::string& description, const std::string& path, double* scale) const
 {
     if (!enabled())
         return false;
     const std::string stem = folder_ + "/" + white_image_key(description);
-    std::string text, png;
-    if (!read_file(stem + ".json", &text) || !read_file(stem + ".png", &png))
+    std::string text;
+    if (!read_file(stem + ".json", &text))
         return false;
     const nlohmann::json entry = nlohmann::json::parse(text, nullptr, false);
     if (entry.is_discarded() || !entry.is_object())
@@ -153,26 +182,46 @@ bool WhiteImageCache::find(const std::string& description, CachedWhiteImage* fou
         return false;
     if (s == entry.end() || !s->is_number() || n == entry.end() || !n->is_number_unsigned() || h == entry.end() || !h->is_string())
         return false;
-    // The PNG is the one the entry was written with (not cut short, not another entry's).
-    if (n->get<std::uint64_t>() != png.size() || h->get<std::string>() != white_image_key(png))
+    std::FILE* in = std::fopen((stem + ".png").c_str(), "rb");
+    if (in == nullptr)
         return false;
-    found->png = png;
-    found->scale = s->get<double>();
-    return true;
+    // The PNG is the one the entry was written with (not cut short, not another entry's): checked
+    // as it is copied, and the copy abandoned when it is not.
+    const bool copied = write_file_streamed("white image", path, [&](std::FILE* out) -> Fill {
+        Hash128 hash;
+        std::uint64_t bytes = 0;
+        if (!copy_file(in, out, &hash, &bytes))
+            return std::ferror(out) ? Fill::Failed : Fill::Abandoned;
+        return bytes == n->get<std::uint64_t>() && hash.hex() == h->get<std::string>() ? Fill::Complete : Fill::Abandoned;
+    });
+    std::fclose(in);
+    if (copied)
+        *scale = s->get<double>();
+    return copied;
 }
 
-bool WhiteImageCache::store(const std::string& description, const CachedWhiteImage& entry) const
+bool WhiteImageCache::store(const std::string& description, const std::string& png_path, double scale) const
 {
     if (!enabled())
         return false;
     const std::string stem = folder_ + "/" + white_image_key(description);
-    nlohmann::json record = {{"description", description},
-                             {"scale", entry.scale},
-                             {"png_bytes", std::uint64_t(entry.png.size())},
-                             {"png_hash", white_image_key(entry.png)}};
+    std::FILE* in = std::fopen(png_path.c_str(), "rb");
+    if (in == nullptr) {
+        std::fprintf(stderr, "plenoptic camera: cannot read %s to cache it: %s\n", png_path.c_str(), std::strerror(errno));
+        return false;
+    }
+    Hash128 hash;
+    std::uint64_t bytes = 0;
     // The PNG first: an entry is found only when its JSON is there and names this PNG.
-    return write_file_atomically("cached white image", stem + ".png", entry.png) &&
-           write_file_atomically("cached white image's record", stem + ".json", record.dump(1) + "\n");
+    const bool copied = write_file_streamed("cached white image", stem + ".png", [&](std::FILE* out) {
+        return copy_file(in, out, &hash, &bytes) ? Fill::Complete : Fill::Failed;
+    });
+    std::fclose(in);
+    if (!copied)
+        return false;
+    const nlohmann::json record = {
+        {"description", description}, {"scale", scale}, {"png_bytes", bytes}, {"png_hash", hash.hex()}};
+    return write_file_atomically("cached white image's record", stem + ".json", record.dump(1) + "\n");
 }
 
 } // namespace plenoptic

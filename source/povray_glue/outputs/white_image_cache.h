@@ -26,11 +26,6 @@ namespace plenoptic {
 // The environment variable naming the cache folder.
 const char* const kWhiteImageCacheVariable = "PLENOPTIC_WHITE_IMAGE_CACHE";
 
-struct CachedWhiteImage {
-    std::string png;  // the PNG file's bytes
-    double scale = 1; // what the linear values were divided by (WhiteImageFile::scale)
-};
-
 // The text a white image's key is the hash of (see above). `executable` is the program's identity
 // (executable_identity()); `index` the white image's number in its request, `raw` whether it
 // goes through the read-out.
@@ -58,12 +53,15 @@ public:
     const std::string& executable() const { return executable_; }
     std::string png_path(const std::string& description) const;
 
-    // The entry of `description` into *found; false when there is none, or its description or
-    // files do not match (a damaged or foreign entry is never used).
-    bool find(const std::string& description, CachedWhiteImage* found) const;
-    // Stores the entry (each file written atomically: a reader never sees half an entry); false,
-    // with a message, when it cannot be written (the render goes on).
-    bool store(const std::string& description, const CachedWhiteImage& entry) const;
+    // Writes the entry of `description` to `path` (atomically, copied piece by piece) and its
+    // scale (what the linear values were divided by, WhiteImageFile::scale) to *scale; false, and
+    // `path` untouched, when there is none, or its description or files do not match (a damaged
+    // or foreign entry is never used).
+    bool copy_out(const std::string& description, const std::string& path, double* scale) const;
+    // Stores the white image `png_path` as the entry of `description` (each file written
+    // atomically: a reader never sees half an entry); false, with a message, when it cannot be
+    // written (the render goes on).
+    bool store(const std::string& description, const std::string& png_path, double scale) const;
 
 private:
     WhiteImageCache() {}

@@ -7,9 +7,11 @@
 // camera's (white_image_cache.h), and stored there when computed.
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 
 #include "plenoptic/sensor/diffraction.h"
 #include "plenoptic/sensor/sensor_chain.h"
@@ -26,48 +28,126 @@ namespace {
 // The same camera, film included, at f-number N: the one place the white images get it from.
 PlenopticCamera camera_at_f_number(const PlenopticCamera& camera, double f_number) { return with_f_number(camera, f_number); }
 
-// The PNG of white image index k (`values`: its grey irradiance per pixel, rows from the top) in
-// `png` (empty if libpng failed), and in `scale` what the linear values were divided by. false:
-// cancelled.
-bool white_png(const PlenopticCamera& optics, const std::vector<float>& values, const CameraParams& params, bool raw, int k,
-               CancelQuery cancelled, std::string& png, double& scale)
+// Rows of the white image computed at once where no convolution sets the bands.
+const int kWhiteBandRows = 64;
+
+// White image index k of `optics` written to `path` as a PNG, band by band of rows (memory: a few
+// bands, whatever the sensor's size): the grey irradiance per pixel (white_image_rows); with
+// diffraction, as R, G and B (diffraction differs by colour) convolved band by band; through the
+// read-out when `raw`, else linear, divided by `scale`. false: cancelled (nothing written, no
+// message) or a file could not be written (with a message).
+bool write_white_png(const PlenopticCamera& optics, const CameraParams& params, bool raw, int k, const std::string& path,
+                     CancelQuery cancelled, double& scale)
 {
     const int W = optics.sensor.film.width, H = optics.sensor.film.height;
     const SensorChainParams& chain = params.sensor.chain;
-    // R, G and B of the grey white image, where they are needed: diffraction differs by colour
-    // (the white image is then RGB), and the read-out reads three channels.
     const Diffraction diffraction = diffraction_of(optics, params.diffraction);
-    std::vector<float> rgb;
-    if (diffraction.applied || raw) {
-        rgb.resize(values.size() * 3);
-        for (size_t p = 0; p < values.size(); ++p)
-            rgb[3 * p] = rgb[3 * p + 1] = rgb[3 * p + 2] = values[p];
-    }
-    if (diffraction.applied) {
-        const std::vector<AiryKernel> kernels = channel_kernels(optics, diffraction);
-        if (!convolve_channels(rgb, W, H, 3, kernels.data(), cancelled))
+    // The values' channels: R, G and B of the grey white image where they are needed (diffraction,
+    // or the read-out, which reads three channels), else grey.
+    const int channels = diffraction.applied || raw ? 3 : 1;
+
+    // Minutes for a large sensor (it is traced as the picture is): say how far, every tenth.
+    const bool large = size_t(W) * H >= 4000000;
+    if (large)
+        std::fprintf(stderr, "plenoptic camera: white image %s: %d x %d pixels\n", base_name(path).c_str(), W, H);
+    int tenths = 0;
+    // The white image's rows, from the top: grey, then R = G = B when three channels.
+    std::vector<float> grey;
+    const RowReader white_rows = [&](int first, int count, float* to) {
+        grey.resize(size_t(count) * W);
+        if (!white_image_rows(optics, first, count, grey.data(), cancelled))
             return false;
-    }
+        if (large && (first + count) * 10 >= (tenths + 1) * H) {
+            tenths = (first + count) * 10 / H;
+            std::fprintf(stderr, "plenoptic camera: white image %s: %d of %d rows\n", base_name(path).c_str(), first + count, H);
+        }
+        for (size_t p = 0; p < grey.size(); ++p)
+            for (int c = 0; c < channels; ++c)
+                to[p * size_t(channels) + size_t(c)] = grey[p];
+        return true;
+    };
+    // Every row of the finished values (after diffraction), from the top, to `sink`.
+    auto produce = [&](const RowWriter& sink) {
+        if (diffraction.applied) {
+            const std::vector<AiryKernel> kernels = channel_kernels(optics, diffraction);
+            return convolve_rows(W, H, 3, kernels.data(), white_rows, sink, cancelled);
+        }
+        std::vector<float> band(size_t(std::min(kWhiteBandRows, H)) * W * channels);
+        for (int first = 0; first < H; first += kWhiteBandRows) {
+            const int rows = std::min(kWhiteBandRows, H - first);
+            if (!white_rows(first, rows, band.data()) || !sink(first, rows, band.data()))
+                return false;
+        }
+        return true;
+    };
+
     scale = 1;
     if (raw) {
         SensorChainParams frame = chain;
         frame.seed = chain.seed ^ (0x7768697465000000ULL + std::uint64_t(k + 1));  // "white": its own noise
-        png = raw_png(sensor_raw(frame, rgb, W, H), W, H, chain.bayer != BayerPattern::None ? 1 : 3, chain.bit_depth);
-        return true;
+        const int out_channels = chain.bayer != BayerPattern::None ? 1 : 3;
+        return write_file_streamed("white image", path, [&](std::FILE* file) -> Fill {
+            PngRowWriter png(file, W, H, out_channels, chain.bit_depth);
+            std::vector<std::uint16_t> values;
+            bool failed = false;
+            const RowWriter read_out = [&](int first, int count, const float* rgb) {
+                values.resize(size_t(count) * W * out_channels);
+                sensor_raw_rows(frame, rgb, W, first, count, values.data());
+                for (int r = 0; r < count; ++r)
+                    if (!png.write_row(&values[size_t(r) * W * out_channels])) {
+                        failed = true;
+                        return false;
+                    }
+                return true;
+            };
+            if (!produce(read_out))
+                return failed ? Fill::Failed : Fill::Abandoned;
+            return png.finish() ? Fill::Complete : Fill::Failed;
+        });
     }
     // Irradiance can exceed 1 (overlap at a microimage's rim, a lens cell's corners): divided by a
-    // power of two so that nothing clips, recorded as the entry's scale.
-    const std::vector<float>& source = diffraction.applied ? rgb : values;
+    // power of two so that nothing clips, recorded as the entry's scale. The largest value is known
+    // only at the end, so the values wait in a temporary file (not in memory) for the second pass.
+    std::FILE* values = std::tmpfile();
+    if (values == nullptr) {
+        std::fprintf(stderr, "plenoptic camera: cannot write white image %s: no temporary file (%s)\n", path.c_str(),
+                     std::strerror(errno));
+        return false;
+    }
     float largest = 0;
-    for (float v : source)
-        largest = std::max(largest, v);
-    while (scale < largest && scale < 65536)
-        scale *= 2;
-    std::vector<std::uint16_t> linear(source.size());
-    for (size_t p = 0; p < source.size(); ++p)
-        linear[p] = std::uint16_t(std::lround(std::min(1.0, std::max(0.0, source[p] / scale)) * 65535.0));
-    png = raw_png(linear, W, H, diffraction.applied ? 3 : 1, 16);
-    return true;
+    bool spilled = true;
+    const RowWriter keep = [&](int, int count, const float* from) {
+        const size_t n = size_t(count) * W * channels;
+        for (size_t p = 0; p < n; ++p)
+            largest = std::max(largest, from[p]);
+        spilled = spilled && std::fwrite(from, sizeof(float), n, values) == n;
+        return spilled;
+    };
+    bool written = false;
+    if (produce(keep)) {
+        while (scale < largest && scale < 65536)
+            scale *= 2;
+        std::rewind(values);
+        written = write_file_streamed("white image", path, [&](std::FILE* file) -> Fill {
+            PngRowWriter png(file, W, H, channels, 16);
+            std::vector<float> row(size_t(W) * channels);
+            std::vector<std::uint16_t> linear(row.size());
+            for (int j = 0; j < H; ++j) {
+                if (std::fread(row.data(), sizeof(float), row.size(), values) != row.size())
+                    return Fill::Failed;
+                for (size_t p = 0; p < row.size(); ++p)
+                    linear[p] = std::uint16_t(std::lround(std::min(1.0, std::max(0.0, row[p] / scale)) * 65535.0));
+                if (!png.write_row(linear.data()))
+                    return Fill::Failed;
+            }
+            return png.finish() ? Fill::Complete : Fill::Failed;
+        });
+    } else if (!spilled) {
+        std::fprintf(stderr, "plenoptic camera: cannot write white image %s: its temporary file: %s\n", path.c_str(),
+                     std::strerror(errno));
+    }
+    std::fclose(values);
+    return written;
 }
 
 class WhiteImagesOutput : public Output {
@@ -92,31 +172,23 @@ public:
             const PlenopticCamera& optics = own ? model : *other;
             const bool raw = params.sensor.chain.given && !white.noise_free;
             const std::string path = image.beside(white_image_suffix(white, k));
-            std::string png;
             double scale = 1;
             const std::string description =
                 cache_.enabled() ? white_image_description(optics, params, f_number, k, raw, cache_.executable()) : "";
-            CachedWhiteImage cached;
-            if (cache_.enabled() && cache_.find(description, &cached)) {
+            bool written = false;
+            if (cache_.enabled() && cache_.copy_out(description, path, &scale)) {
                 std::fprintf(stderr, "plenoptic camera: white image %s: the cached one, %s\n", base_name(path).c_str(),
                              cache_.png_path(description).c_str());
-                png = cached.png;
-                scale = cached.scale;
+                written = true;
             } else {
-                const std::vector<float> values = white_image(optics, image.cancelled);
-                if (values.empty())
-                    break;  // cancelled
-                if (!white_png(optics, values, params, raw, k, image.cancelled, png, scale))
-                    break;  // cancelled
-                if (cache_.enabled() && !png.empty()) {
-                    cached.png = png;
-                    cached.scale = scale;
-                    if (cache_.store(description, cached))
-                        std::fprintf(stderr, "plenoptic camera: white image %s: computed, and cached as %s\n",
-                                     base_name(path).c_str(), cache_.png_path(description).c_str());
-                }
+                written = write_white_png(optics, params, raw, k, path, image.cancelled, scale);
+                if (image.cancelled())
+                    break;
+                if (written && cache_.enabled() && cache_.store(description, path, scale))
+                    std::fprintf(stderr, "plenoptic camera: white image %s: computed, and cached as %s\n",
+                                 base_name(path).c_str(), cache_.png_path(description).c_str());
             }
-            if (!png.empty() && write_file_atomically("white image", path, png)) {
+            if (written) {
                 WhiteImageFile file;
                 file.file = base_name(path);
                 file.f_number = f_number;
