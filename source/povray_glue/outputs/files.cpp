@@ -79,6 +79,18 @@ bool write_through_temporary(const char* what, const std::string& path, const st
 
 } // namespace
 
+std::FILE* scratch_file_beside(const std::string& path)
+{
+    const std::string tmp = temporary_beside(path);
+    if (tmp.empty())
+        return nullptr;
+    std::FILE* f = std::fopen(tmp.c_str(), "w+b");
+    const int error = errno;
+    std::remove(tmp.c_str());
+    errno = error;
+    return f;
+}
+
 bool write_file_streamed(const char* what, const std::string& path, const std::function<Fill(std::FILE* file)>& fill)
 {
     const std::string tmp = temporary_beside(path);

@@ -32,6 +32,11 @@ bool write_file_atomically(const char* what, const std::string& path,
 enum class Fill { Complete, Failed, Abandoned };
 bool write_file_streamed(const char* what, const std::string& path, const std::function<Fill(std::FILE* file)>& fill);
 
+// A scratch file for reading and writing in the directory of `path` (where the outputs have room),
+// already removed from the directory, so it vanishes when closed or when the program ends;
+// nullptr (errno set) when it cannot be made.
+std::FILE* scratch_file_beside(const std::string& path);
+
 // Writes a W x H one-channel float EXR (channel `channel`) row by row (memory: one row):
 // fill(j, row) fills row j and returns false to stop (cancelled: nothing is written, no
 // message). `what` names the file in messages.

@@ -107,11 +107,12 @@ bool write_white_png(const PlenopticCamera& optics, const CameraParams& params, 
     }
     // Irradiance can exceed 1 (overlap at a microimage's rim, a lens cell's corners): divided by a
     // power of two so that nothing clips, recorded as the entry's scale. The largest value is known
-    // only at the end, so the values wait in a temporary file (not in memory) for the second pass.
-    std::FILE* values = std::tmpfile();
+    // only at the end, so the values wait in a scratch file beside it (not in memory) for the second
+    // pass.
+    std::FILE* values = scratch_file_beside(path);
     if (values == nullptr) {
-        std::fprintf(stderr, "plenoptic camera: cannot write white image %s: no temporary file (%s)\n", path.c_str(),
-                     std::strerror(errno));
+        std::fprintf(stderr, "plenoptic camera: cannot write white image %s: no scratch file beside it (%s)\n",
+                     path.c_str(), std::strerror(errno));
         return false;
     }
     float largest = 0;
