@@ -20,6 +20,7 @@
 // Declarations (a data-set spec sets them; defaults in brackets):
 //   Twin_Focus          focus distance, m [2]
 //   Dataset_Samples [16], Dataset_White_Image [1], Dataset_Sensor_Seed [1]
+//   Dataset_Depth_Map [0]: also the depth map (the views export's disparity needs it)
 // The white image, <stem>.white.png, is the camera's at its f/2, in DN (as the raw): Lytro ships
 // one per zoom and focus setting, which a data-set spec sweeps (scenes/twin_lytro_illum.toml).
 //
@@ -35,6 +36,7 @@ global_settings { assumed_gamma 1.0 }
 #ifndef (Dataset_Samples) #declare Dataset_Samples = 16; #end
 #ifndef (Dataset_White_Image) #declare Dataset_White_Image = 1; #end
 #ifndef (Dataset_Sensor_Seed) #declare Dataset_Sensor_Seed = 1; #end
+#ifndef (Dataset_Depth_Map) #declare Dataset_Depth_Map = 0; #end
 
 camera {
   plenoptic
@@ -65,4 +67,5 @@ camera {
   }
   samples Dataset_Samples
   #if (Dataset_White_Image) white_image #end
+  #if (Dataset_Depth_Map) depth_map #end
 }

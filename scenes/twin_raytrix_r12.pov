@@ -27,6 +27,9 @@
 // Declarations (a data-set spec sets them; defaults in brackets):
 //   Twin_Setting    1: R12-A [1], 2: R12-B, 3: R12-C (array position and checkerboard)
 //   Twin_F_Number   the aperture the picture is taken at [4]
+//   Twin_Main_Lens  1: the double-Gauss traced [1]; 2: its thick-lens equivalent (thick_lens);
+//                   3: a thin lens of its paraxial numbers (twin_raytrix_r12_camera.inc, which
+//                   holds the camera, says which; docs/digital-twins.md, "Exporting the twins")
 //   Twin_Board_RX, Twin_Board_RY, Twin_Board_RZ, Twin_Board_Scale: the board's rotation
 //                   (degrees, x then y then z) and its distance from the front vertex as a
 //                   multiple of the setting's [-0.5, 17.2, -3.6 and 1: one of the R12-A poses of
@@ -34,6 +37,7 @@
 //                   the distance scaled with the square, 0.60 m and 0.90 m]
 //   Dataset_Samples [16], Dataset_White_Image [1]: white images at the five f-numbers, beside
 //                   the image: <stem>.white.f4.png ... <stem>.white.f16.png
+//   Dataset_Depth_Map [0]: also the depth and virtual depth maps
 //
 // Full size (12.5 Mpx; its time is a benchmark's, docs/digital-twins.md):
 //   build/povray +Iscenes/twin_raytrix_r12.pov +Lscenes +Llenses +Otwin_r12.png +W4080 +H3068
@@ -43,40 +47,13 @@
 global_settings { assumed_gamma 1.0 }
 #include "calibration_targets.inc"
 
-#ifndef (Twin_Setting) #declare Twin_Setting = 1; #end
-#ifndef (Twin_F_Number) #declare Twin_F_Number = 4; #end
-#ifndef (Dataset_Samples) #declare Dataset_Samples = 16; #end
-#ifndef (Dataset_White_Image) #declare Dataset_White_Image = 1; #end
+#include "twin_raytrix_r12_camera.inc"            // the camera (Twin_Setting, Twin_F_Number, Twin_Main_Lens, Dataset_*)
+
 #ifndef (Twin_Board_RX) #declare Twin_Board_RX = -0.5; #end
 #ifndef (Twin_Board_RY) #declare Twin_Board_RY = 17.2; #end
 #ifndef (Twin_Board_RZ) #declare Twin_Board_RZ = -3.6; #end
 #ifndef (Twin_Board_Scale) #declare Twin_Board_Scale = 1; #end
 #declare Twin_Board_Distance = Twin_Board_Scale * select(Twin_Setting - 2, 0.30, 0.60, 0.90);
-
-camera {
-  plenoptic
-  location <0, 0, 0> look_at <0, 0, 1>   // the lens's front vertex
-  mm_per_unit 1000
-  main_lens {
-    lens_file "double_gauss_50mm_tronnier_f2.dat"
-    f_number Twin_F_Number
-    #switch (Twin_Setting)
-      #case (1) distance 42.607738 #break          // R12-A: 56.86 mm behind the rear principal plane
-      #case (2) focus_distance 1.0 #break          // R12-B: h = 1000 mm
-      #case (3) distance 36.105905 #break          // R12-C: the back focal distance (infinity)
-      #else #error "Twin_Setting: 1 (R12-A), 2 (R12-B) or 3 (R12-C)"
-    #end
-  }
-  microlens_array {
-    hexagonal
-    pitch 0.12744                                  // mm
-    focal_lengths <0.58267, 0.52402, 0.56057>      // mm, COMPOTE's order (our types 0, 1, 2)
-    distance 0.33713                               // mm: d < f, the Galilean arrangement
-  }
-  sensor { pixel_size 0.0055 }                     // 4080 x 3068 at full size
-  samples Dataset_Samples
-  #if (Dataset_White_Image) white_image f_numbers <4, 5.66, 8, 11.31, 16> #end
-}
 
 background { rgb 0.2 }
 object {
