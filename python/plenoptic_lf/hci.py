@@ -51,50 +51,58 @@ def write_pfm(path: str, values: npt.ArrayLike) -> None:
 
 
 def check_hci_camera(meta: Metadata) -> None:
-    """DecodeError unless the render is a plenoptic 1.0 camera whose sub-aperture views form the
-    benchmark's camera grid exactly: a thin main lens without distortion, one kind of thin
-    microlens with d = f, an array aligned with the sensor (not turned, not tilted), square pixels."""
+    """DecodeError unless the render's sub-aperture views form the benchmark's camera grid exactly
+    (check_pinhole_views)."""
+    check_pinhole_views(meta, "--hci", DecodeError)
+
+
+def check_pinhole_views(meta: Metadata, who: str, error: type) -> None:
+    """`error` (a message starting with `who`, the option or format asking) unless every
+    sub-aperture view of the render is a pinhole camera on one grid with square pixels, which a
+    disparity per pixel needs: a thin_lens or thick_lens main lens without distortion, one kind of
+    thin microlens with d = f (plenoptic 1.0), an array aligned with the sensor (not turned, not
+    tilted), square pixels, the array beyond the focal length, an upright exit pupil."""
     if meta.main_lens_type == "prescription":
-        raise DecodeError("--hci's disparity ground truth assumes an ideal lens, whose sub-aperture views are "
-                          "pinhole cameras on one grid; this render's main lens is a traced prescription, whose "
-                          "distortion and pupil aberration bend each view's rays differently, so no single "
-                          "disparity per pixel exists. Render the same camera with thick_lens (its paraxial "
-                          "equivalent) for an HCI export")
+        raise error("%s: the disparity ground truth assumes an ideal lens, whose sub-aperture views are "
+                    "pinhole cameras on one grid; this render's main lens is a traced prescription, whose "
+                    "distortion and pupil aberration bend each view's rays differently, so no single "
+                    "disparity per pixel exists. Render the same camera with thick_lens (its paraxial "
+                    "equivalent)" % who)
     if meta.main_lens_type not in ("thin_lens", "thick_lens"):
-        raise DecodeError("--hci needs a thin_lens or thick_lens main lens (its views are then an exact camera "
-                          "grid); this render's main lens is %s" % meta.main_lens_type)
+        raise error("%s needs a thin_lens or thick_lens main lens (its views are then pinhole cameras on one "
+                    "grid); this render's main lens is %s" % (who, meta.main_lens_type))
     if meta.main_lens.distorted:
-        raise DecodeError("--hci needs a thin_lens without distortion: a distorted lens's views are not "
-                          "pinhole cameras, so no single disparity per pixel exists")
+        raise error("%s needs a lens without distortion: a distorted lens's views are not pinhole cameras, "
+                    "so no single disparity per pixel exists" % who)
     array = meta.array
     focal = array.focal_lengths_mm
     if array.lens != "thin_lens" or len(focal) != 1:
-        raise DecodeError("--hci needs one kind of thin microlens (plenoptic 1.0); this array has %s"
-                          % ("pinholes" if array.lens == "pinhole" else "%d lens types" % len(focal)))
+        raise error("%s needs one kind of thin microlens (plenoptic 1.0); this array has %s"
+                    % (who, "pinholes" if array.lens == "pinhole" else "%d lens types" % len(focal)))
     f = focal[0]
     d = array.distance_mm
     F = meta.focal_length_mm
     assert F is not None, "a thin_lens or thick_lens has a focal length (Metadata checks it)"
     if not math.isclose(meta.array_distance_mm, f, rel_tol=1e-6):
-        raise DecodeError("--hci decodes plenoptic 1.0 cameras (array to sensor distance d = microlens focal "
-                          "length f); this one has d = %g mm and f = %g mm, a focused (2.0) camera whose "
-                          "microimages are not sub-aperture samples" % (d, f))
-    rotate = array.rotate_deg
+        raise error("%s decodes plenoptic 1.0 cameras (array to sensor distance d = microlens focal length "
+                    "f); this one has d = %g mm and f = %g mm, a focused (2.0) camera whose microimages are "
+                    "not sub-aperture samples" % (who, d, f))
+    rotate = tuple(array.rotate_deg)
     if any(abs(r) > 0 for r in rotate):
-        raise DecodeError("--hci needs an array aligned with the sensor (rotate <0, 0, 0>); this one is turned "
-                          "(rotate <%g, %g, %g>): its views' pixel axes are not the camera grid's axes" % rotate)
+        raise error(who + " needs an array aligned with the sensor (rotate <0, 0, 0>); this one is turned "
+                    "(rotate <%g, %g, %g>): its views' pixel axes are not the camera grid's axes" % rotate)
     px, py = meta.pixel_size_mm
     if not math.isclose(px, py, rel_tol=1e-9):
-        raise DecodeError("--hci needs square pixels (one baseline for both axes); pixel_size is %g x %g mm"
-                          % (px, py))
+        raise error("%s needs square pixels (one baseline and one disparity for both axes); pixel_size is "
+                    "%g x %g mm" % (who, px, py))
     D = meta.rear_principal_z + meta.main_distance_mm
     if not D > F:
-        raise DecodeError("--hci needs the array beyond the focal length (D = %g mm from the %s, F = %g mm): "
-                          "otherwise nothing is in focus in front of the lens"
-                          % (D, "lens" if meta.main_lens_type == "thin_lens" else "rear principal plane", F))
+        raise error("%s needs the array beyond the focal length (D = %g mm from the %s, F = %g mm): "
+                    "otherwise nothing in front of the lens is in focus on it"
+                    % (who, D, "lens" if meta.main_lens_type == "thin_lens" else "rear principal plane", F))
     if not HciGeometry(meta, 1.0).pupil_magnification > 0:
-        raise DecodeError("--hci needs a lens whose exit pupil is an upright image of its entrance pupil; this "
-                          "thick lens's pupil magnification is negative, which turns its camera grid over")
+        raise error("%s needs a lens whose exit pupil is an upright image of its entrance pupil; this "
+                    "thick lens's pupil magnification is negative, which turns its camera grid over" % who)
 
 
 class HciGeometry:

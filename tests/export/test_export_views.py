@@ -27,6 +27,7 @@ rectangular and a hexagonal array) looks along +z at one textured, self-lit plan
 """
 import json
 import os
+import shutil
 import subprocess
 import sys
 
@@ -231,6 +232,9 @@ def test_ctrl_c_stops_promptly_and_leaves_nothing(args, export):
     import time
     png = export[0]
     folder = export[1] + "_interrupted"
+    # What an earlier run killed by a timeout (SIGKILL, which nothing can clean up after) left.
+    for stale in [e for e in os.listdir(args.work) if os.path.basename(folder) in e]:
+        shutil.rmtree(os.path.join(args.work, stale), ignore_errors=True)
     process = subprocess.Popen([sys.executable, os.path.join(args.tools, "plenoptic-export"), png, "--to", "views",
                                 folder, "--step", "0.25"], stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
     try:

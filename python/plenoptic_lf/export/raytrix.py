@@ -138,9 +138,15 @@ def calibration(render: Render, blur_px: float = 1.0, cap: float = 100.0, fmt: s
     types: list[dict[str, Any]] = []
     reader_type = hex_focal_type(alpha, beta)
     for t, f in enumerate(focal):
+        if not f > d:
+            raise ExportError("raytrix: lens type %d has f = %g mm <= d = %g mm: the XML describes focused "
+                              "plenoptic cameras, whose depth ranges are positive virtual depths (Raytrix's "
+                              "Galilean arrangement, d < f for every type); a plenoptic 1.0 camera (d = f) is "
+                              "decoded into views instead (--to views or eslf)" % (t, f, d))
         members = np.nonzero(lenses.type == t)[0]
         colours = set(reader_type[members].tolist())
-        if len(colours) != 1:
+        # One lens type: the toolbox's rule is not consulted (every lens is type 0).
+        if len(focal) > 1 and len(colours) != 1:
             raise ExportError("raytrix: lens type %d does not map onto one colour of the toolbox's hexagonal "
                               "lens-type rule" % t)
         # The offset of the type: the axial coordinates of its lens nearest the centre lens.

@@ -28,14 +28,13 @@ rows, depths at the nearest row.
 from __future__ import annotations
 
 import json
-import math
 import os
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..hci import HciGeometry, _nearest_samples, _resample_rows, _square_rows, planar_depth_mm
+from ..hci import HciGeometry, check_pinhole_views, _nearest_samples, _resample_rows, _square_rows, planar_depth_mm
 from ..lightfield import plan_decode
 from . import ExportError, Render
 
@@ -78,44 +77,9 @@ def read_pfm(path: str | os.PathLike[str]) -> np.ndarray:
 
 
 def check_views_camera(meta: Any) -> None:
-    """ExportError unless every view is a pinhole camera on one grid with square pixels (what
-    plenoptic-decode --hci asks too): a thin_lens or thick_lens main lens without distortion, one
-    kind of thin microlens at d = f (plenoptic 1.0), an array aligned with the sensor, square
-    pixels, the array beyond the focal length."""
-    if meta.main_lens_type == "prescription":
-        raise ExportError("views: a traced prescription's distortion and pupil aberration bend each view's rays "
-                          "differently, so its views are not pinhole cameras and no single disparity per pixel "
-                          "exists; render the same camera with thick_lens (its paraxial equivalent)")
-    if meta.main_lens_type not in ("thin_lens", "thick_lens"):
-        raise ExportError("views needs a thin_lens or thick_lens main lens (its views are then pinhole cameras on "
-                          "one grid); this render's main lens is %s" % meta.main_lens_type)
-    if meta.main_lens.distorted:
-        raise ExportError("views: a distorted lens's views are not pinhole cameras, so no single disparity per "
-                          "pixel exists; render without distortion")
-    array = meta.array
-    focal = array.focal_lengths_mm
-    if array.lens != "thin_lens" or len(focal) != 1:
-        raise ExportError("views needs one kind of thin microlens (plenoptic 1.0); this array has %s"
-                          % ("pinholes" if array.lens == "pinhole" else "%d lens types" % len(focal)))
-    if not math.isclose(meta.array_distance_mm, focal[0], rel_tol=1e-6):
-        raise ExportError("views decodes plenoptic 1.0 cameras (array to sensor distance d = microlens focal length "
-                          "f); this one has d = %g mm and f = %g mm, a focused (2.0) camera whose microimages are "
-                          "not sub-aperture samples" % (array.distance_mm, focal[0]))
-    rotate = array.rotate_deg
-    if any(abs(x) > 0 for x in rotate):
-        raise ExportError("views needs an array aligned with the sensor (rotate <0, 0, 0>); this one is turned "
-                          "(rotate <%g, %g, %g>): its views' pixel axes are not the camera grid's" % tuple(rotate))
-    px, py = meta.pixel_size_mm
-    if not math.isclose(px, py, rel_tol=1e-9):
-        raise ExportError("views needs square pixels (one disparity for both axes); pixel_size is %g x %g mm"
-                          % (px, py))
-    F = meta.focal_length_mm
-    if not meta.rear_principal_z + meta.main_distance_mm > F:
-        raise ExportError("views needs the array beyond the main lens's focal length (F = %g mm): otherwise "
-                          "nothing in front of the lens is imaged onto it" % F)
-    if not HciGeometry(meta, 1.0).pupil_magnification > 0:
-        raise ExportError("views needs a lens whose exit pupil is an upright image of its entrance pupil; this "
-                          "thick lens's pupil magnification is negative, which turns its camera grid over")
+    """ExportError unless every view is a pinhole camera on one grid with square pixels: the
+    decoder's own check for --hci (hci.check_pinhole_views), in this format's name."""
+    check_pinhole_views(meta, "views", ExportError)
 
 
 README = """# Views with ground-truth disparity
