@@ -11,7 +11,7 @@
 //
 //   plenoptic_pass_fractions --lens-file FILE --f-number N --focus-distance Z
 //       --sensor W H PIXEL_MM [--array-matched PITCH_MM | --array PITCH_MM F_MM D_MM] [--thick]
-//       [--samples S] [--patch P]
+//       [--samples S] [--patch P] [--unaimed] [--lit-patch L]
 //
 // --array-matched puts a hexagonal plenoptic 1.0 array at the focused image: thin microlenses of
 // focal length f = PITCH * the lens's working f-number (exit pupil to array over its diameter),
@@ -20,6 +20,11 @@
 // (thick_lens) instead of the exact trace. --samples: samples per pixel (the make_sample count;
 // default 256); --patch: the side of the pixel patches (default 16, or two microlens pitches).
 // Besides the three places, a profile: patches along the centre row from the axis to the edge.
+// --unaimed samples every pixel and cell uniformly (the camera's sampling.aim off: how samples
+// were spread before they were aimed where light passes, camera/aim.h). --lit-patch L adds, per
+// place, the counts over the lit pixels of an L x L patch there (a pixel is lit when any of the
+// points the uniform sampling looks at passes: pixel_receives_light with the aiming off), with the
+// smallest pass fraction of a lit pixel, the 5th percentile, and how many lit pixels pass 95 %.
 // light_field_radius_mm is where the pupil bounds find that no light passes any more (-1 for the
 // thick lens, which has no such bounds; the bounds with an array are for points of its plane).
 
@@ -31,6 +36,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "plenoptic/lens/main_lens.h"
 #include "plenoptic/camera/plenoptic_camera.h"
@@ -38,6 +44,7 @@
 #include "plenoptic/camera/params.h"
 #include "plenoptic/lens/prescription.h"
 #include "plenoptic/core/sampling.h"
+#include "plenoptic/camera/pixel.h"
 
 namespace {
 
@@ -55,6 +62,8 @@ struct Options {
     bool thick = false;
     int samples = 256;
     int patch = 0;
+    bool unaimed = false;
+    int lit_patch = 0;
 };
 
 void usage()
@@ -62,7 +71,7 @@ void usage()
     std::fprintf(stderr,
                  "usage: plenoptic_pass_fractions --lens-file FILE --f-number N --focus-distance Z\n"
                  "         --sensor W H PIXEL_MM [--array-matched PITCH_MM | --array PITCH_MM F_MM D_MM] [--thick]\n"
-                 "         [--samples S] [--patch P]\n");
+                 "         [--samples S] [--patch P] [--unaimed] [--lit-patch L]\n");
 }
 
 bool parse(int argc, char** argv, Options* o)
@@ -93,13 +102,17 @@ bool parse(int argc, char** argv, Options* o)
             o->samples = std::atoi(argv[++a]);
         else if (arg == "--patch" && left >= 1)
             o->patch = std::atoi(argv[++a]);
+        else if (arg == "--unaimed")
+            o->unaimed = true;
+        else if (arg == "--lit-patch" && left >= 1)
+            o->lit_patch = std::atoi(argv[++a]);
         else
             return false;
     }
     if (o->array_focal_mm > 0 && !(o->array_distance_mm > 0))
         return false;
     return !o->lens_file.empty() && o->f_number > 0 && o->focus_distance > 0 && o->width > 0 && o->height > 0 &&
-           o->pixel_mm > 0 && o->samples >= 2 && o->patch >= 0 && o->array_pitch_mm >= 0;
+           o->pixel_mm > 0 && o->samples >= 2 && o->patch >= 0 && o->lit_patch >= 0 && o->array_pitch_mm >= 0;
 }
 
 // The camera a scene with these keywords would give (main_lens { lens_file f_number
@@ -171,6 +184,38 @@ void count_pixel(const PlenopticCamera& m, int i, int j, int samples, double rea
     }
 }
 
+// Over the lit pixels of the patch of side `side` from (i0, j0): their samples and how many pass,
+// and the spread of the pixels' own pass fractions.
+std::string lit_counts_json(const PlenopticCamera& m, const PlenopticCamera& uniform, int i0, int j0, int side, int samples)
+{
+    long long generated = 0, passed = 0;
+    std::vector<double> fractions;
+    for (int j = j0; j < j0 + side; ++j)
+        for (int i = i0; i < i0 + side; ++i) {
+            if (!pixel_receives_light(uniform, i, j))
+                continue;
+            int pass = 0;
+            for (int n = 0; n < samples; ++n)
+                if (m.generate_ray(i, j, make_sample(i, j, n, samples)).passed)
+                    ++pass;
+            generated += samples;
+            passed += pass;
+            fractions.push_back(double(pass) / samples);
+        }
+    std::sort(fractions.begin(), fractions.end());
+    int at_least_95 = 0;
+    for (double f : fractions)
+        at_least_95 += f >= 0.95 ? 1 : 0;
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "{\"lit_pixels\": %d, \"generated\": %lld, \"passed\": %lld, \"pass_fraction\": %.6f, "
+                  "\"smallest_pixel_fraction\": %.6f, \"pixel_fraction_5th_percentile\": %.6f, \"pixels_at_least_95\": %d}",
+                  int(fractions.size()), generated, passed, generated > 0 ? double(passed) / double(generated) : 0.0,
+                  fractions.empty() ? 0.0 : fractions.front(),
+                  fractions.empty() ? 0.0 : fractions[fractions.size() / 20], at_least_95);
+    return text;
+}
+
 std::string fraction(long long part, long long whole)
 {
     char text[32];
@@ -236,7 +281,11 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "plenoptic_pass_fractions: %s\n", error.c_str());
         return 1;
     }
-    const PlenopticCamera m = with_film(make_camera(params), o.width, o.height);
+    PlenopticCamera m = with_film(make_camera(params), o.width, o.height);
+    PlenopticCamera uniform = m;
+    uniform.sampling.aim = false;
+    if (o.unaimed)
+        m.sampling.aim = false;
     const int W = o.width, H = o.height;
     int patch = o.patch;
     if (patch == 0)
@@ -268,7 +317,8 @@ int main(int argc, char** argv)
     else
         std::printf(" \"array\": null,\n");
     std::printf(" \"sensor\": {\"width\": %d, \"height\": %d, \"pixel_size_mm\": %.9g}, \"samples\": %d, "
-                "\"patch\": %d,\n \"places\": [\n", W, H, o.pixel_mm, o.samples, patch);
+                "\"patch\": %d, \"aimed\": %s,\n \"places\": [\n", W, H, o.pixel_mm, o.samples, patch,
+                m.sampling.aim ? "true" : "false");
     for (int k = 0; k < 3; ++k) {
         const Place& p = places[k];
         Count pixel, block;
@@ -280,8 +330,16 @@ int main(int argc, char** argv)
         std::printf("  {\"place\": \"%s\", \"pixel\": [%d, %d], \"field_radius_mm\": %.6f,\n", p.name, p.i, p.j,
                     std::hypot(at.x, at.y));
         std::printf("   \"pixel_counts\": %s,\n", counts_json(pixel, unbounded).c_str());
-        std::printf("   \"patch_first_pixel\": [%d, %d], \"patch_counts\": %s}%s\n", p.i0, p.j0,
-                    counts_json(block, unbounded).c_str(), k < 2 ? "," : "");
+        std::printf("   \"patch_first_pixel\": [%d, %d], \"patch_counts\": %s", p.i0, p.j0,
+                    counts_json(block, unbounded).c_str());
+        if (o.lit_patch > 0) {
+            // The lit-pixel patch at the same place, inside the picture.
+            const int side = std::min(o.lit_patch, std::min(W, H));
+            const int li = std::max(0, std::min(W - side, p.i - side / 2)), lj = std::max(0, std::min(H - side, p.j - side / 2));
+            std::printf(",\n   \"lit_patch_first_pixel\": [%d, %d], \"lit_patch\": %d, \"lit_counts\": %s", li, lj,
+                        side, lit_counts_json(m, uniform, li, lj, side, o.samples).c_str());
+        }
+        std::printf("}%s\n", k < 2 ? "," : "");
     }
     std::printf(" ],\n");
     // Along the centre row from the axis to the right edge: patches at kProfile field radii.

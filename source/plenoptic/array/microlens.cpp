@@ -49,7 +49,7 @@ public:
 
 // Ideal thin lenses, refracting in the array's own frame: with the direction normalised to unit
 // component along the normal, w' = w - (h - c) / f for a ray meeting the lens at h.
-class ThinMicrolens : public Microlens {
+class ThinMicrolens final : public Microlens {
 public:
     ThinMicrolens(const double* focal_mm, int type_count) : type_count_(type_count)
     {
@@ -74,11 +74,17 @@ public:
     // passes light unbent, unless a mask blocks it.
     ArrayRay sample_ray(const MicrolensArray& array, const Vec3& p, LensIndex lens, double u, double v) const override
     {
+        return cell_ray(array, p, lens, array.cell_point(u, v));
+    }
+
+    bool aims() const override { return true; }
+
+    ArrayRay cell_ray(const MicrolensArray& array, const Vec3& p, LensIndex lens, Vec2 offset) const override
+    {
         if (!array.errors && array.aperture_scale == 1) {
             // Ideal lenses filling their cells: the lattice centre, the type's focal length.
             const double f = focal_mm_[array.type_of(lens)];
             const Vec2 c = array.lattice_centre_local(lens);
-            const Vec2 offset = array.cell_point(u, v);
             const Vec3 leave = array.to_optics(Vec3{c.x + offset.x, c.y + offset.y, 0});
             const Vec3 w = mul_transposed(array.pose.rotation, leave - p);
             if (!(w.z > 0))
@@ -87,7 +93,6 @@ public:
             return ArrayRay{leave, mul(array.pose.rotation, refracted), true, leave};
         }
         const LensFrame frame = array.frame(lens);
-        const Vec2 offset = array.cell_point(u, v);
         const bool lens_part = array.in_aperture(offset);
         if (!lens_part && array.mask)
             return no_ray();

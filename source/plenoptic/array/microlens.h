@@ -73,6 +73,23 @@ public:
     // allocation, no search, no trigonometry.
     virtual ArrayRay sample_ray(const MicrolensArray& array, const Vec3& p, LensIndex lens, double u, double v) const = 0;
 
+    // Whether the camera may aim a pixel's samples at the part of a cell (and of the pixel) where
+    // light can pass (camera/aim.h): only for lenses that act as ideal thin lenses of their focal
+    // length (focal_length_mm of the lens's type), whose rays through cell points are affine in
+    // the point; false for every other kind, which is then sampled uniformly over its cell.
+    virtual bool aims() const { return false; }
+    // For a lens that aims: the ray from sensor point p through the point `offset` (array-local,
+    // from the lens's centre) of lens `lens`'s cell, as sample_ray makes it for the sample that
+    // picks that point. Lenses that do not aim have none (not passed).
+    virtual ArrayRay cell_ray(const MicrolensArray& array, const Vec3& p, LensIndex lens, Vec2 offset) const
+    {
+        (void)array;
+        (void)p;
+        (void)lens;
+        (void)offset;
+        return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false};
+    }
+
     // The ray from sensor point p through lens `lens` that leaves the lens heading for `target` (a
     // point in front of the array: a pinhole main lens), returned from `target` on. Not passed when
     // there is none (a pinhole's only ray from p misses any given point but by chance), when p or

@@ -38,7 +38,7 @@ double lit_fraction_near_axis(const PlenopticCamera& camera)
     for (int j = j0; j < j0 + patch; ++j)
         for (int i = i0; i < i0 + patch; ++i)
             for (int n = 0; n < kSamplesPerPixel; ++n, ++total) {
-                const OpticsRay ray = generate_ray(model, i, j, make_sample(i, j, n, kSamplesPerPixel));
+                const OpticsRay ray = generate_ray_unaimed(model, i, j, make_sample(i, j, n, kSamplesPerPixel));
                 if (ray.passed)
                     ++passing;
             }

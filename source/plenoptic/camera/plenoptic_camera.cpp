@@ -10,6 +10,7 @@
 #include "plenoptic/core/lattice.h"
 #include "plenoptic/camera/radiometry.h"
 #include "plenoptic/core/sampling.h"
+#include "plenoptic/camera/aim.h"
 
 namespace plenoptic {
 
@@ -220,6 +221,7 @@ PlenopticCamera make_camera(const CameraParams& params)
     m.sampling.variance = sampling.variance;
     if (m.sampling.adaptive)
         m.sampling.thresholds = adaptive_thresholds(m.sampling.samples_max, m.sampling.confidence, m.sampling.variance);
+    m.sampling.aim = camera_can_aim(m);
 
     if (params.spectral.given()) {
         std::shared_ptr<SpectralCameras> spectral = std::make_shared<SpectralCameras>();

@@ -86,6 +86,9 @@ struct Sampling {
     double confidence = 0;
     double variance = 0;
     std::vector<double> thresholds; // adaptive stop thresholds, index n-1 for n samples
+    // Samples aimed where light passes (camera/aim.h: camera_can_aim); false samples every pixel
+    // and cell uniformly.
+    bool aim = false;
     // The metadata's samples section.
     MetadataJson metadata() const;
 };

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plenoptic/camera/aim.h"
 #include "plenoptic/camera/radiometry.h"
 #include "plenoptic/camera/rays_internal.h"
 
@@ -66,9 +67,11 @@ bool weigh(const PlenopticCamera& m, bool passed, Vec3 s, Vec3 q, Vec3 n, Optics
     return passed;
 }
 
-// The whole camera for one sensor point and one aperture sample (lens_u, lens_v).
+// The whole camera for one sensor point and one aperture sample (lens_u, lens_v); with `aim`, the
+// sample is drawn from the part of the microlens's cell where light from p can pass (camera/aim.h)
+// and the ray weighted by that part's share.
 bool trace_sensor_point(const PlenopticCamera& m, Vec3 p, const LensIndex* forced, double lens_u, double lens_v,
-                        bool check_apertures, OpticsRay* out)
+                        bool check_apertures, OpticsRay* out, bool aim = false)
 {
     if (m.array.grid == GridType::None && m.pupil_bounds && check_apertures) {
         // A real lens: towards a point of the region of the exit pupil's plane where light from p
@@ -115,7 +118,9 @@ bool trace_sensor_point(const PlenopticCamera& m, Vec3 p, const LensIndex* force
     }
 
     // Where the ray leaves the array, and its direction after the microlens (optics frame).
-    const ArrayRay ray = m.array.microlens->sample_ray(m.array, p, lens, lens_u, lens_v);
+    double aimed = 1;
+    const ArrayRay ray = aim ? aimed_cell_ray(m, p, lens, lens_u, lens_v, &aimed)
+                             : m.array.microlens->sample_ray(m.array, p, lens, lens_u, lens_v);
     if (!ray.passed)
         return false;  // the sensor point is not behind the array
     const Vec3& leave = ray.origin;
@@ -133,8 +138,10 @@ bool trace_sensor_point(const PlenopticCamera& m, Vec3 p, const LensIndex* force
         !m.pupil_bounds->may_pass(leave, direction))
         return false;
     // On through the main lens (a ray that misses its apertures carries no light).
-    return weigh(m, emit(m.lens->to_scene(leave, direction, check_apertures), out), p, ray.sampled, m.array.pose.normal,
-                 out);
+    const bool passed = weigh(m, emit(m.lens->to_scene(leave, direction, check_apertures), out), p, ray.sampled,
+                              m.array.pose.normal, out);
+    out->weight *= aimed;
+    return passed;
 }
 
 // Whether light through `lens` can reach some point of the pixel centred at p. With k = D/d
@@ -215,11 +222,29 @@ OwnLens own_lens(const PlenopticCamera& m, Vec3 p)
     return OwnLens{m.array.nearest(q.x, q.y), true};
 }
 
-OpticsRay generate_ray(const PlenopticCamera& m, int i, int j, const CameraSample& sample, const LensIndex* lens)
+OpticsRay generate_ray_unaimed(const PlenopticCamera& m, int i, int j, const CameraSample& sample, const LensIndex* lens)
 {
     const Vec3 p = m.sensor.point(i + sample.pixel_u, j + sample.pixel_v);
     OpticsRay ray;
     ray.passed = trace_sensor_point(m, p, lens, sample.lens_u, sample.lens_v, true, &ray);
+    return ray;
+}
+
+OpticsRay generate_ray(const PlenopticCamera& m, int i, int j, const CameraSample& sample, const LensIndex* lens)
+{
+    if (!m.sampling.aim)
+        return generate_ray_unaimed(m, i, j, sample, lens);
+    // The pixel's point where light through its lens can land, then the cell's part where light from
+    // there can pass; the weights of both choices multiply.
+    OpticsRay ray;
+    const PixelAim at = aim_pixel(m, i, j, sample.pixel_u, sample.pixel_v, lens);
+    if (!at.passed) {
+        ray.passed = false;
+        return ray;
+    }
+    const Vec3 p = m.sensor.point(at.pu, at.pv);
+    ray.passed = trace_sensor_point(m, p, at.lens_forced ? &at.lens : lens, sample.lens_u, sample.lens_v, true, &ray, true);
+    ray.weight *= at.weight;
     return ray;
 }
 

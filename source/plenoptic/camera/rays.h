@@ -19,7 +19,8 @@ struct OpticsRay {
     // What the ray's colour counts for in its pixel: 1, except for a real lens without an array,
     // whose samples cover a region of its exit pupil's plane (PupilBounds) rather than the paraxial
     // pupil: the region's area over the paraxial pupil's, so that a pixel's value does not depend
-    // on the region sampled. With a lit-area table (PlenopticCamera::lit_area, a round stop): the area of
+    // on the region sampled; and for an aimed sample behind an array (camera/aim.h): the sampled
+    // part's share of the pixel times its share of the cell. With a lit-area table (PlenopticCamera::lit_area, a round stop): the area of
     // the region's lit part over the paraxial pupil's, and the pixel averages its passing
     // samples only (shade_pixel).
     double weight;
@@ -44,7 +45,15 @@ OwnLens own_lens(const PlenopticCamera& model, Vec3 sensor_point_mm);
 // (overlap modelling); nullptr uses the own lens of the sample's sensor point. Not passed when
 // an aperture blocks the ray (it then carries no light: black, opaque). No allocation, no
 // search over lenses, no trigonometry except the concentric disc map of a bare main lens.
+// When the camera aims its samples (model.sampling.aim, camera/aim.h), the sample's pixel point and
+// cell point are drawn from the parts of the pixel and of the cell where light can pass, and the
+// ray's weight carries those parts' shares: the pixel's value is unchanged in expectation.
 OpticsRay generate_ray(const PlenopticCamera& model, int i, int j, const CameraSample& sample, const LensIndex* lens = nullptr);
+// The same with the sample's pixel point and cell point as they are, never aimed (uniform over
+// the pixel and the cell, weight 1 but for the radiometry): for those who ask whether light passes
+// at a given sensor point and cell point (the microimage truth, the dark-image check).
+OpticsRay generate_ray_unaimed(const PlenopticCamera& model, int i, int j, const CameraSample& sample,
+                               const LensIndex* lens = nullptr);
 
 // The lenses whose light can reach pixel (i, j) when the model models overlap: the pixel
 // centre's own lens first, then every neighbour within model.overlap.rings rings that passes a

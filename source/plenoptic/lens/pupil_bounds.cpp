@@ -192,6 +192,42 @@ PupilDisc PupilBounds::disc_for(Vec3 point) const
     return PupilDisc{Vec3{cx, cy, pupil_z_}, span.radius};
 }
 
+PupilDisc PupilBounds::disc_holding(Vec3 centre, double radius) const
+{
+    // disc_for(q) lies in span floor(|q| / step) turned to q's azimuth. For |q - c| <= radius the
+    // spans are those from (|c| - radius) to (|c| + radius), and the unit vector of q is within
+    // 2 radius / |c| of c's (|q/|q| - c/|c|| <= 2 |q - c| / |c|; at most 2 anyway): so each span's
+    // disc, turned to c's azimuth and widened by |centre_x| times that, holds the span's discs of
+    // every such q. When the cell may hold the axis the discs are centred on it instead.
+    const double r = std::sqrt(centre.x * centre.x + centre.y * centre.y);
+    radius = std::fabs(radius);
+    const double lo = std::max(0.0, r - radius) / step_mm_, hi = (r + radius) / step_mm_;
+    if (!(lo < kBins) || !std::isfinite(hi))
+        return PupilDisc{Vec3{0, 0, pupil_z_}, 0};
+    const int first = int(lo), last = std::min(kBins - 1, int(hi));
+    const bool about_axis = !(r > radius);
+    const double turn = about_axis ? 0 : std::min(2.0, 2 * radius / r);
+    double near = INFINITY, far = -INFINITY;  // along c's direction (or |.| about the axis)
+    for (int k = first; k <= last; ++k) {
+        const Bin& span = spans_[size_t(k)];
+        if (!(span.radius > 0))
+            continue;
+        if (about_axis) {
+            near = std::min(near, -(std::fabs(span.centre_x) + span.radius));
+            far = std::max(far, std::fabs(span.centre_x) + span.radius);
+        } else {
+            const double widened = span.radius + std::fabs(span.centre_x) * turn;
+            near = std::min(near, span.centre_x - widened);
+            far = std::max(far, span.centre_x + widened);
+        }
+    }
+    if (!(far >= near))
+        return PupilDisc{Vec3{0, 0, pupil_z_}, 0};
+    const double along = 0.5 * (near + far);
+    const double ux = about_axis ? 0 : centre.x / r, uy = about_axis ? 0 : centre.y / r;
+    return PupilDisc{Vec3{along * ux, along * uy, pupil_z_}, 0.5 * (far - near)};
+}
+
 bool PupilBounds::may_pass(Vec3 point, Vec3 direction) const
 {
     const double t = (pupil_z_ - point.z) / direction.z;

@@ -32,6 +32,10 @@ public:
     // The disc for a point of that plane (its z is not looked at): it holds every point of the
     // exit pupil's plane through which light from the point can pass.
     PupilDisc disc_for(Vec3 point) const;
+    // A disc holding disc_for(q) for every point q of the bounds' plane within `radius` of
+    // `centre` (its z is not looked at): where light from anywhere in a microlens's cell can pass.
+    // Radius 0 when no light passes from any of them.
+    PupilDisc disc_holding(Vec3 centre, double radius) const;
 
     // False when the ray from `point` (of the bounds' plane) along `direction` certainly misses the
     // lens: it crosses the exit pupil's plane outside disc_for(point). True otherwise (the ray may

@@ -136,5 +136,48 @@ TEST(PupilBounds, MayPassRefusesWhatMissesTheDisc)
     EXPECT_FALSE(bounds.may_pass(Vec3{2 * bounds.field_radius_mm(), 0, -45}, Vec3{0, 0, 1}));  // beyond the field
 }
 
+// disc_holding holds disc_for of every point of the region: points on a fine polar grid over the
+// region (its rim included), for regions on the axis, straddling it, between bins, across bins and
+// beyond the field's edge, each at several azimuths. And it is tight enough to be worth having: for a
+// microlens cell far from the axis it is barely larger than the disc of the cell's centre.
+TEST(PupilBounds, DiscHoldingHoldsTheDiscsOfEveryPointOfTheRegion)
+{
+    const Prescription lens = laikin_wide_angle(3.5);
+    const std::shared_ptr<const MainLens> traced = make_prescription_lens(lens, 0, true);
+    const PupilBounds bounds(lens, *traced, -40);
+    const double edge = bounds.field_radius_mm();
+    ASSERT_GT(edge, 0);
+    int checked = 0, escaped = 0;
+    for (double radius : {0.0, 0.00001, 0.012, 0.1, 0.7 * edge / 48, 3 * edge / 48}) {
+        for (int k = 0; k <= 60; ++k) {
+            const double r = 1.1 * edge * k / 60;
+            for (double azimuth : {0.0, 0.4, 2.5, -1.9}) {
+                const Vec3 centre{r * std::cos(azimuth), r * std::sin(azimuth), -40};
+                const PupilDisc held = bounds.disc_holding(centre, radius);
+                for (int ring = 0; ring <= 8; ++ring) {
+                    for (int a = 0; a < 48; ++a) {
+                        const double t = 2 * kPi * a / 48, s = radius * ring / 8;
+                        const Vec3 q{centre.x + s * std::cos(t), centre.y + s * std::sin(t), -40};
+                        const PupilDisc disc = bounds.disc_for(q);
+                        if (!(disc.radius > 0))
+                            continue;
+                        ++checked;
+                        const double reach = std::hypot(disc.centre.x - held.centre.x, disc.centre.y - held.centre.y) + disc.radius;
+                        if (!(reach <= held.radius * (1 + 1e-12) + 1e-12))
+                            ++escaped;
+                    }
+                }
+            }
+        }
+    }
+    EXPECT_GT(checked, 50000);
+    EXPECT_EQ(escaped, 0);
+    // A 20 um cell half-way out: the held disc exceeds the centre's by little.
+    const Vec3 half_way{0.5 * edge, 0.2, -40};
+    const PupilDisc own = bounds.disc_for(half_way), held = bounds.disc_holding(half_way, 0.012);
+    EXPECT_LT(held.radius, 1.1 * own.radius);
+    EXPECT_EQ(bounds.disc_holding(Vec3{2 * edge, 0, -40}, 0.01).radius, 0);  // beyond the field
+}
+
 } // namespace
 } // namespace plenoptic

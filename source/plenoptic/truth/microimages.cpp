@@ -46,7 +46,7 @@ public:
     bool lit(double u, double v) const
     {
         const CameraSample sample{u, v, lens_u_, lens_v_};
-        const OpticsRay ray = generate_ray(m_, 0, 0, sample, &lens_);
+        const OpticsRay ray = generate_ray_unaimed(m_, 0, 0, sample, &lens_);
         if (!ray.passed)
             return false;
         if (m_.overlap.modelled)

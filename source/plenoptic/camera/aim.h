@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Samples where light passes: behind an array, the main lens lights only part of each microlens
+// cell (and a pixel at a microimage's rim only part of its area). For ideal thin microlenses
+// (Microlens::aims) behind an image-forming main lens and an array parallel to the sensor, the
+// camera aims a pixel's samples at a conservative region holding every point where light can pass
+// and weights each sample by the sampled area over the whole (OpticsRay::weight), so that a pixel's
+// value is an unbiased estimate of the one uniform samples give.
+//
+// The geometry (array-local frame, lens centre c, focal length f, sensor point s at distance d
+// behind the lens plane): the ray from s through cell point h leaves the thin lens with slope
+// (h - s) / d - (h - c) / f, so it crosses the plane at distance Z in front of the lens at
+//     x(h, s) = g h - (Z / d) s + (Z / f) c,   g = 1 + Z / d - Z / f,
+// affine in h and in s. Light passes the main lens only where x lies in a disc (centre m, radius
+// rho) of that plane: the thin lens's aperture, the thick lens's exit pupil (both exact), a traced
+// lens's pupil bounds (PupilBounds::disc_holding over the cell: conservative). So
+//  - for a sensor point, the cell points whose rays can pass lie in the disc of centre
+//    (m + (Z / d) s - (Z / f) c) / g and radius rho / |g| (lit_cell_disc);
+//  - the sensor points that light through the lens can reach at all lie in the disc of centre
+//    (c (1 + Z / d) - m) d / Z and radius (rho + |g| R) d / Z, R the cell's circumradius
+//    (lit_sensor_disc: the microimage, conservatively).
+// Each region is sampled by its chords (sample_chords): x uniform over the region's x range, then y
+// uniform over the chord at x; the weight is the x range times the chord over the whole's area.
+
+#ifndef PLENOPTIC_AIM_H
+#define PLENOPTIC_AIM_H
+
+#include <cmath>
+
+#include "plenoptic/array/microlens.h"
+#include "plenoptic/camera/plenoptic_camera.h"
+#include "plenoptic/core/lattice.h"
+#include "plenoptic/core/vec.h"
+
+namespace plenoptic {
+
+// A disc in a plane parallel to the array (array-local x, y). Radius infinite: the whole plane.
+struct AimDisc {
+    Vec2 centre;
+    double radius;
+};
+
+// What aiming needs of one lens (array-local, mm): its centre and plane, focal length, the cell's
+// circumradius, and the disc of the plane Z in front of it (Z > 0) where light can pass the main
+// lens (radius 0: none passes through this lens).
+struct LensAim {
+    LensIndex lens;
+    Vec2 c;
+    double z;
+    double f;
+    double circumradius;
+    double Z;
+    Vec2 m;
+    double rho;
+};
+
+// Whether the camera aims its samples (PlenopticCamera::sampling.aim): behind an image-forming main
+// lens, with an array parallel to the sensor whose microlenses aim (Microlens::aims), and more than
+// one sample per pixel (one sample is the chief ray). make_camera sets it; the camera can clear it.
+bool camera_can_aim(const PlenopticCamera& model);
+
+// The lens's aim data; false when the lens cannot be aimed at (then sample it uniformly): a traced
+// lens without pupil bounds, a lens off the bounds' plane, a limiting plane not in front of it.
+bool lens_aim(const PlenopticCamera& model, LensIndex lens, LensAim* out);
+
+// The disc of sensor points (array-local x, y; the sensor d behind the lens plane, d > 0) holding
+// every sensor point from which a ray through the lens's cell can pass the main lens.
+AimDisc lit_sensor_disc(const LensAim& aim, double d);
+
+// The disc of cell points (array-local, from the lens's centre) holding every point through which
+// the ray from sensor point s (array-local, behind the lens) can pass the main lens; infinite
+// radius when every point can (g = 0).
+AimDisc lit_cell_disc(const LensAim& aim, Vec3 s);
+
+// Half the height of a lens's cell (core/lattice.h: cell_polygon, centred on the lens) at x from its
+// centre; negative outside the cell's x range.
+double cell_half_height(GridType grid, double pitch_mm, double x);
+
+// A point of a region sampled by its chords, and its weight (the sampled measure over the whole
+// region's); passed false when the chord at that x is empty (the sample carries no light).
+struct ChordSample {
+    Vec2 point;
+    double weight;
+    bool passed;
+};
+
+// The region {x0 <= x <= x1, |y - yc(x)| <= half(x)} intersected with the ellipse of centre e and
+// semi-axes (ax, ay), for sample (u, v): x uniform over [max(x0, xa), min(x1, xb)] (xa, xb: the
+// caller's x range of the intersection, or of the ellipse), y uniform over the chord at x. Weight:
+// the x range times the chord, over `area`.
+template <class HalfHeight>
+ChordSample sample_chords(double x0, double x1, double xa, double xb, HalfHeight half_height, Vec2 e, double ax,
+                          double ay, double area, double u, double v)
+{
+    const double lo = x0 > xa ? x0 : xa, hi = x1 < xb ? x1 : xb;
+    if (!(hi > lo))
+        return ChordSample{Vec2{0, 0}, 0, false};
+    const double x = lo + u * (hi - lo);
+    const double t = (x - e.x) / ax;
+    const double chord = ay * std::sqrt(t < 1 ? 1 - t * t : 0);
+    double y0, y1;
+    half_height(x, &y0, &y1);
+    const double a = y0 > e.y - chord ? y0 : e.y - chord, b = y1 < e.y + chord ? y1 : e.y + chord;
+    if (!(b > a))
+        return ChordSample{Vec2{x, e.y}, 0, false};
+    return ChordSample{Vec2{x, a + v * (b - a)}, (hi - lo) * (b - a) / area, true};
+}
+
+// Where a sample of pixel (i, j) looks (the pixel point (pu, pv) in pixel coordinates, corner
+// convention) and through which lens, with the weight of that choice. When the pixel lies partly
+// outside the lit_sensor_disc of its centre's lens, the point is drawn from the pixel's part in the
+// union of the discs of that lens and its neighbours (the lenses whose own regions the pixel can
+// meet; with a forced lens, overlap modelling, that lens's disc alone, and then lens_forced); a pixel
+// that no light reaches gets no point (passed false). Otherwise the sample's own point, weight 1.
+struct PixelAim {
+    double pu, pv;
+    double weight;
+    bool lens_forced;
+    LensIndex lens;
+    bool passed;
+};
+PixelAim aim_pixel(const PlenopticCamera& model, int i, int j, double pixel_u, double pixel_v, const LensIndex* forced);
+
+// The ray from sensor point p through `lens` for aperture sample (u, v), drawn from the part of
+// the cell where light from p can pass (lit_cell_disc), with *weight that part's sampled measure
+// over the cell's area; the uniform sample_ray (weight 1) when that part holds the whole cell or
+// the lens cannot be aimed at. Not passed when no point of the cell can pass.
+ArrayRay aimed_cell_ray(const PlenopticCamera& model, const Vec3& p, LensIndex lens, double u, double v, double* weight);
+
+} // namespace plenoptic
+
+#endif
