@@ -26,8 +26,11 @@ const double kSqrt3 = 1.7320508075688772935;
 
 bool camera_can_aim(const PlenopticCamera& m)
 {
+    // Lenses tilted by their errors and the unbent light of a clear gap (fill_factor) leave the
+    // thin lens's affine map; a mask would only block more, but is kept with the gap for simplicity.
     return m.lens && m.lens->forms_image() && m.array.grid != GridType::None && m.array.microlens &&
-           m.array.microlens->aims() && !m.array.pose.tilted && m.sampling.samples_max > 1;
+           m.array.microlens->aims() && !m.array.pose.tilted && !(m.array.errors && m.array.errors->tilts()) &&
+           !(m.array.fill_factor < 1) && m.sampling.samples_max > 1;
 }
 
 bool lens_aim(const PlenopticCamera& m, LensIndex lens, LensAim* out)
@@ -225,11 +228,13 @@ PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, doubl
         // Through the exit pupil's centre e the pixel projects onto the array scaled by
         // (array - e) / (sensor - e); a point within delta of the centre's projection belongs to
         // the centre's lens or a neighbour while delta < 0.25 pitch (the next ring is at least
-        // 1.15 pitch from any point of the cell, the cell's corners at most 0.71 pitch).
+        // 1.15 pitch from any point of the cell, the cell's corners at most 0.71 pitch), less
+        // 1.5 times the farthest a lens is displaced from its lattice place (its errors).
         const Vec3 e = m.lens->exit_pupil_centre();
         const double scale = (m.array.pose.centre_mm.z - e.z) / (m.sensor.z_mm - e.z);
         const double delta = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]) * std::fabs(scale);
-        if (!(delta < 0.25 * m.array.pitch_mm))
+        const double shift = m.array.errors ? m.array.errors->max_shift_mm() : 0;
+        if (!(delta + 1.5 * shift < 0.25 * m.array.pitch_mm))
             return out;
         const GridType grid = m.array.grid;
         const std::int64_t skew = skew_k(grid, lens);

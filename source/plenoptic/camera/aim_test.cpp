@@ -47,6 +47,18 @@ CameraParams triplet_camera(bool thick, double d, GridType grid)
     return with_pixels(p, 0.02);
 }
 
+// A camera whose lenses are displaced in the plane and along the axis and whose focal lengths
+// scatter (the array's errors).
+CameraParams with_errors(CameraParams p, double position_mm, double position_z_mm, double focal)
+{
+    p.array.has_errors = true;
+    p.array.errors.position_sd_mm = position_mm;
+    p.array.errors.position_sd_z_mm = position_z_mm;
+    p.array.errors.focal_sd = focal;
+    p.array.errors.seed = 7;
+    return p;
+}
+
 std::vector<AimCase> setups()
 {
     return {
@@ -57,6 +69,10 @@ std::vector<AimCase> setups()
         {"traced triplet, plenoptic 1.0", triplet_camera(false, 1.5, GridType::Hexagonal)},
         {"traced triplet, plenoptic 2.0", triplet_camera(false, 1.1, GridType::Hexagonal)},
         {"traced triplet, plenoptic 2.0, square", triplet_camera(false, 1.9, GridType::Rectangular)},
+        {"thin lens, plenoptic 1.0, lenses displaced and their focal lengths scattered",
+         with_errors(with_pixels(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52), 0.05), 0.01, 0.02, 0.03)},
+        {"traced triplet, plenoptic 2.0, lenses displaced in the plane and their focal lengths scattered",
+         with_errors(triplet_camera(false, 1.1, GridType::Hexagonal), 0.01, 0, 0.03)},
     };
 }
 
@@ -221,6 +237,13 @@ TEST(Aim, OffWhereItCannotAim)
     CameraParams turned = thin;
     test::set_pose(&turned, 0, 0, 30, 0, 0, 0);  // turned in its plane only: still parallel
     EXPECT_TRUE(make_camera(turned).sampling.aim);
+    CameraParams tilting = thin;
+    tilting.array.has_errors = true;
+    tilting.array.errors.rotation_deg = 1;  // lenses tilted by their errors
+    EXPECT_FALSE(make_camera(tilting).sampling.aim);
+    CameraParams gapped = thin;
+    gapped.array.fill_factor = 0.8;  // light through the gap is not bent
+    EXPECT_FALSE(make_camera(gapped).sampling.aim);
     CameraParams bare = thin;
     bare.main = MainLensParams();
     EXPECT_FALSE(make_camera(bare).sampling.aim);  // no main lens
