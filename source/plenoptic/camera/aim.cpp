@@ -199,9 +199,57 @@ struct Intervals {
 
 } // namespace
 
-PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, double pixel_v, const LensIndex* forced)
+namespace {
+
+// What a camera's aim depends on, to tell a cached plan's camera from another (a camera copied or
+// made at the same address differs in one of these when its geometry does).
+struct CameraKey {
+    const PlenopticCamera* camera;
+    const void* parts[4];
+    double geometry[12];
+    bool operator==(const CameraKey& o) const
+    {
+        if (camera != o.camera)
+            return false;
+        for (int k = 0; k < 4; ++k)
+            if (parts[k] != o.parts[k])
+                return false;
+        for (int k = 0; k < 12; ++k)
+            if (!(geometry[k] == o.geometry[k]))
+                return false;
+        return true;
+    }
+};
+
+CameraKey key_of(const PlenopticCamera& m)
 {
-    PixelAim out{i + pixel_u, j + pixel_v, 1, false, LensIndex{0, 0}, true};
+    const Sensor& s = m.sensor;
+    const ArrayPose& pose = m.array.pose;
+    return CameraKey{&m,
+                     {m.lens.get(), m.array.microlens.get(), m.pupil_bounds.get(), m.array.errors.get()},
+                     {s.z_mm, s.pixel_size_mm[0], s.pixel_size_mm[1], s.offset_mm[0], s.offset_mm[1], double(s.film.width),
+                      double(s.film.height), pose.centre_mm.x, pose.centre_mm.y, pose.centre_mm.z, pose.rotation.m[0][0],
+                      pose.rotation.m[0][1]}};
+}
+
+// A pixel's aim, worked out once for all its samples: its points are uniform (the whole pixel may be
+// lit), none (no light reaches it), or drawn from the union of `count` ellipses, whose x ranges
+// within the pixel are `xs` (of total length `width`).
+struct PixelPlan {
+    enum Kind { Uniform, Dark, Aimed } kind;
+    bool forced;
+    LensIndex lens;
+    int count;
+    PixelEllipse ellipses[kMaxParts];
+    Intervals xs;
+    double width;
+};
+
+void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced, PixelPlan* plan)
+{
+    plan->kind = PixelPlan::Uniform;
+    plan->forced = forced != nullptr;
+    plan->count = 0;
     const Vec3 middle = m.sensor.point(i + 0.5, j + 0.5);
     LensIndex lens;
     if (forced) {
@@ -209,18 +257,19 @@ PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, doubl
     } else {
         const OwnLens own = own_lens(m, middle);
         if (!own.found)
-            return out;
+            return;
         lens = own.lens;
     }
+    plan->lens = lens;
     LensAim a;
     PixelEllipse own_ellipse;
     const Vec3 s = m.array.to_local(middle);
     if (!lens_aim(m, lens, &a) || !pixel_ellipse(m, a, s, &own_ellipse) || holds_pixel(own_ellipse, i, j))
-        return out;  // the whole pixel may be lit: its own points, as the uniform samples
+        return;  // the whole pixel may be lit: its own points, as the uniform samples
     // The ellipses that can light the pixel: the forced lens's; or, for the pixel's own lenses, the
     // lens of its centre and its neighbours (the lattice cells a pixel far smaller than a cell can
     // meet: checked below).
-    PixelEllipse ellipses[kMaxParts];
+    PixelEllipse* ellipses = plan->ellipses;
     int count = 0;
     if (forced) {
         ellipses[count++] = own_ellipse;
@@ -235,7 +284,7 @@ PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, doubl
         const double delta = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]) * std::fabs(scale);
         const double shift = m.array.errors ? m.array.errors->max_shift_mm() : 0;
         if (!(delta + 1.5 * shift < 0.25 * m.array.pitch_mm))
-            return out;
+            return;
         const GridType grid = m.array.grid;
         const std::int64_t skew = skew_k(grid, lens);
         for (int dl = -1; dl <= 1; ++dl)
@@ -247,13 +296,14 @@ PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, doubl
                 if (dk == 0 && dl == 0)
                     e = own_ellipse;
                 else if (!lens_aim(m, other, &a) || !pixel_ellipse(m, a, s, &e))
-                    return out;
+                    return;
                 ellipses[count++] = e;
             }
     }
+    plan->count = count;
     // x: the union over the ellipses of the x range of the pixel's part in each (the ellipse's at
     // the pixel's row nearest its centre).
-    Intervals xs;
+    plan->xs = Intervals();
     for (int k = 0; k < count; ++k) {
         const PixelEllipse& e = ellipses[k];
         const double row = e.cv < j ? j : (e.cv > j + 1 ? j + 1 : e.cv);
@@ -261,20 +311,58 @@ PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, doubl
         if (!(t * t <= 1))
             continue;
         const double reach = e.au * std::sqrt(1 - t * t);
-        xs.add(std::max<double>(i, e.cu - reach), std::min<double>(i + 1, e.cu + reach));
+        plan->xs.add(std::max<double>(i, e.cu - reach), std::min<double>(i + 1, e.cu + reach));
     }
-    const double width = xs.merge();
-    if (!(width > 0)) {
+    plan->width = plan->xs.merge();
+    plan->kind = plan->width > 0 ? PixelPlan::Aimed : PixelPlan::Dark;
+}
+
+// The plan of the pixel last asked for on this thread (samples come pixel by pixel).
+struct CachedPlan {
+    bool valid = false;
+    CameraKey key;
+    int i = 0, j = 0;
+    bool forced = false;
+    LensIndex forced_lens{0, 0};
+    PixelPlan plan;
+};
+
+} // namespace
+
+PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, double pixel_v, const LensIndex* forced)
+{
+    PixelAim out{i + pixel_u, j + pixel_v, 1, false, LensIndex{0, 0}, true};
+    static thread_local CachedPlan cache;
+    const CameraKey key = key_of(m);
+    if (!(cache.valid && cache.i == i && cache.j == j && cache.forced == (forced != nullptr) &&
+          (!forced || cache.forced_lens == *forced) && cache.key == key)) {
+        plan_pixel(m, i, j, forced, &cache.plan);
+        cache.valid = true;
+        cache.key = key;
+        cache.i = i;
+        cache.j = j;
+        cache.forced = forced != nullptr;
+        if (forced)
+            cache.forced_lens = *forced;
+    }
+    const PixelPlan& plan = cache.plan;
+    if (plan.kind == PixelPlan::Uniform)
+        return out;
+    if (plan.forced) {
+        out.lens_forced = true;
+        out.lens = plan.lens;
+    }
+    if (plan.kind == PixelPlan::Dark) {
         out.passed = false;  // no light reaches the pixel
         return out;
     }
-    const double x = xs.at(pixel_u, width);
+    const double x = plan.xs.at(pixel_u, plan.width);
     // y: the union of the chords at x within the pixel's rows.
     Intervals ys;
-    for (int k = 0; k < count; ++k) {
-        const double half = chord(ellipses[k], x);
+    for (int k = 0; k < plan.count; ++k) {
+        const double half = chord(plan.ellipses[k], x);
         if (half >= 0)
-            ys.add(std::max<double>(j, ellipses[k].cv - half), std::min<double>(j + 1, ellipses[k].cv + half));
+            ys.add(std::max<double>(j, plan.ellipses[k].cv - half), std::min<double>(j + 1, plan.ellipses[k].cv + half));
     }
     const double height = ys.merge();
     if (!(height > 0)) {
@@ -283,11 +371,7 @@ PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, doubl
     }
     out.pu = x;
     out.pv = ys.at(pixel_v, height);
-    out.weight = width * height;
-    if (forced) {
-        out.lens_forced = true;
-        out.lens = lens;
-    }
+    out.weight = plan.width * height;
     return out;
 }
 
@@ -295,9 +379,23 @@ ArrayRay aimed_cell_ray(const PlenopticCamera& m, const Vec3& p, LensIndex lens,
 {
     *weight = 1;
     const MicrolensArray& array = m.array;
-    LensAim a;
-    if (!lens_aim(m, lens, &a))
+    // The lens last aimed at on this thread (a pixel's samples mostly go through one lens).
+    struct CachedLens {
+        bool valid = false, aimed = false;
+        CameraKey key;
+        LensAim aim;
+    };
+    static thread_local CachedLens cache;
+    const CameraKey key = key_of(m);
+    if (!(cache.valid && cache.aim.lens == lens && cache.key == key)) {
+        cache.aimed = lens_aim(m, lens, &cache.aim);
+        cache.aim.lens = lens;
+        cache.key = key;
+        cache.valid = true;
+    }
+    if (!cache.aimed)
         return array.microlens->sample_ray(array, p, lens, u, v);
+    const LensAim& a = cache.aim;
     const Vec3 s = array.to_local(p);
     if (!(a.z - s.z > 0))
         return array.microlens->sample_ray(array, p, lens, u, v);

@@ -232,8 +232,12 @@ OpticsRay generate_ray_unaimed(const PlenopticCamera& m, int i, int j, const Cam
 
 OpticsRay generate_ray(const PlenopticCamera& m, int i, int j, const CameraSample& sample, const LensIndex* lens)
 {
-    if (!m.sampling.aim)
-        return generate_ray_unaimed(m, i, j, sample, lens);
+    if (!m.sampling.aim) {
+        const Vec3 p = m.sensor.point(i + sample.pixel_u, j + sample.pixel_v);
+        OpticsRay ray;
+        ray.passed = trace_sensor_point(m, p, lens, sample.lens_u, sample.lens_v, true, &ray);
+        return ray;
+    }
     // The pixel's point where light through its lens can land, then the cell's part where light from
     // there can pass; the weights of both choices multiply.
     OpticsRay ray;
