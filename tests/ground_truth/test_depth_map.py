@@ -122,8 +122,14 @@ def test_depth_map(args):
     assert (not (lit & surely_blocked).any()), ("every pixel whose chief ray crosses the main lens %.2f mm "
                  "outside the aperture is -1 (%d are not)" % (spread, (lit & surely_blocked).sum()))
     black = (image == 0).all(axis=2)
-    assert (np.array_equal(blocked, black)), ("-1 exactly where the pixel is black (%d pixels -1, %d black, "
-                 "%d disagree)" % (blocked.sum(), black.sum(), (blocked != black).sum()))
+    # -1 where the pixel is black. The camera aims its samples where light passes (docs/camera.md,
+    # "Sampling"), so it also finds slivers of light too faint for the 16-bit image: such a pixel is
+    # black without being -1, and lies at the rim of the lit field (never where light surely reaches).
+    assert not (blocked & ~black).any(), "every -1 pixel is black (%d are not)" % (blocked & ~black).sum()
+    faint = black & ~blocked
+    assert (not (faint & surely_lit).any() and faint.sum() <= 0.01 * W * H), (
+        "a black pixel that is not -1 receives light too faint for the image, at the rim of the lit field "
+        "(%d such pixels, %d of them where light surely reaches)" % (faint.sum(), (faint & surely_lit).sum()))
     others = np.isfinite(measured) & ~blocked
     assert not (measured[others] < 0).any(), "no other negative depths (%d)" % (measured[others] < 0).sum()
 

@@ -220,7 +220,10 @@ Rgbt shade_samples(const PlenopticCamera& model, int i, int j, TraceFn& trace, c
         }
         if (lit_area)
             return lit_area_value(model, i, j, count, passed, sum, trace, stream);
-        if (budget.pixel_count > 1 && passed < count)
+        // Aimed samples (camera/aim.h) carry weights, and choosing the probes' ratio estimate only
+        // when some sample was blocked would bias the pixel by the weights that passed: their plain
+        // mean is unbiased, and few of them are blocked.
+        if (budget.pixel_count > 1 && passed < count && !model.sampling.aim)
             return vignetted_value(model, i, j, count, passed, sum, trace, stream);
         return Rgbt{sum[0] / count, sum[1] / count, sum[2] / count, sum[3] / count};
     }
@@ -278,7 +281,7 @@ Rgbt shade_samples(const PlenopticCamera& model, int i, int j, TraceFn& trace, c
     }
     if (lens_count == 1 && budget.pixel_count > 1 && model.lit_area)
         return lit_area_value(model, i, j, n, passed, plain, trace, stream);
-    if (lens_count == 1 && budget.pixel_count > 1 && passed < n)
+    if (lens_count == 1 && budget.pixel_count > 1 && passed < n && !model.sampling.aim)
         return vignetted_value(model, i, j, n, passed, sums[0].sum, trace, stream);
     estimate(sums, lens_count, value, variance);
     const double t = lens_count > 1 ? std::min(1.0, std::max(0.0, value[3])) : value[3];
@@ -349,7 +352,8 @@ Rgbt spectral_pixel(const PlenopticCamera& model, int i, int j, TraceFn& trace)
 // black and opaque (0, 0, 0, t = 0). Fixed count: model.sampling.samples_max samples. Adaptive (as
 // focal_blur): samples_min samples, then batches of 4, stopping once at least one sample has
 // passed the apertures and the variance of the estimate is below thresholds[n-1] in every
-// channel (r, g, b, t), or samples_max is reached. When some of the n samples were blocked, the
+// channel (r, g, b, t), or samples_max is reached. When some of the n samples were blocked (and the
+// camera does not aim them: aimed samples, camera/aim.h, take their plain weighted mean), the
 // value is detail::vignetted_value: the mean of the traced colours times the fraction of 4n
 // sample points that pass (no scene ray for those). Behind a real lens with a lit-area table
 // (no array, round stop) every pixel of n > 1 samples is the mean colour of its passing samples

@@ -70,8 +70,10 @@ bool weigh(const PlenopticCamera& m, bool passed, Vec3 s, Vec3 q, Vec3 n, Optics
 // The whole camera for one sensor point and one aperture sample (lens_u, lens_v); with `aim`, the
 // sample is drawn from the part of the microlens's cell where light from p can pass (camera/aim.h)
 // and the ray weighted by that part's share.
-bool trace_sensor_point(const PlenopticCamera& m, Vec3 p, const LensIndex* forced, double lens_u, double lens_v,
-                        bool check_apertures, OpticsRay* out, bool aim = false)
+// (A template, so that the uniform path compiles as it did before aiming: no cost where nothing aims.)
+template <bool aim>
+bool trace_sensor_point_as(const PlenopticCamera& m, Vec3 p, const LensIndex* forced, double lens_u, double lens_v,
+                           bool check_apertures, OpticsRay* out)
 {
     if (m.array.grid == GridType::None && m.pupil_bounds && check_apertures) {
         // A real lens: towards a point of the region of the exit pupil's plane where light from p
@@ -142,6 +144,12 @@ bool trace_sensor_point(const PlenopticCamera& m, Vec3 p, const LensIndex* force
                               m.array.pose.normal, out);
     out->weight *= aimed;
     return passed;
+}
+
+bool trace_sensor_point(const PlenopticCamera& m, Vec3 p, const LensIndex* forced, double lens_u, double lens_v,
+                        bool check_apertures, OpticsRay* out)
+{
+    return trace_sensor_point_as<false>(m, p, forced, lens_u, lens_v, check_apertures, out);
 }
 
 // Whether light through `lens` can reach some point of the pixel centred at p. With k = D/d
@@ -222,7 +230,11 @@ OwnLens own_lens(const PlenopticCamera& m, Vec3 p)
     return OwnLens{m.array.nearest(q.x, q.y), true};
 }
 
-OpticsRay generate_ray_unaimed(const PlenopticCamera& m, int i, int j, const CameraSample& sample, const LensIndex* lens)
+namespace {
+
+// The sample's own pixel point and cell point (inline in both callers: the uniform path costs what
+// it did before aiming).
+inline OpticsRay uniform_ray(const PlenopticCamera& m, int i, int j, const CameraSample& sample, const LensIndex* lens)
 {
     const Vec3 p = m.sensor.point(i + sample.pixel_u, j + sample.pixel_v);
     OpticsRay ray;
@@ -230,14 +242,17 @@ OpticsRay generate_ray_unaimed(const PlenopticCamera& m, int i, int j, const Cam
     return ray;
 }
 
+} // namespace
+
+OpticsRay generate_ray_unaimed(const PlenopticCamera& m, int i, int j, const CameraSample& sample, const LensIndex* lens)
+{
+    return uniform_ray(m, i, j, sample, lens);
+}
+
 OpticsRay generate_ray(const PlenopticCamera& m, int i, int j, const CameraSample& sample, const LensIndex* lens)
 {
-    if (!m.sampling.aim) {
-        const Vec3 p = m.sensor.point(i + sample.pixel_u, j + sample.pixel_v);
-        OpticsRay ray;
-        ray.passed = trace_sensor_point(m, p, lens, sample.lens_u, sample.lens_v, true, &ray);
-        return ray;
-    }
+    if (!m.sampling.aim)
+        return uniform_ray(m, i, j, sample, lens);
     // The pixel's point where light through its lens can land, then the cell's part where light from
     // there can pass; the weights of both choices multiply.
     OpticsRay ray;
@@ -247,8 +262,9 @@ OpticsRay generate_ray(const PlenopticCamera& m, int i, int j, const CameraSampl
         return ray;
     }
     const Vec3 p = m.sensor.point(at.pu, at.pv);
-    ray.passed = trace_sensor_point(m, p, at.lens_forced ? &at.lens : lens, sample.lens_u, sample.lens_v, true, &ray, true);
-    ray.weight *= at.weight;
+    ray.passed = trace_sensor_point_as<true>(m, p, at.lens_forced ? &at.lens : lens, sample.lens_u, sample.lens_v, true, &ray);
+    if (ray.passed)
+        ray.weight *= at.weight;
     return ray;
 }
 
