@@ -87,7 +87,7 @@ public:
         (void)p;
         (void)lens;
         (void)offset;
-        return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false};
+        return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false, Vec3{0, 0, 0}};
     }
 
     // The ray from sensor point p through lens `lens` that leaves the lens heading for `target` (a

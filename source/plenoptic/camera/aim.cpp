@@ -415,7 +415,7 @@ ArrayRay aimed_cell_ray(const PlenopticCamera& m, const Vec3& p, LensIndex lens,
         },
         disc.centre, disc.radius, disc.radius, area, u, v);
     if (!sample.passed)
-        return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false};
+        return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false, Vec3{0, 0, 0}};
     *weight = sample.weight;
     return array.microlens->cell_ray(array, p, lens, sample.point);
 }

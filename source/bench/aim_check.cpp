@@ -1,0 +1,245 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// plenoptic_aim_check: whether the samples aimed where light passes (camera/aim.h) give the pixel
+// values uniform samples give, in expectation (a statistical check, not a timing). It builds the
+// camera as plenoptic_pass_fractions does (a real lens file, exact or --thick, the matched
+// hexagonal array) and, over the pixels of a patch at the centre, an edge and a corner of the
+// sensor, compares three estimates of each pixel under a made-up scene (a radiance that is a
+// function of the ray leaving the camera, so no renderer is needed):
+//   - reference: the plain mean of REF uniform samples (ray weight times radiance; unbiased);
+//   - unaimed: shade_pixel at S samples with the aiming off (the vignetting probes' ratio);
+//   - aimed: shade_pixel at S samples with the aiming on (the plain mean of weighted samples).
+// The per-pixel samples are randomised quasi-Monte Carlo points (each pixel's own rotation), so
+// the errors of different pixels are independent: the mean over N pixels of (estimate -
+// reference) and its standard error (the spread of those differences over sqrt N) say whether an
+// estimate is biased. The pixels are split into rim pixels (reference below 0.98 of the patch's
+// brightest, above 0) and interior ones. Prints one JSON object.
+//
+//   plenoptic_aim_check --lens-file FILE --f-number N --focus-distance Z --sensor W H PIXEL_MM
+//       --array-matched PITCH_MM [--thick] [--samples S] [--reference REF] [--patch P]
+//       [--scene white|stripes]
+//
+// Scenes: white (radiance 1 everywhere: the estimate is the pixel's lit measure), stripes
+// (radiance 1 + 0.8 sin(400 dx) with dx the ray's x direction: varies across a cell's rays).
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "plenoptic/camera/params.h"
+#include "plenoptic/camera/pixel.h"
+#include "plenoptic/camera/plenoptic_camera.h"
+#include "plenoptic/core/sampling.h"
+#include "plenoptic/lens/main_lens.h"
+#include "plenoptic/lens/prescription.h"
+#include "plenoptic/optics.h"
+
+namespace {
+
+using namespace plenoptic;
+
+struct Options {
+    std::string lens_file;
+    double f_number = 0, focus_distance = 0;
+    int width = 0, height = 0;
+    double pixel_mm = 0, pitch_mm = 0;
+    bool thick = false;
+    int samples = 16, reference = 1024, patch = 48;
+    bool stripes = false;
+};
+
+bool parse(int argc, char** argv, Options* o)
+{
+    for (int a = 1; a < argc; ++a) {
+        const std::string arg = argv[a];
+        const int left = argc - a - 1;
+        if (arg == "--lens-file" && left >= 1)
+            o->lens_file = argv[++a];
+        else if (arg == "--f-number" && left >= 1)
+            o->f_number = std::atof(argv[++a]);
+        else if (arg == "--focus-distance" && left >= 1)
+            o->focus_distance = std::atof(argv[++a]);
+        else if (arg == "--sensor" && left >= 3) {
+            o->width = std::atoi(argv[++a]);
+            o->height = std::atoi(argv[++a]);
+            o->pixel_mm = std::atof(argv[++a]);
+        } else if (arg == "--array-matched" && left >= 1)
+            o->pitch_mm = std::atof(argv[++a]);
+        else if (arg == "--thick")
+            o->thick = true;
+        else if (arg == "--samples" && left >= 1)
+            o->samples = std::atoi(argv[++a]);
+        else if (arg == "--reference" && left >= 1)
+            o->reference = std::atoi(argv[++a]);
+        else if (arg == "--patch" && left >= 1)
+            o->patch = std::atoi(argv[++a]);
+        else if (arg == "--scene" && left >= 1) {
+            const std::string s = argv[++a];
+            if (s != "white" && s != "stripes")
+                return false;
+            o->stripes = s == "stripes";
+        } else
+            return false;
+    }
+    return !o->lens_file.empty() && o->f_number > 0 && o->focus_distance > 0 && o->width > 0 && o->height > 0 &&
+           o->pixel_mm > 0 && o->pitch_mm > 0 && o->samples >= 2 && o->reference >= 2 && o->patch > 0;
+}
+
+CameraParams camera(const Options& o, const Prescription& lens, double focal_mm)
+{
+    CameraParams p;
+    p.main.given = true;
+    p.main.type = o.thick ? MainLensType::ThickLens : MainLensType::Prescription;
+    p.main.has_prescription = true;
+    p.main.prescription = lens;
+    p.main.lens_file = o.lens_file;
+    p.main.has_f_number = true;
+    p.main.f_number = o.f_number;
+    p.main.has_focus_distance = true;
+    p.main.focus_distance_units = o.focus_distance;
+    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = o.pixel_mm;
+    if (focal_mm > 0) {
+        p.array.given = true;
+        p.array.grid = GridType::Hexagonal;
+        p.array.has_pitch = true;
+        p.array.pitch_mm = o.pitch_mm;
+        p.array.has_lens = true;
+        p.array.lens = MicrolensType::ThinLens;
+        p.array.focal_length_count = 1;
+        p.array.focal_lengths_mm[0] = focal_mm;
+        p.array.has_distance = true;
+        p.array.distance_mm = focal_mm;
+    }
+    p.sampling.samples = o.samples;
+    return p;
+}
+
+struct Stat {
+    long long n = 0;
+    double sum = 0, sum_sq = 0;
+    void add(double x)
+    {
+        ++n;
+        sum += x;
+        sum_sq += x * x;
+    }
+    double mean() const { return n > 0 ? sum / n : 0; }
+    double standard_error() const
+    {
+        if (n < 2)
+            return 0;
+        const double m = mean();
+        return std::sqrt(std::max(0.0, (sum_sq / n - m * m) / (n - 1)));
+    }
+};
+
+std::string stat_json(const Stat& s)
+{
+    char text[160];
+    std::snprintf(text, sizeof text, "{\"pixels\": %lld, \"mean\": %.3e, \"standard_error\": %.3e}", s.n, s.mean(),
+                  s.standard_error());
+    return text;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    Options o;
+    if (!parse(argc, argv, &o)) {
+        std::fprintf(stderr, "usage: plenoptic_aim_check --lens-file FILE --f-number N --focus-distance Z --sensor W H "
+                             "PIXEL_MM --array-matched PITCH_MM [--thick] [--samples S] [--reference REF] [--patch P] "
+                             "[--scene white|stripes]\n");
+        return 2;
+    }
+    std::ifstream file(o.lens_file);
+    std::stringstream text;
+    text << file.rdbuf();
+    const ParsedPrescription parsed = parse_lens_file(text.str());
+    if (!file || parsed.error.any()) {
+        std::fprintf(stderr, "plenoptic_aim_check: cannot read %s\n", o.lens_file.c_str());
+        return 1;
+    }
+    double focal_mm;
+    {
+        const PlenopticCamera first = make_camera(camera(o, parsed.prescription, 0));
+        const double exit_pupil_z = first.lens_length_mm() - first.paraxial().exit_pupil_z;
+        focal_mm = o.pitch_mm * (exit_pupil_z + first.distance_mm) / first.paraxial().exit_pupil_mm;
+    }
+    const CameraParams params = camera(o, parsed.prescription, focal_mm);
+    const std::string error = check_camera(params);
+    if (!error.empty()) {
+        std::fprintf(stderr, "plenoptic_aim_check: %s\n", error.c_str());
+        return 1;
+    }
+    const PlenopticCamera aimed = with_film(make_camera(params), o.width, o.height);
+    PlenopticCamera unaimed = aimed;
+    unaimed.sampling.aim = false;
+    const bool stripes = o.stripes;
+    auto radiance = [stripes](const OpticsRay& ray) {
+        if (!stripes)
+            return 1.0;
+        const double norm = std::sqrt(ray.dir.x * ray.dir.x + ray.dir.y * ray.dir.y + ray.dir.z * ray.dir.z);
+        return 1 + 0.8 * std::sin(400 * ray.dir.x / norm);
+    };
+    auto trace = [&radiance](const OpticsRay& ray) {
+        const double v = radiance(ray);
+        return Rgbt{v, v, v, 0};
+    };
+    const int W = o.width, H = o.height, side = std::min(o.patch, std::min(W, H));
+    struct Place {
+        const char* name;
+        int i0, j0;
+    };
+    const Place places[] = {{"centre", W / 2 - side / 2, H / 2 - side / 2},
+                            {"edge", W - side, H / 2 - side / 2},
+                            {"corner", W - side, H - side}};
+    std::printf("{\"lens_file\": \"%s\", \"thick_lens\": %s, \"scene\": \"%s\", \"samples\": %d, \"reference\": %d, "
+                "\"patch\": %d, \"aiming\": %s,\n \"places\": [\n",
+                o.lens_file.c_str(), o.thick ? "true" : "false", stripes ? "stripes" : "white", o.samples, o.reference,
+                side, aimed.sampling.aim ? "true" : "false");
+    for (int k = 0; k < 3; ++k) {
+        const Place& p = places[k];
+        std::vector<double> reference, old_value, new_value;
+        double brightest = 0;
+        for (int j = p.j0; j < p.j0 + side; ++j)
+            for (int i = p.i0; i < p.i0 + side; ++i) {
+                double sum = 0;
+                for (int n = 0; n < o.reference; ++n) {
+                    const OpticsRay ray = unaimed.generate_ray(i, j, make_sample(i, j, n, o.reference));
+                    if (ray.passed)
+                        sum += ray.weight * radiance(ray);
+                }
+                reference.push_back(sum / o.reference);
+                brightest = std::max(brightest, reference.back());
+                old_value.push_back(shade_pixel(unaimed, i, j, trace).r);
+                new_value.push_back(shade_pixel(aimed, i, j, trace).r);
+            }
+        Stat old_rim, new_rim, old_inside, new_inside, old_all, new_all, paired;
+        for (size_t n = 0; n < reference.size(); ++n) {
+            const double r = reference[n];
+            const bool dark = !(r > 0) && old_value[n] == 0 && new_value[n] == 0;
+            if (dark)
+                continue;
+            const bool rim = r < 0.98 * brightest;
+            (rim ? old_rim : old_inside).add(old_value[n] - r);
+            (rim ? new_rim : new_inside).add(new_value[n] - r);
+            old_all.add(old_value[n] - r);
+            new_all.add(new_value[n] - r);
+            paired.add(new_value[n] - old_value[n]);
+        }
+        std::printf("  {\"place\": \"%s\", \"first_pixel\": [%d, %d], \"brightest\": %.6f,\n", p.name, p.i0, p.j0,
+                    brightest);
+        std::printf("   \"unaimed_minus_reference\": {\"all\": %s, \"rim\": %s, \"inside\": %s},\n",
+                    stat_json(old_all).c_str(), stat_json(old_rim).c_str(), stat_json(old_inside).c_str());
+        std::printf("   \"aimed_minus_reference\": {\"all\": %s, \"rim\": %s, \"inside\": %s},\n",
+                    stat_json(new_all).c_str(), stat_json(new_rim).c_str(), stat_json(new_inside).c_str());
+        std::printf("   \"aimed_minus_unaimed\": %s}%s\n", stat_json(paired).c_str(), k < 2 ? "," : "");
+    }
+    std::printf(" ]}\n");
+    return 0;
+}
