@@ -42,7 +42,7 @@ bool lens_aim(const PlenopticCamera& m, LensIndex lens, LensAim* out)
         // The bounds are for points of one plane: a lens off it (displaced along the axis) is not aimed at.
         if (!(std::fabs(centre.z - m.pupil_bounds->plane_z()) <= 1e-9 * (1 + std::fabs(centre.z))))
             return false;
-        disc = m.pupil_bounds->disc_holding(centre, circumradius);
+        disc = m.pupil_bounds->disc_holding(centre, circumradius, true);
     } else if (m.lens->traced()) {
         return false;
     } else {

@@ -222,6 +222,10 @@ PlenopticCamera make_camera(const CameraParams& params)
     if (m.sampling.adaptive)
         m.sampling.thresholds = adaptive_thresholds(m.sampling.samples_max, m.sampling.confidence, m.sampling.variance);
     m.sampling.aim = camera_can_aim(m);
+    // Behind a traced lens, bounds with tight discs to aim by (the spectral bands' cameras, made
+    // below at their wavelengths, aim by the bounds' own discs).
+    if (m.sampling.aim && m.pupil_bounds && m.array.grid != GridType::None && !params.spectral.given())
+        m.pupil_bounds = m.lens->pupil_bounds(m.array.pose.centre_mm.z, true);
 
     if (params.spectral.given()) {
         std::shared_ptr<SpectralCameras> spectral = std::make_shared<SpectralCameras>();

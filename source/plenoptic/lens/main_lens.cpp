@@ -385,13 +385,13 @@ public:
           image_distance_mm_(image_distance_mm)
     {
     }
-    std::shared_ptr<const PupilBounds> pupil_bounds(double plane_z) const override
+    std::shared_ptr<const PupilBounds> pupil_bounds(double plane_z, bool tight) const override
     {
         // The round stop holds the iris: bounds from the lens without blades hold the lens with them.
         Prescription round = *prescription();
         round.blades = 0;
         const std::shared_ptr<const MainLens> traced = make_prescription_lens(round, 0, true, image_distance_mm_);
-        return std::make_shared<PupilBounds>(round, *traced, plane_z);
+        return std::make_shared<PupilBounds>(round, *traced, plane_z, tight);
     }
     std::shared_ptr<const LitAreaTable> lit_area(const PupilBounds& bounds, double irradiance_k_mm2,
                                                  double angular_exponent) const override

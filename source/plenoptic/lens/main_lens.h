@@ -97,9 +97,11 @@ public:
     // Where light from points of the plane z = plane_z (the array, or the sensor) passes the lens:
     // made for a lens traced surface by surface (lens/pupil_bounds.h); nullptr for the others,
     // whose exit pupil says it.
-    virtual std::shared_ptr<const PupilBounds> pupil_bounds(double plane_z) const
+    // With `tight`, the bounds also hold tight discs for aimed samples (PupilBounds, camera/aim.h).
+    virtual std::shared_ptr<const PupilBounds> pupil_bounds(double plane_z, bool tight = false) const
     {
         (void)plane_z;
+        (void)tight;
         return nullptr;
     }
     // Without an array: the lit area of the exit pupil's plane per sensor radius, from these

@@ -26,6 +26,12 @@ const int kAzimuths = 64;        // boundary directions refined by bisection
 const int kBisections = 24;      // steps of each bisection (2^-24 of the grid radius)
 const double kMargin = 1.01;     // radius margin for the bins, and again for points between them
 const int kMaxFieldDoublings = 60;
+// Tight discs (for aiming): boundary directions, field radii measured per span besides its two
+// bins, and the margin on each span's radius for what lies between the measured radii (validated
+// by brute force in pupil_bounds_test).
+const int kTightAzimuths = 256;
+const int kTightBetween = 3;
+const double kTightMargin = 1.001;
 // A lens with a conic or aspheric surface: its rear surface's sag is sampled at kAsphereSagSamples
 // heights for the search square, and every disc's radius is widened by kAsphereMargin more (an
 // asphere can make the passing region less convex than spheres do).
@@ -71,8 +77,10 @@ void search_square(const Prescription& lens, double r, double plane_z, double pu
 }
 
 // Whether any ray from field radius r passes, and then the bin's disc.
-bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* centre_x, double* radius)
+bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* centre_x, double* radius,
+              bool tight = false)
 {
+    const int azimuths = tight ? kTightAzimuths : kAzimuths;
     double sx, half;
     search_square(lens, r, probe.plane_z, probe.pupil_z, &sx, &half);
     if (!(std::isfinite(sx) && std::isfinite(half) && half > 0))
@@ -98,31 +106,87 @@ bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* ce
     for (const Vec2& p : passing)
         grid_radius = std::max(grid_radius, std::hypot(p.x - cx, p.y));
     grid_radius += 2 * cell;  // a passing point lies within a cell diagonal of a passing grid point
-    double refined = 0;
-    if (probe.passes(r, cx, 0)) {
-        for (int k = 0; k < kAzimuths; ++k) {
-            const double angle = 2 * kPi * k / kAzimuths;
+    // The boundary measured along `azimuths` directions from (x0, 0), by bisection: the radius of a
+    // disc about it that holds the region (infinite when the region is not star-shaped about it),
+    // and the x extent of the boundary points.
+    auto refine = [&](double x0, double* x_lo, double* x_hi) {
+        if (!probe.passes(r, x0, 0))
+            return double(INFINITY);
+        double reach = 0;
+        *x_lo = INFINITY;
+        *x_hi = -INFINITY;
+        std::vector<Vec2> ends;  // tight: the bisections' outer ends, from (x0, 0)
+        if (tight)
+            ends.reserve(size_t(azimuths));
+        for (int k = 0; k < azimuths; ++k) {
+            const double angle = 2 * kPi * k / azimuths;
             const double dx = std::cos(angle), dy = std::sin(angle);
-            double inside = 0, outside = grid_radius;
+            double inside = 0, outside = grid_radius + std::fabs(x0 - cx);
             for (int s = 0; s < kBisections; ++s) {
                 const double mid = 0.5 * (inside + outside);
-                if (probe.passes(r, cx + mid * dx, mid * dy))
+                if (probe.passes(r, x0 + mid * dx, mid * dy))
                     inside = mid;
                 else
                     outside = mid;
             }
-            refined = std::max(refined, outside);
+            reach = std::max(reach, outside);
+            *x_lo = std::min(*x_lo, x0 + outside * dx);
+            *x_hi = std::max(*x_hi, x0 + outside * dx);
+            if (tight)
+                ends.push_back(Vec2{outside * dx, outside * dy});
         }
-        // Between two of the directions a convex region's boundary reaches at most 1 / cos(pi / n)
-        // times farther; and a region the bisection misread must still hold the grid's points.
-        refined /= std::cos(kPi / kAzimuths);
+        if (tight) {
+            // A convex region's boundary between directions k and k + 1 lies in the triangle of the
+            // chord from end k to end k + 1 and the lines through ends k - 1, k and k + 2, k + 1
+            // (a boundary point beyond either line would put end k or k + 1 inside the region): so
+            // the apex where those lines meet bounds it, also at a corner of the region (where the
+            // boundary turns sharply between two directions). Where the lines do not meet beyond
+            // the chord (the region is not convex there, or straight), the chord's ends over
+            // cos(pi / n), as the bounds take it.
+            const double slack = 1 / std::cos(kPi / azimuths);
+            double bound = reach;
+            for (int k = 0; k < azimuths; ++k) {
+                const Vec2 p0 = ends[size_t((k + azimuths - 1) % azimuths)], p1 = ends[size_t(k)];
+                const Vec2 q1 = ends[size_t((k + 1) % azimuths)], q0 = ends[size_t((k + 2) % azimuths)];
+                const double d1x = p1.x - p0.x, d1y = p1.y - p0.y, d2x = q1.x - q0.x, d2y = q1.y - q0.y;
+                const double den = d1x * d2y - d1y * d2x;
+                const double wx = q1.x - p1.x, wy = q1.y - p1.y;
+                const double sa = (wx * d2y - wy * d2x) / den, ta = (wx * d1y - wy * d1x) / den;
+                const double chord = std::max(std::hypot(p1.x, p1.y), std::hypot(q1.x, q1.y));
+                double apex = chord * slack;
+                if (std::isfinite(sa) && std::isfinite(ta) && sa >= 0 && ta >= 0)
+                    apex = std::max(chord, std::hypot(p1.x + sa * d1x, p1.y + sa * d1y));
+                bound = std::max(bound, apex);
+            }
+            reach = bound * (1 + 1e-6);  // and the bisections' own resolution (2^-24)
+        } else {
+            // Between two of the directions a convex region's boundary reaches at most 1 / cos(pi / n)
+            // times farther; and a region the bisection misread must still hold the grid's points.
+            reach /= std::cos(kPi / azimuths);
+        }
         for (const Vec2& p : passing)
-            refined = std::max(refined, std::hypot(p.x - cx, p.y));
-    } else {
+            reach = std::max(reach, std::hypot(p.x - x0, p.y));
+        return reach;
+    };
+    double x_lo = 0, x_hi = 0;
+    double refined = refine(cx, &x_lo, &x_hi);
+    if (!std::isfinite(refined))
         refined = grid_radius;  // not star-shaped about its centre: keep the grid's bound
-    }
     *centre_x = cx;
-    *radius = std::min(grid_radius, refined * kMargin);
+    if (tight && refined < grid_radius) {
+        // The grid's centre is off by up to a grid cell: measured again from the middle of the
+        // boundary's x extent, the disc about that centre is kept when it is smaller.
+        const double x1 = 0.5 * (x_lo + x_hi);
+        double lo1 = 0, hi1 = 0;
+        const double again = refine(x1, &lo1, &hi1);
+        if (std::isfinite(again) && again < refined) {
+            *centre_x = x1;
+            refined = again;
+        }
+    }
+    // Tight: the measured boundary (the bisection's outer ends, the convex allowance between the
+    // directions); the bounds add kMargin.
+    *radius = std::min(grid_radius, tight ? refined : refined * kMargin);
     return true;
 }
 
@@ -137,6 +201,11 @@ void enclose(double c1, double r1, double c2, double r2, double* c, double* r)
 } // namespace
 
 PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, double plane_z)
+    : PupilBounds(lens, traced, plane_z, false)
+{
+}
+
+PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, double plane_z, bool tight)
     : plane_z_(plane_z), pupil_z_(traced.exit_pupil_centre().z), step_mm_(0), field_radius_mm_(0), reach_mm_(0)
 {
     const Probe probe{traced, plane_z, pupil_z_};
@@ -176,6 +245,41 @@ PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, doubl
         spans_.push_back(span);
         reach_mm_ = std::max(reach_mm_, std::fabs(span.centre_x) + span.radius);
     }
+    if (!tight)
+        return;
+    // Tight spans: the tight discs at both bins and kTightBetween radii between them, enclosed,
+    // widened by kTightMargin. Where no light passes at a measured radius but does at another of
+    // the span, the span holds the lit ones (as the bounds do at the field's edge).
+    std::vector<Bin> ends(kBins + 1, Bin{0, 0});
+    for (int i = 0; i <= kBins; ++i)
+        if (bins[size_t(i)].radius > 0 && bin_disc(lens, probe, i * step_mm_, &cx, &radius, true))
+            ends[size_t(i)] = Bin{cx, radius};
+    for (int i = 0; i < kBins; ++i) {
+        Bin span{0, 0};
+        bool any = false;
+        for (int k = 0; k <= kTightBetween + 1; ++k) {
+            Bin at{0, 0};
+            if (k == 0)
+                at = ends[size_t(i)];
+            else if (k == kTightBetween + 1)
+                at = ends[size_t(i + 1)];
+            else if (bin_disc(lens, probe, (i + double(k) / (kTightBetween + 1)) * step_mm_, &cx, &radius, true))
+                at = Bin{cx, radius};
+            if (!(at.radius > 0))
+                continue;
+            if (any)
+                enclose(span.centre_x, span.radius, at.centre_x, at.radius, &span.centre_x, &span.radius);
+            else
+                span = at;
+            any = true;
+        }
+        span.radius *= kTightMargin;
+        if (aspheric)
+            span.radius *= kAsphereMargin;
+        if (!(span.radius > 0))
+            span = spans_[size_t(i)];  // none measured lit: the bounds' own disc
+        tight_spans_.push_back(span);
+    }
 }
 
 PupilDisc PupilBounds::disc_for(Vec3 point) const
@@ -192,7 +296,14 @@ PupilDisc PupilBounds::disc_for(Vec3 point) const
     return PupilDisc{Vec3{cx, cy, pupil_z_}, span.radius};
 }
 
-PupilDisc PupilBounds::disc_holding(Vec3 centre, double radius) const
+PupilDisc PupilBounds::disc_holding(Vec3 centre, double radius, bool tight) const
+{
+    if (tight && has_tight())
+        return holding(tight_spans_, step_mm_, centre, radius);
+    return holding(spans_, step_mm_, centre, radius);
+}
+
+PupilDisc PupilBounds::holding(const std::vector<Bin>& spans, double step_mm, Vec3 centre, double radius) const
 {
     // disc_for(q) lies in span floor(|q| / step) turned to q's azimuth. For |q - c| <= radius the
     // spans are those from (|c| - radius) to (|c| + radius), and the unit vector of q is within
@@ -201,15 +312,16 @@ PupilDisc PupilBounds::disc_holding(Vec3 centre, double radius) const
     // every such q. When the cell may hold the axis the discs are centred on it instead.
     const double r = std::sqrt(centre.x * centre.x + centre.y * centre.y);
     radius = std::fabs(radius);
-    const double lo = std::max(0.0, r - radius) / step_mm_, hi = (r + radius) / step_mm_;
-    if (!(lo < kBins) || !std::isfinite(hi))
+    const int bins = int(spans.size());
+    const double lo = std::max(0.0, r - radius) / step_mm, hi = (r + radius) / step_mm;
+    if (!(lo < bins) || !std::isfinite(hi))
         return PupilDisc{Vec3{0, 0, pupil_z_}, 0};
-    const int first = int(lo), last = std::min(kBins - 1, int(hi));
+    const int first = int(lo), last = std::min(bins - 1, int(hi));
     const bool about_axis = !(r > radius);
     const double turn = about_axis ? 0 : std::min(2.0, 2 * radius / r);
     double near = INFINITY, far = -INFINITY;  // along c's direction (or |.| about the axis)
     for (int k = first; k <= last; ++k) {
-        const Bin& span = spans_[size_t(k)];
+        const Bin& span = spans[size_t(k)];
         if (!(span.radius > 0))
             continue;
         if (about_axis) {

@@ -28,6 +28,16 @@ public:
     // array) behind `traced`, the exact lens of `lens` (rear vertex at z = 0). The iris is ignored
     // (the round stop holds it), so `traced` should be built without blades.
     PupilBounds(const Prescription& lens, const MainLens& traced, double plane_z);
+    // The same bounds and, with `tight`, also tight discs for samples aimed where light passes
+    // (camera/aim.h; disc_holding with tight true): each bin's region measured along
+    // kTightAzimuths directions from the grid's centre and again from the middle of the measured
+    // boundary (the smaller disc kept), bounded between two directions by where the neighbouring
+    // chords' lines meet (a convex region's boundary cannot pass them, corners included) instead
+    // of the 1 % margins; each span's disc holds the discs measured at its bins and three field
+    // radii between them, widened by kTightMargin. Conservative as the bounds are, by brute force
+    // (pupil_bounds_test, the triplet and the catalogue's lenses); about 15 times the bounds'
+    // traces to make.
+    PupilBounds(const Prescription& lens, const MainLens& traced, double plane_z, bool tight);
 
     // The disc for a point of that plane (its z is not looked at): it holds every point of the
     // exit pupil's plane through which light from the point can pass.
@@ -35,7 +45,10 @@ public:
     // A disc holding disc_for(q) for every point q of the bounds' plane within `radius` of
     // `centre` (its z is not looked at): where light from anywhere in a microlens's cell can pass.
     // Radius 0 when no light passes from any of them.
-    PupilDisc disc_holding(Vec3 centre, double radius) const;
+    // With `tight`, from the tight discs when the bounds were made with them (otherwise the same).
+    PupilDisc disc_holding(Vec3 centre, double radius, bool tight = false) const;
+    // Whether the bounds hold tight discs too.
+    bool has_tight() const { return !tight_spans_.empty(); }
 
     // False when the ray from `point` (of the bounds' plane) along `direction` certainly misses the
     // lens: it crosses the exit pupil's plane outside disc_for(point). True otherwise (the ray may
@@ -62,6 +75,8 @@ private:
     double field_radius_mm_;
     double reach_mm_;
     std::vector<Bin> spans_;  // span i: a disc holding bins i and i + 1 (points between them)
+    std::vector<Bin> tight_spans_;  // the same, tight (empty unless asked for)
+    PupilDisc holding(const std::vector<Bin>& spans, double step_mm, Vec3 centre, double radius) const;
 };
 
 } // namespace plenoptic
