@@ -42,13 +42,25 @@ bool lens_aim(const PlenopticCamera& m, LensIndex lens, LensAim* out)
         // The bounds are for points of one plane: a lens off it (displaced along the axis) is not aimed at.
         if (!(std::fabs(centre.z - m.pupil_bounds->plane_z()) <= 1e-9 * (1 + std::fabs(centre.z))))
             return false;
-        disc = m.pupil_bounds->disc_holding(centre, circumradius, true);
+        PupilDisc discs[3];
+        const int count = m.pupil_bounds->discs_holding(centre, circumradius, discs);
+        disc = discs[0];
+        out->cuts = count == 3 ? 2 : 0;
+        for (int k = 0; k < out->cuts; ++k) {
+            const Vec3 q = m.array.to_local(discs[k + 1].centre);
+            out->cut_m[k] = Vec2{q.x, q.y};
+            out->cut_rho[k] = discs[k + 1].radius;
+            if (!(is_finite(out->cut_m[k]) && out->cut_rho[k] >= 0 && std::isfinite(out->cut_rho[k])))
+                return false;
+        }
     } else if (m.lens->traced()) {
         return false;
     } else {
         // An ideal lens blocks exactly outside its exit pupil (the thin lens's aperture in its plane).
         disc = PupilDisc{m.lens->exit_pupil_centre(), m.lens->exit_pupil_radius()};
     }
+    if (!m.pupil_bounds)
+        out->cuts = 0;
     const Vec3 c = m.array.to_local(centre);
     const Vec3 d = m.array.to_local(disc.centre);
     out->lens = lens;
@@ -63,19 +75,21 @@ bool lens_aim(const PlenopticCamera& m, LensIndex lens, LensAim* out)
            std::isfinite(out->rho) && is_finite(out->m) && is_finite(out->c);
 }
 
-AimDisc lit_sensor_disc(const LensAim& a, double d)
+namespace {
+
+AimDisc sensor_disc(const LensAim& a, double d, Vec2 m, double rho)
 {
     // |(Z/d) s - c (1 + Z/d) + m| <= rho + |g| R, divided by Z/d.
     const double g = 1 + a.Z / d - a.Z / a.f;
     const double k = d / a.Z;
-    const Vec2 shift{(a.c.x - a.m.x) * k, (a.c.y - a.m.y) * k};
-    const double radius = (a.rho + std::fabs(g) * a.circumradius) * k;
+    const Vec2 shift{(a.c.x - m.x) * k, (a.c.y - m.y) * k};
+    const double radius = (rho + std::fabs(g) * a.circumradius) * k;
     const double slack = kRoundingMargin * (std::fabs(shift.x) + std::fabs(shift.y) + radius + std::fabs(a.c.x) +
                                             std::fabs(a.c.y));
     return AimDisc{Vec2{a.c.x + shift.x, a.c.y + shift.y}, radius * (1 + kRoundingMargin) + slack};
 }
 
-AimDisc lit_cell_disc(const LensAim& a, Vec3 s)
+AimDisc cell_disc(const LensAim& a, Vec3 s, Vec2 m, double rho)
 {
     // g h - (Z/d) s + (Z/f) c within rho of m; from the lens's centre: h - c within rho / |g| of
     // (m - c + (Z/d) (s - c)) / g.
@@ -84,9 +98,31 @@ AimDisc lit_cell_disc(const LensAim& a, Vec3 s)
     if (!(g != 0) || !std::isfinite(g))
         return AimDisc{Vec2{0, 0}, std::numeric_limits<double>::infinity()};
     const double k = a.Z / d;
-    const double x = a.m.x - a.c.x + k * (s.x - a.c.x), y = a.m.y - a.c.y + k * (s.y - a.c.y);
-    const double slack = kRoundingMargin * (std::fabs(x) + std::fabs(y) + a.rho) / std::fabs(g);
-    return AimDisc{Vec2{x / g, y / g}, a.rho / std::fabs(g) * (1 + kRoundingMargin) + slack};
+    const double x = m.x - a.c.x + k * (s.x - a.c.x), y = m.y - a.c.y + k * (s.y - a.c.y);
+    const double slack = kRoundingMargin * (std::fabs(x) + std::fabs(y) + rho) / std::fabs(g);
+    return AimDisc{Vec2{x / g, y / g}, rho / std::fabs(g) * (1 + kRoundingMargin) + slack};
+}
+
+} // namespace
+
+AimDisc lit_sensor_disc(const LensAim& a, double d)
+{
+    return sensor_disc(a, d, a.m, a.rho);
+}
+
+AimDisc lit_sensor_cut(const LensAim& a, double d, int k)
+{
+    return sensor_disc(a, d, a.cut_m[k], a.cut_rho[k]);
+}
+
+AimDisc lit_cell_disc(const LensAim& a, Vec3 s)
+{
+    return cell_disc(a, s, a.m, a.rho);
+}
+
+AimDisc lit_cell_cut(const LensAim& a, Vec3 s, int k)
+{
+    return cell_disc(a, s, a.cut_m[k], a.cut_rho[k]);
 }
 
 double cell_half_height(GridType grid, double pitch_mm, double x)
@@ -108,12 +144,12 @@ struct PixelEllipse {
     double cu, cv, au, av;
 };
 
-bool pixel_ellipse(const PlenopticCamera& m, const LensAim& a, const Vec3& s, PixelEllipse* e)
+bool pixel_ellipse(const PlenopticCamera& m, const LensAim& a, const Vec3& s, PixelEllipse* e, int cut = -1)
 {
     const double d = a.z - s.z;
     if (!(d > 0))
         return false;
-    const AimDisc disc = lit_sensor_disc(a, d);
+    const AimDisc disc = cut < 0 ? lit_sensor_disc(a, d) : lit_sensor_cut(a, d, cut);
     const Vec3 q = m.array.to_optics(Vec3{disc.centre.x, disc.centre.y, s.z});
     const Sensor& sensor = m.sensor;
     const double px = sensor.pixel_size_mm[0], py = sensor.pixel_size_mm[1];
@@ -241,15 +277,30 @@ struct PixelPlan {
     LensIndex lens;
     int count;
     PixelEllipse ellipses[kMaxParts];
+    // Behind a traced lens: lens k's light lands only in ellipses[k] and its cuts[k][0 .. cut_count[k]-1].
+    int cut_count[kMaxParts];
+    PixelEllipse cuts[kMaxParts][2];
     Intervals xs;
     double width;
 };
+
+// A lens's ellipse and its cuts, for the pixel's plan (false when one is not finite).
+bool lens_ellipses(const PlenopticCamera& m, const LensAim& a, const Vec3& s, PixelPlan* plan, int k)
+{
+    plan->cut_count[k] = a.cuts;
+    for (int c = 0; c < a.cuts; ++c)
+        if (!pixel_ellipse(m, a, s, &plan->cuts[k][c], c))
+            return false;
+    return true;
+}
 
 void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced, PixelPlan* plan)
 {
     plan->kind = PixelPlan::Uniform;
     plan->forced = forced != nullptr;
     plan->count = 0;
+    for (int k = 0; k < kMaxParts; ++k)
+        plan->cut_count[k] = 0;
     const Vec3 middle = m.sensor.point(i + 0.5, j + 0.5);
     LensIndex lens;
     if (forced) {
@@ -264,8 +315,15 @@ void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced,
     LensAim a;
     PixelEllipse own_ellipse;
     const Vec3 s = m.array.to_local(middle);
-    if (!lens_aim(m, lens, &a) || !pixel_ellipse(m, a, s, &own_ellipse) || holds_pixel(own_ellipse, i, j))
+    if (!lens_aim(m, lens, &a) || !pixel_ellipse(m, a, s, &own_ellipse) || !lens_ellipses(m, a, s, plan, 0))
         return;  // the whole pixel may be lit: its own points, as the uniform samples
+    bool held = holds_pixel(own_ellipse, i, j);
+    for (int c = 0; c < plan->cut_count[0]; ++c)
+        held = held && holds_pixel(plan->cuts[0][c], i, j);
+    if (held)
+        return;
+    const int own_cuts = plan->cut_count[0];
+    const PixelEllipse own_cut[2] = {plan->cuts[0][0], plan->cuts[0][1]};
     // The ellipses that can light the pixel: the forced lens's; or, for the pixel's own lenses, the
     // lens of its centre and its neighbours (the lattice cells a pixel far smaller than a cell can
     // meet: checked below).
@@ -293,9 +351,12 @@ void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced,
                     continue;  // not a neighbour in skew indices
                 const LensIndex other = from_skew(grid, skew + dk, lens.l + dl);
                 PixelEllipse e;
-                if (dk == 0 && dl == 0)
+                if (dk == 0 && dl == 0) {
                     e = own_ellipse;
-                else if (!lens_aim(m, other, &a) || !pixel_ellipse(m, a, s, &e))
+                    plan->cut_count[count] = own_cuts;
+                    plan->cuts[count][0] = own_cut[0];
+                    plan->cuts[count][1] = own_cut[1];
+                } else if (!lens_aim(m, other, &a) || !pixel_ellipse(m, a, s, &e) || !lens_ellipses(m, a, s, plan, count))
                     return;
                 ellipses[count++] = e;
             }
@@ -303,15 +364,26 @@ void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced,
     plan->count = count;
     // x: the union over the ellipses of the x range of the pixel's part in each (the ellipse's at
     // the pixel's row nearest its centre).
+    // With cuts, the intersection of the x ranges of the pixel's part in each (which holds the x
+    // range of the pixel's part in their intersection).
     plan->xs = Intervals();
     for (int k = 0; k < count; ++k) {
-        const PixelEllipse& e = ellipses[k];
-        const double row = e.cv < j ? j : (e.cv > j + 1 ? j + 1 : e.cv);
-        const double t = (row - e.cv) / e.av;
-        if (!(t * t <= 1))
-            continue;
-        const double reach = e.au * std::sqrt(1 - t * t);
-        plan->xs.add(std::max<double>(i, e.cu - reach), std::min<double>(i + 1, e.cu + reach));
+        double lo = i, hi = i + 1;
+        bool none = false;
+        for (int c = -1; c < plan->cut_count[k]; ++c) {
+            const PixelEllipse& e = c < 0 ? ellipses[k] : plan->cuts[k][c];
+            const double row = e.cv < j ? j : (e.cv > j + 1 ? j + 1 : e.cv);
+            const double t = (row - e.cv) / e.av;
+            if (!(t * t <= 1)) {
+                none = true;
+                break;
+            }
+            const double reach = e.au * std::sqrt(1 - t * t);
+            lo = std::max<double>(lo, e.cu - reach);
+            hi = std::min<double>(hi, e.cu + reach);
+        }
+        if (!none)
+            plan->xs.add(lo, hi);
     }
     plan->width = plan->xs.merge();
     plan->kind = plan->width > 0 ? PixelPlan::Aimed : PixelPlan::Dark;
@@ -361,8 +433,16 @@ PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, doubl
     Intervals ys;
     for (int k = 0; k < plan.count; ++k) {
         const double half = chord(plan.ellipses[k], x);
-        if (half >= 0)
-            ys.add(std::max<double>(j, plan.ellipses[k].cv - half), std::min<double>(j + 1, plan.ellipses[k].cv + half));
+        if (!(half >= 0))
+            continue;
+        double lo = std::max<double>(j, plan.ellipses[k].cv - half), hi = std::min<double>(j + 1, plan.ellipses[k].cv + half);
+        for (int c = 0; c < plan.cut_count[k]; ++c) {
+            const PixelEllipse& e = plan.cuts[k][c];
+            const double h = chord(e, x);
+            lo = h >= 0 ? std::max(lo, e.cv - h) : INFINITY;
+            hi = std::min(hi, e.cv + h);
+        }
+        ys.add(lo, hi);
     }
     const double height = ys.merge();
     if (!(height > 0)) {
@@ -400,12 +480,45 @@ ArrayRay aimed_cell_ray(const PlenopticCamera& m, const Vec3& p, LensIndex lens,
     if (!(a.z - s.z > 0))
         return array.microlens->sample_ray(array, p, lens, u, v);
     const AimDisc disc = lit_cell_disc(a, s);
-    if (!(disc.radius < std::numeric_limits<double>::infinity()) ||
-        std::sqrt(disc.centre.x * disc.centre.x + disc.centre.y * disc.centre.y) + a.circumradius <= disc.radius)
-        return array.microlens->sample_ray(array, p, lens, u, v);  // the whole cell may pass
     const GridType grid = array.grid;
     const double pitch = array.pitch_mm;
     const double area = grid == GridType::Hexagonal ? 0.5 * kSqrt3 * pitch * pitch : pitch * pitch;
+    if (a.cuts > 0) {
+        // The cell's part in the disc and both cuts: x uniform over their common x range, y over
+        // the chords' intersection at x.
+        AimDisc discs[3] = {disc, lit_cell_cut(a, s, 0), lit_cell_cut(a, s, 1)};
+        bool whole = true;
+        double lo = -0.5 * pitch, hi = 0.5 * pitch;
+        for (const AimDisc& d : discs) {
+            if (!(d.radius < std::numeric_limits<double>::infinity()))
+                continue;
+            whole = whole && std::sqrt(d.centre.x * d.centre.x + d.centre.y * d.centre.y) + a.circumradius <= d.radius;
+            lo = std::max(lo, d.centre.x - d.radius);
+            hi = std::min(hi, d.centre.x + d.radius);
+        }
+        if (whole)
+            return array.microlens->sample_ray(array, p, lens, u, v);  // the whole cell may pass
+        if (!(hi > lo))
+            return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false, Vec3{0, 0, 0}};
+        const double x = lo + u * (hi - lo);
+        const double half = cell_half_height(grid, pitch, x);
+        double y0 = -half, y1 = half;
+        for (const AimDisc& d : discs) {
+            if (!(d.radius < std::numeric_limits<double>::infinity()))
+                continue;
+            const double t = (x - d.centre.x) / d.radius;
+            const double c = d.radius * std::sqrt(t < 1 ? 1 - t * t : 0);
+            y0 = std::max(y0, d.centre.y - c);
+            y1 = std::min(y1, d.centre.y + c);
+        }
+        if (!(y1 > y0))
+            return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false, Vec3{0, 0, 0}};
+        *weight = (hi - lo) * (y1 - y0) / area;
+        return array.microlens->cell_ray(array, p, lens, Vec2{x, y0 + v * (y1 - y0)});
+    }
+    if (!(disc.radius < std::numeric_limits<double>::infinity()) ||
+        std::sqrt(disc.centre.x * disc.centre.x + disc.centre.y * disc.centre.y) + a.circumradius <= disc.radius)
+        return array.microlens->sample_ray(array, p, lens, u, v);  // the whole cell may pass
     const ChordSample sample = sample_chords(
         -0.5 * pitch, 0.5 * pitch, disc.centre.x - disc.radius, disc.centre.x + disc.radius,
         [grid, pitch](double x, double* y0, double* y1) {

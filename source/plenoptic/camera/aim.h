@@ -51,6 +51,11 @@ struct LensAim {
     double Z;
     Vec2 m;
     double rho;
+    // Behind a traced lens, off the axis: `cuts` (0 or 2) more discs of that plane, each also
+    // holding where light can pass (PupilBounds::discs_holding); light passes only in all of them.
+    int cuts;
+    Vec2 cut_m[2];
+    double cut_rho[2];
 };
 
 // Whether the camera aims its samples (PlenopticCamera::sampling.aim): behind an image-forming main
@@ -65,11 +70,15 @@ bool lens_aim(const PlenopticCamera& model, LensIndex lens, LensAim* out);
 // The disc of sensor points (array-local x, y; the sensor d behind the lens plane, d > 0) holding
 // every sensor point from which a ray through the lens's cell can pass the main lens.
 AimDisc lit_sensor_disc(const LensAim& aim, double d);
+// The same for cutting disc k (0 or 1) of the lens's plane instead of its disc.
+AimDisc lit_sensor_cut(const LensAim& aim, double d, int k);
 
 // The disc of cell points (array-local, from the lens's centre) holding every point through which
 // the ray from sensor point s (array-local, behind the lens) can pass the main lens; infinite
 // radius when every point can (g = 0).
 AimDisc lit_cell_disc(const LensAim& aim, Vec3 s);
+// The same for cutting disc k (0 or 1) of the lens's plane instead of its disc.
+AimDisc lit_cell_cut(const LensAim& aim, Vec3 s, int k);
 
 // Half the height of a lens's cell (core/lattice.h: cell_polygon, centred on the lens) at x from its
 // centre; negative outside the cell's x range.

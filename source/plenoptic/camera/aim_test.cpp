@@ -107,14 +107,15 @@ TEST(Aim, CellHalfHeightIsTheLatticeCell)
 // Every (sensor point, cell point) pair through which the renderer's unaimed ray passes, for the
 // sensor points of a grid over the picture and the cell points of a grid over the cell, through
 // the point's own lens and its neighbours: the sensor point lies in the lens's lit_sensor_disc and
-// the cell point in lit_cell_disc of the sensor point.
+// the cell point in lit_cell_disc of the sensor point, and behind the traced lens in both cuts'
+// (lit_sensor_cut, lit_cell_cut).
 TEST(Aim, DiscsHoldEveryPassingRay)
 {
     for (const AimCase& setup : setups()) {
         const int W = 160, H = 120;
         const PlenopticCamera m = with_film(make_camera(setup.params), W, H);
         ASSERT_TRUE(m.sampling.aim) << setup.name;
-        long passing = 0, sensor_out = 0, cell_out = 0, aimed_lenses = 0;
+        long passing = 0, sensor_out = 0, cell_out = 0, aimed_lenses = 0, cut_lenses = 0;
         const int cells = 20;
         for (int b = 0; b <= 30; ++b) {
             for (int a = 0; a <= 40; ++a) {
@@ -134,6 +135,12 @@ TEST(Aim, DiscsHoldEveryPassingRay)
                     const Vec3 s = m.array.to_local(p);
                     const AimDisc sensor = lit_sensor_disc(aim, aim.z - s.z);
                     const AimDisc cell = lit_cell_disc(aim, s);
+                    AimDisc sensor_cuts[2], cell_cuts[2];
+                    for (int k = 0; k < aim.cuts; ++k) {
+                        sensor_cuts[k] = lit_sensor_cut(aim, aim.z - s.z, k);
+                        cell_cuts[k] = lit_cell_cut(aim, s, k);
+                    }
+                    cut_lenses += aim.cuts > 0 ? 1 : 0;
                     for (int j = 0; j < cells; ++j) {
                         for (int i = 0; i < cells; ++i) {
                             const double u = (i + 0.5) / cells, v = (j + 0.5) / cells;
@@ -146,6 +153,14 @@ TEST(Aim, DiscsHoldEveryPassingRay)
                             const Vec2 h = m.array.cell_point(u, v);
                             if (std::hypot(h.x - cell.centre.x, h.y - cell.centre.y) > cell.radius)
                                 ++cell_out;
+                            for (int k = 0; k < aim.cuts; ++k) {
+                                const AimDisc& a = sensor_cuts[k];
+                                const AimDisc& b = cell_cuts[k];
+                                if (std::hypot(s.x - a.centre.x, s.y - a.centre.y) > a.radius)
+                                    ++sensor_out;
+                                if (std::hypot(h.x - b.centre.x, h.y - b.centre.y) > b.radius)
+                                    ++cell_out;
+                            }
                         }
                     }
                 }
@@ -155,6 +170,11 @@ TEST(Aim, DiscsHoldEveryPassingRay)
         EXPECT_GT(aimed_lenses, 1000) << setup.name;
         EXPECT_EQ(sensor_out, 0) << setup.name;
         EXPECT_EQ(cell_out, 0) << setup.name;
+        // Behind the traced triplet most lenses are off the axis: cut as well.
+        if (setup.params.main.type == MainLensType::Prescription)
+            EXPECT_GT(cut_lenses, 500) << setup.name;
+        else
+            EXPECT_EQ(cut_lenses, 0) << setup.name;
     }
 }
 

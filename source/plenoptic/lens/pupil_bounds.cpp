@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include "plenoptic/core/setup_progress.h"
 
@@ -31,7 +32,11 @@ const int kMaxFieldDoublings = 60;
 // by brute force in pupil_bounds_test).
 const int kTightAzimuths = 256;
 const int kTightBetween = 3;
-const double kTightMargin = 1.001;
+const double kTightMargin = 1.0001;
+// The cutting discs' further margin: their far side follows the region's edge across the field
+// less smoothly than the disc does (the double Gauss's near the axis left 0.3 um between the
+// measured radii with kTightMargin alone; validated by brute force in pupil_bounds_test).
+const double kCutMargin = 1.0003;
 // A lens with a conic or aspheric surface: its rear surface's sag is sampled at kAsphereSagSamples
 // heights for the search square, and every disc's radius is widened by kAsphereMargin more (an
 // asphere can make the passing region less convex than spheres do).
@@ -78,7 +83,7 @@ void search_square(const Prescription& lens, double r, double plane_z, double pu
 
 // Whether any ray from field radius r passes, and then the bin's disc.
 bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* centre_x, double* radius,
-              bool tight = false)
+              bool tight = false, std::vector<Vec2>* hull = nullptr)
 {
     const int azimuths = tight ? kTightAzimuths : kAzimuths;
     double sx, half;
@@ -109,7 +114,7 @@ bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* ce
     // The boundary measured along `azimuths` directions from (x0, 0), by bisection: the radius of a
     // disc about it that holds the region (infinite when the region is not star-shaped about it),
     // and the x extent of the boundary points.
-    auto refine = [&](double x0, double* x_lo, double* x_hi) {
+    auto refine = [&](double x0, double* x_lo, double* x_hi, std::vector<Vec2>* corners) {
         if (!probe.passes(r, x0, 0))
             return double(INFINITY);
         double reach = 0;
@@ -145,6 +150,15 @@ bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* ce
             // cos(pi / n), as the bounds take it.
             const double slack = 1 / std::cos(kPi / azimuths);
             double bound = reach;
+            // The polygon holding the region (for the cutting discs): (x0, 0), the ends, the apexes,
+            // and where the directions' lines are not met, the ends taken out to the chord's bound
+            // over cos(pi / n) (the sector there lies in that triangle); the grid's points too.
+            if (corners) {
+                corners->clear();
+                corners->push_back(Vec2{x0, 0});
+                for (const Vec2& p : passing)
+                    corners->push_back(p);
+            }
             for (int k = 0; k < azimuths; ++k) {
                 const Vec2 p0 = ends[size_t((k + azimuths - 1) % azimuths)], p1 = ends[size_t(k)];
                 const Vec2 q1 = ends[size_t((k + 1) % azimuths)], q0 = ends[size_t((k + 2) % azimuths)];
@@ -154,9 +168,24 @@ bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* ce
                 const double sa = (wx * d2y - wy * d2x) / den, ta = (wx * d1y - wy * d1x) / den;
                 const double chord = std::max(std::hypot(p1.x, p1.y), std::hypot(q1.x, q1.y));
                 double apex = chord * slack;
-                if (std::isfinite(sa) && std::isfinite(ta) && sa >= 0 && ta >= 0)
+                const bool met = std::isfinite(sa) && std::isfinite(ta) && sa >= 0 && ta >= 0;
+                if (met)
                     apex = std::max(chord, std::hypot(p1.x + sa * d1x, p1.y + sa * d1y));
                 bound = std::max(bound, apex);
+                if (corners) {
+                    const double grow = 1 + 1e-6;
+                    if (met) {
+                        corners->push_back(Vec2{x0 + p1.x * grow, p1.y * grow});
+                        corners->push_back(Vec2{x0 + (p1.x + sa * d1x) * grow, (p1.y + sa * d1y) * grow});
+                    } else {
+                        const double out = chord * slack * slack * grow;
+                        const double n1 = std::hypot(p1.x, p1.y), n2 = std::hypot(q1.x, q1.y);
+                        if (n1 > 0)
+                            corners->push_back(Vec2{x0 + p1.x / n1 * out, p1.y / n1 * out});
+                        if (n2 > 0)
+                            corners->push_back(Vec2{x0 + q1.x / n2 * out, q1.y / n2 * out});
+                    }
+                }
             }
             reach = bound * (1 + 1e-6);  // and the bisections' own resolution (2^-24)
         } else {
@@ -169,7 +198,8 @@ bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* ce
         return reach;
     };
     double x_lo = 0, x_hi = 0;
-    double refined = refine(cx, &x_lo, &x_hi);
+    std::vector<Vec2> corners, corners_again;
+    double refined = refine(cx, &x_lo, &x_hi, tight ? &corners : nullptr);
     if (!std::isfinite(refined))
         refined = grid_radius;  // not star-shaped about its centre: keep the grid's bound
     *centre_x = cx;
@@ -178,11 +208,17 @@ bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* ce
         // boundary's x extent, the disc about that centre is kept when it is smaller.
         const double x1 = 0.5 * (x_lo + x_hi);
         double lo1 = 0, hi1 = 0;
-        const double again = refine(x1, &lo1, &hi1);
+        const double again = refine(x1, &lo1, &hi1, &corners_again);
         if (std::isfinite(again) && again < refined) {
             *centre_x = x1;
             refined = again;
+            corners.swap(corners_again);
         }
+    }
+    if (hull) {
+        hull->clear();
+        if (tight && refined < grid_radius)
+            hull->swap(corners);  // empty: no polygon (the region was not measured star-shaped)
     }
     // Tight: the measured boundary (the bisection's outer ends, the convex allowance between the
     // directions); the bounds add kMargin.
@@ -197,6 +233,37 @@ void enclose(double c1, double r1, double c2, double r2, double* c, double* r)
     *c = 0.5 * (lo + hi);
     *r = 0.5 * (hi - lo);
 }
+
+// The radius of the disc centred at (x, 0) holding the polygon `hull` (its farthest corner).
+double reach_from(const std::vector<Vec2>& hull, double x)
+{
+    double reach = 0;
+    for (const Vec2& p : hull)
+        reach = std::max(reach, std::hypot(p.x - x, p.y));
+    return reach;
+}
+
+// The area of the part of the disc (c0, r0) within the disc (c1, r1), both on the x axis and both
+// holding (x0, 0) (a sum over directions from it).
+double area_within(double x0, double c0, double r0, double c1, double r1)
+{
+    const int n = 256;
+    double area = 0;
+    for (int k = 0; k < n; ++k) {
+        const double a = 2 * kPi * (k + 0.5) / n, dx = std::cos(a);
+        double t = INFINITY;
+        for (const double* d : {&c0, &c1}) {
+            const double c = *d, r = d == &c0 ? r0 : r1;
+            const double b = (x0 - c) * dx, q = (x0 - c) * (x0 - c) - r * r;  // |x0 + t u - c|^2 = r^2
+            t = std::min(t, -b + std::sqrt(std::max(0.0, b * b - q)));
+        }
+        area += 0.5 * t * t;
+    }
+    return area * 2 * kPi / n;
+}
+
+// Offsets of the cutting discs' centres from the region's, in units of its disc's radius.
+const double kCutOffsets[] = {0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1, 1.5, 2, 3};
 
 } // namespace
 
@@ -249,36 +316,101 @@ PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, doubl
         return;
     // Tight spans: the tight discs at both bins and kTightBetween radii between them, enclosed,
     // widened by kTightMargin. Where no light passes at a measured radius but does at another of
-    // the span, the span holds the lit ones (as the bounds do at the field's edge).
-    std::vector<Bin> ends(kBins + 1, Bin{0, 0});
-    for (int i = 0; i <= kBins; ++i)
-        if (bins[size_t(i)].radius > 0 && bin_disc(lens, probe, i * step_mm_, &cx, &radius, true))
-            ends[size_t(i)] = Bin{cx, radius};
+    // the span, the span holds the lit ones (as the bounds do at the field's edge). And two
+    // cutting discs per span, centred on either side of the region along x (a cat's eye is
+    // narrower along x than its disc), each holding the measured polygons of the span's radii:
+    // the offset from the region's centre that leaves the least of the middle radius's disc
+    // within the cut, the same offset at every radius of the span.
+    struct Measured {
+        bool lit;
+        double centre_x, radius;
+        std::vector<Vec2> hull;
+    };
+    std::vector<Measured> at_bins(kBins + 1);
+    for (int i = 0; i <= kBins; ++i) {
+        Measured& m = at_bins[size_t(i)];
+        m.lit = bins[size_t(i)].radius > 0 && bin_disc(lens, probe, i * step_mm_, &m.centre_x, &m.radius, true, &m.hull);
+    }
     for (int i = 0; i < kBins; ++i) {
-        Bin span{0, 0};
-        bool any = false;
+        std::vector<Measured> at(size_t(kTightBetween + 2));
         for (int k = 0; k <= kTightBetween + 1; ++k) {
-            Bin at{0, 0};
             if (k == 0)
-                at = ends[size_t(i)];
+                at[0] = at_bins[size_t(i)];
             else if (k == kTightBetween + 1)
-                at = ends[size_t(i + 1)];
-            else if (bin_disc(lens, probe, (i + double(k) / (kTightBetween + 1)) * step_mm_, &cx, &radius, true))
-                at = Bin{cx, radius};
-            if (!(at.radius > 0))
+                at[size_t(k)] = at_bins[size_t(i + 1)];
+            else {
+                Measured& m = at[size_t(k)];
+                m.lit = bin_disc(lens, probe, (i + double(k) / (kTightBetween + 1)) * step_mm_, &m.centre_x, &m.radius,
+                                 true, &m.hull);
+            }
+        }
+        Bin span{0, 0}, cut_lo{0, 0}, cut_hi{0, 0};
+        bool any = false, cuts = true;
+        for (const Measured& m : at) {
+            if (!m.lit || !(m.radius > 0))
                 continue;
             if (any)
-                enclose(span.centre_x, span.radius, at.centre_x, at.radius, &span.centre_x, &span.radius);
+                enclose(span.centre_x, span.radius, m.centre_x, m.radius, &span.centre_x, &span.radius);
             else
-                span = at;
+                span = Bin{m.centre_x, m.radius};
             any = true;
+            cuts = cuts && !m.hull.empty();
+        }
+        // The offsets, chosen at the middle lit radius.
+        double off_lo = 0, off_hi = 0;
+        if (any && cuts) {
+            const Measured* middle = nullptr;  // the lit radius nearest the middle
+            for (int k = 0; k <= kTightBetween + 1; ++k)
+                if (at[size_t(k)].lit && at[size_t(k)].radius > 0 &&
+                    (!middle || std::abs(2 * k - kTightBetween - 1) < std::abs(2 * int(middle - at.data()) - kTightBetween - 1)))
+                    middle = &at[size_t(k)];
+            const double x0 = middle->centre_x, r0 = middle->radius;
+            double best_lo = INFINITY, best_hi = INFINITY;
+            for (double f : kCutOffsets) {
+                const double lo_c = x0 - f * r0, hi_c = x0 + f * r0;
+                const double lo_a = area_within(x0, x0, r0, lo_c, reach_from(middle->hull, lo_c));
+                const double hi_a = area_within(x0, x0, r0, hi_c, reach_from(middle->hull, hi_c));
+                if (lo_a < best_lo) {
+                    best_lo = lo_a;
+                    off_lo = f * r0;
+                }
+                if (hi_a < best_hi) {
+                    best_hi = hi_a;
+                    off_hi = f * r0;
+                }
+            }
+            bool first = true;
+            for (const Measured& m : at) {
+                if (!m.lit || !(m.radius > 0))
+                    continue;
+                const Bin lo{m.centre_x - off_lo, reach_from(m.hull, m.centre_x - off_lo)};
+                const Bin hi{m.centre_x + off_hi, reach_from(m.hull, m.centre_x + off_hi)};
+                if (first) {
+                    cut_lo = lo;
+                    cut_hi = hi;
+                } else {
+                    enclose(cut_lo.centre_x, cut_lo.radius, lo.centre_x, lo.radius, &cut_lo.centre_x, &cut_lo.radius);
+                    enclose(cut_hi.centre_x, cut_hi.radius, hi.centre_x, hi.radius, &cut_hi.centre_x, &cut_hi.radius);
+                }
+                first = false;
+            }
         }
         span.radius *= kTightMargin;
-        if (aspheric)
+        cut_lo.radius *= kTightMargin * kCutMargin;
+        cut_hi.radius *= kTightMargin * kCutMargin;
+        if (aspheric) {
             span.radius *= kAsphereMargin;
+            cut_lo.radius *= kAsphereMargin;
+            cut_hi.radius *= kAsphereMargin;
+        }
         if (!(span.radius > 0))
             span = spans_[size_t(i)];  // none measured lit: the bounds' own disc
+        // Without polygons (a region not measured star-shaped) the cuts are the span's disc.
+        if (!(cut_lo.radius > 0 && cut_hi.radius > 0) || aspheric)
+            cut_lo = cut_hi = span;
         tight_spans_.push_back(span);
+        cut_lo_spans_.push_back(cut_lo);
+        cut_hi_spans_.push_back(cut_hi);
     }
 }
 
@@ -299,11 +431,22 @@ PupilDisc PupilBounds::disc_for(Vec3 point) const
 PupilDisc PupilBounds::disc_holding(Vec3 centre, double radius, bool tight) const
 {
     if (tight && has_tight())
-        return holding(tight_spans_, step_mm_, centre, radius);
-    return holding(spans_, step_mm_, centre, radius);
+        return holding(tight_spans_, step_mm_, centre, radius, true);
+    return holding(spans_, step_mm_, centre, radius, false);
 }
 
-PupilDisc PupilBounds::holding(const std::vector<Bin>& spans, double step_mm, Vec3 centre, double radius) const
+int PupilBounds::discs_holding(Vec3 centre, double radius, PupilDisc out[3]) const
+{
+    out[0] = disc_holding(centre, radius, true);
+    if (!has_tight() || !(out[0].radius > 0) || !(std::sqrt(centre.x * centre.x + centre.y * centre.y) > std::fabs(radius)))
+        return 1;
+    out[1] = holding(cut_lo_spans_, step_mm_, centre, radius, true);
+    out[2] = holding(cut_hi_spans_, step_mm_, centre, radius, true);
+    return out[1].radius > 0 && out[2].radius > 0 ? 3 : 1;
+}
+
+PupilDisc PupilBounds::holding(const std::vector<Bin>& spans, double step_mm, Vec3 centre, double radius,
+                               bool exact_turn) const
 {
     // disc_for(q) lies in span floor(|q| / step) turned to q's azimuth. For |q - c| <= radius the
     // spans are those from (|c| - radius) to (|c| + radius), and the unit vector of q is within
@@ -318,7 +461,10 @@ PupilDisc PupilBounds::holding(const std::vector<Bin>& spans, double step_mm, Ve
         return PupilDisc{Vec3{0, 0, pupil_z_}, 0};
     const int first = int(lo), last = std::min(bins - 1, int(hi));
     const bool about_axis = !(r > radius);
-    const double turn = about_axis ? 0 : std::min(2.0, 2 * radius / r);
+    // Tight: the unit vectors' distance itself, 2 sin(a / 2) for the largest angle a = asin(radius / r).
+    const double turn = about_axis ? 0
+                        : exact_turn ? 2 * std::sin(0.5 * std::asin(radius / r)) * (1 + 1e-9)
+                                     : std::min(2.0, 2 * radius / r);
     double near = INFINITY, far = -INFINITY;  // along c's direction (or |.| about the axis)
     for (int k = first; k <= last; ++k) {
         const Bin& span = spans[size_t(k)];

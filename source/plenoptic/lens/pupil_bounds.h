@@ -49,6 +49,10 @@ public:
     PupilDisc disc_holding(Vec3 centre, double radius, bool tight = false) const;
     // Whether the bounds hold tight discs too.
     bool has_tight() const { return !tight_spans_.empty(); }
+    // With tight discs: the tight disc_holding and, for a cell off the axis, two cutting discs that
+    // also hold disc_for's region for every point of the cell (a cat's eye is their intersection
+    // more closely than a disc); returns how many of out[0..2] it wrote (1 or 3).
+    int discs_holding(Vec3 centre, double radius, PupilDisc out[3]) const;
 
     // False when the ray from `point` (of the bounds' plane) along `direction` certainly misses the
     // lens: it crosses the exit pupil's plane outside disc_for(point). True otherwise (the ray may
@@ -76,7 +80,8 @@ private:
     double reach_mm_;
     std::vector<Bin> spans_;  // span i: a disc holding bins i and i + 1 (points between them)
     std::vector<Bin> tight_spans_;  // the same, tight (empty unless asked for)
-    PupilDisc holding(const std::vector<Bin>& spans, double step_mm, Vec3 centre, double radius) const;
+    std::vector<Bin> cut_lo_spans_, cut_hi_spans_;  // the cutting discs (centred below and above)
+    PupilDisc holding(const std::vector<Bin>& spans, double step_mm, Vec3 centre, double radius, bool exact_turn) const;
 };
 
 } // namespace plenoptic
