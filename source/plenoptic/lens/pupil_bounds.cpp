@@ -198,23 +198,34 @@ bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* ce
         return reach;
     };
     double x_lo = 0, x_hi = 0;
-    std::vector<Vec2> corners, corners_again;
-    double refined = refine(cx, &x_lo, &x_hi, tight ? &corners : nullptr);
+    std::vector<Vec2> corners;
+    double x0 = cx;
+    if (tight && probe.passes(r, cx, 0)) {
+        // The grid's centre is off by up to a grid cell (which made neighbouring radii's discs
+        // jump): measured from the middle of the region's x extent instead, found by bisection
+        // along the x axis (the region is symmetric about it, so a convex one is widest there).
+        double ends[2];
+        for (int side = 0; side < 2; ++side) {
+            double inside = 0, outside = grid_radius;
+            for (int s = 0; s < kBisections; ++s) {
+                const double mid = 0.5 * (inside + outside);
+                if (probe.passes(r, cx + (side ? mid : -mid), 0))
+                    inside = mid;
+                else
+                    outside = mid;
+            }
+            ends[side] = cx + (side ? outside : -outside);
+        }
+        x0 = 0.5 * (ends[0] + ends[1]);
+    }
+    double refined = refine(x0, &x_lo, &x_hi, tight ? &corners : nullptr);
+    if (!std::isfinite(refined) && x0 != cx) {
+        x0 = cx;
+        refined = refine(x0, &x_lo, &x_hi, &corners);
+    }
     if (!std::isfinite(refined))
         refined = grid_radius;  // not star-shaped about its centre: keep the grid's bound
-    *centre_x = cx;
-    if (tight && refined < grid_radius) {
-        // The grid's centre is off by up to a grid cell: measured again from the middle of the
-        // boundary's x extent, the disc about that centre is kept when it is smaller.
-        const double x1 = 0.5 * (x_lo + x_hi);
-        double lo1 = 0, hi1 = 0;
-        const double again = refine(x1, &lo1, &hi1, &corners_again);
-        if (std::isfinite(again) && again < refined) {
-            *centre_x = x1;
-            refined = again;
-            corners.swap(corners_again);
-        }
-    }
+    *centre_x = x0;
     if (hull) {
         hull->clear();
         if (tight && refined < grid_radius)
