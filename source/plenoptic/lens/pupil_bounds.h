@@ -30,12 +30,12 @@ public:
     PupilBounds(const Prescription& lens, const MainLens& traced, double plane_z);
     // The same bounds and, with `tight`, also tight discs for samples aimed where light passes
     // (camera/aim.h; disc_holding with tight true): each bin's region measured along
-    // kTightAzimuths directions from the grid's centre and again from the middle of the measured
-    // boundary (the smaller disc kept), bounded between two directions by where the neighbouring
-    // chords' lines meet (a convex region's boundary cannot pass them, corners included) instead
-    // of the 1 % margins; each span's disc holds the discs measured at its bins and three field
-    // radii between them, widened by kTightMargin. Conservative as the bounds are, by brute force
-    // (pupil_bounds_test, the triplet and the catalogue's lenses); about 15 times the bounds'
+    // kTightAzimuths directions from the middle of its x extent, bounded between two directions by
+    // where the neighbouring chords' lines meet (a convex region's boundary cannot pass them,
+    // corners included) instead of the 1 % margins; each span's disc holds the discs measured at
+    // its bins and three field radii between them, widened by kTightMargin; and two cutting discs
+    // per span (discs_holding). Conservative as the bounds are, by brute force
+    // (pupil_bounds_test, the triplet and the catalogue's lenses); about 8 times the bounds'
     // traces to make.
     PupilBounds(const Prescription& lens, const MainLens& traced, double plane_z, bool tight);
 
