@@ -8,16 +8,26 @@
 //
 //   plenoptic_microimage_truth --lens-file FILE --f-number N --focus-distance Z
 //       --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--offset X_MM Y_MM] [--threads T]
-//       [--errors S F R SEED] [--refracting R CAP SUBSTRATE IOR] [--reference] [--csv OUT]
+//       [--errors S F R SEED] [--refracting R CAP SUBSTRATE IOR] [--caps-to-sensor] [--reference]
+//       [--every-lens] [--check N] [--csv OUT]
 //
 // --offset shifts the sensor (sensor { offset }): a crop of a larger raw away from its centre,
 // e.g. its corner. --errors gives the array manufacturing errors (errors { position S focal_length F
 // rotation R seed SEED }). --reference measures every lens from scratch (reuse_neighbours false: the
 // integration as it was before the neighbours' radii were reused). --refracting replaces the thin
 // microlenses by plano-convex caps (lens { surface { radius R } thickness CAP ior IOR substrate
-// SUBSTRATE }, the curved side towards the scene; F_MM of --array is then unused).
+// SUBSTRATE }, the curved side towards the scene, or towards the sensor with --caps-to-sensor; F_MM of
+// --array is then unused). Refracting lenses on an array without errors are interpolated between
+// anchors (MicroimageOptions::anchor_step); --every-lens measures every lens instead (anchor_step 0).
+// --check N measures N lenses of the picture each (never interpolated: measured_microimages), drawn
+// at random from a fixed seed, and the picture's four corner lenses, and adds to the JSON the largest
+// differences of the run's answer from theirs (check_du_px, check_dv_px, check_fraction) and the
+// CPU seconds the check took (not counted in cpu_s).
 
 #include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -48,6 +58,10 @@ struct Options {
     int threads = 0;
     bool errors = false;
     bool reference = false;
+    bool every_lens = false;
+    bool caps_to_sensor = false;
+    int check = 0;
+    int anchor_step = -1, refracting_points = 0, check_points = 0;
     bool refracting = false;
     double refracting_values[4] = {0, 0, 0, 0};  // radius, cap, substrate, ior
     double error_values[3] = {0, 0, 0};
@@ -90,13 +104,25 @@ bool parse(int argc, char** argv, Options* o)
                 value = std::atof(argv[++a]);
         } else if (arg == "--reference")
             o->reference = true;
+        else if (arg == "--every-lens")
+            o->every_lens = true;
+        else if (arg == "--caps-to-sensor")
+            o->caps_to_sensor = true;
+        else if (arg == "--check-points" && left >= 1)
+            o->check_points = std::atoi(argv[++a]);
+        else if (arg == "--anchor-step" && left >= 1)
+            o->anchor_step = std::atoi(argv[++a]);
+        else if (arg == "--points" && left >= 1)
+            o->refracting_points = std::atoi(argv[++a]);
+        else if (arg == "--check" && left >= 1)
+            o->check = std::atoi(argv[++a]);
         else if (arg == "--csv" && left >= 1)
             o->csv = argv[++a];
         else
             return false;
     }
     return !o->lens_file.empty() && o->f_number > 0 && o->focus_distance > 0 && o->width > 0 && o->height > 0 &&
-           o->pixel_mm > 0 && o->pitch_mm > 0 && o->focal_mm > 0 && o->distance_mm > 0 && o->threads >= 0;
+           o->pixel_mm > 0 && o->pitch_mm > 0 && o->focal_mm > 0 && o->distance_mm > 0 && o->threads >= 0 && o->check >= 0;
 }
 
 double cpu_seconds()
@@ -116,7 +142,7 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "usage: plenoptic_microimage_truth --lens-file FILE --f-number N --focus-distance Z\n"
                              "         --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--offset X_MM Y_MM]\n"
                              "         [--threads T] [--errors S F R SEED] [--refracting R CAP SUBSTRATE IOR]\n"
-                             "         [--reference] [--csv OUT]\n");
+                             "         [--caps-to-sensor] [--reference] [--every-lens] [--check N] [--csv OUT]\n");
         return 2;
     }
     std::ifstream file(o.lens_file);
@@ -160,7 +186,7 @@ int main(int argc, char** argv)
         p.array.refracting.cap_mm = o.refracting_values[1];
         p.array.refracting.substrate_mm = o.refracting_values[2];
         p.array.refracting.ior = o.refracting_values[3];
-        p.array.refracting.curved_towards_scene = true;
+        p.array.refracting.curved_towards_scene = !o.caps_to_sensor;
     }
     p.array.has_distance = true;
     p.array.distance_mm = o.distance_mm;
@@ -180,10 +206,18 @@ int main(int argc, char** argv)
     MicroimageOptions options = default_microimage_options();
     options.threads = o.threads;
     options.reuse_neighbours = !o.reference;
+    if (o.anchor_step >= 0)
+        options.anchor_step = o.anchor_step;
+    if (o.refracting_points > 0)
+        options.refracting_points = o.refracting_points;
+    if (o.every_lens)
+        options.anchor_step = 0;
 
     const double cpu0 = cpu_seconds();
     const auto wall0 = std::chrono::steady_clock::now();
-    const std::vector<MicroimageTruth> truth = microimage_truth(m, options);
+    MicroimageWork work;
+    const std::vector<MicroimageTruth> truth = microimage_truth(m, options, MicroimageProgress(), MicroimageCancel(),
+                                                                nullptr, &work);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     const double cpu = cpu_seconds() - cpu0;
     std::size_t lit = 0;
@@ -198,11 +232,66 @@ int main(int argc, char** argv)
             return 1;
         }
     }
+    // The check: random lenses of the picture and its corners, each measured.
+    double check_du = 0, check_dv = 0, check_fraction = 0, check_cpu = 0;
+    std::size_t checked = 0;
+    LensIndex worst{0, 0};
+    if (o.check > 0 && !truth.empty()) {
+        std::vector<std::size_t> which;
+        std::uint64_t state = 0x9E3779B97F4A7C15ull;
+        for (int i = 0; i < o.check; ++i) {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            which.push_back(std::size_t((state >> 33) % truth.size()));
+        }
+        // The corners: the first and last lens of the first and the last row.
+        std::size_t first_row_end = 0, last_row_start = truth.size() - 1;
+        while (first_row_end + 1 < truth.size() && truth[first_row_end + 1].lens.l == truth[0].lens.l)
+            ++first_row_end;
+        while (last_row_start > 0 && truth[last_row_start - 1].lens.l == truth.back().lens.l)
+            --last_row_start;
+        which.push_back(0);
+        which.push_back(first_row_end);
+        which.push_back(last_row_start);
+        which.push_back(truth.size() - 1);
+        std::vector<LensIndex> lenses;
+        for (std::size_t i : which)
+            lenses.push_back(truth[i].lens);
+        MicroimageOptions exact = options;
+        exact.anchor_step = 0;
+        if (o.check_points > 0)
+            exact.refracting_points = o.check_points;
+        const double c0 = cpu_seconds();
+        const std::vector<MicroimageTruth> each = measured_microimages(m, lenses, exact);
+        check_cpu = cpu_seconds() - c0;
+        for (std::size_t i = 0; i < which.size(); ++i) {
+            const MicroimageTruth& a = truth[which[i]];
+            const MicroimageTruth& b = each[i];
+            if (a.lit != b.lit) {
+                std::fprintf(stderr, "plenoptic_microimage_truth: lens (%lld, %lld) lit %d, measured %d\n",
+                             (long long)a.lens.k, (long long)a.lens.l, int(a.lit), int(b.lit));
+                check_du = check_dv = INFINITY;
+            }
+            check_fraction = std::max(check_fraction, std::fabs(a.lit_fraction - b.lit_fraction));
+            if (a.lit && b.lit) {
+                const double d = std::max(std::fabs(a.u_px - b.u_px), std::fabs(a.v_px - b.v_px));
+                if (d > std::max(check_du, check_dv))
+                    worst = a.lens;
+                check_du = std::max(check_du, std::fabs(a.u_px - b.u_px));
+                check_dv = std::max(check_dv, std::fabs(a.v_px - b.v_px));
+            }
+            ++checked;
+        }
+    }
     struct rusage usage;
     getrusage(RUSAGE_SELF, &usage);
+    if (checked > 0)
+        std::printf("{\"checked\": %zu, \"check_du_px\": %.3g, \"check_dv_px\": %.3g, \"check_fraction\": %.3g, "
+                    "\"check_cpu_s\": %.3f, \"check_worst_lens\": [%lld, %lld]}\n",
+                    checked, check_du, check_dv, check_fraction, check_cpu, (long long)worst.k, (long long)worst.l);
     std::printf("{\"size\": [%d, %d], \"offset_mm\": [%.9g, %.9g], \"lenses\": %zu, \"lit_lenses\": %zu, "
-                "\"threads\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"peak_rss_mib\": %.1f}\n",
+                "\"threads\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"peak_rss_mib\": %.1f, \"anchors\": %zu, "
+                "\"interpolated\": %zu, \"measured\": %zu}\n",
                 o.width, o.height, o.offset_mm[0], o.offset_mm[1], truth.size(), lit, o.threads, wall, cpu,
-                usage.ru_maxrss / 1024.0);
+                usage.ru_maxrss / 1024.0, work.anchors, work.interpolated, work.measured);
     return 0;
 }

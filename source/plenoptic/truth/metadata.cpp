@@ -184,6 +184,12 @@ Json microimages_json(const MicroimageSummary* summary)
     integration["azimuths"] = summary->options.azimuths;
     integration["tolerance_px"] = json_number(summary->options.tolerance_px);
     integration["aperture_points"] = summary->options.aperture_points;
+    if (summary->work.anchors > 0) {
+        // Refracting microlenses between anchors (docs/real-lenses.md, "Microimage centres").
+        integration["anchor_step"] = summary->options.anchor_step;
+        integration["anchors"] = summary->work.anchors;
+        integration["interpolated_lenses"] = summary->work.interpolated;
+    }
     json["integration"] = integration;
     const LatticeFit& fit = summary->fit;
     if (fit.valid) {

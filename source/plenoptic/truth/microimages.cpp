@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <thread>
+#include <unordered_map>
 
 #include "plenoptic/projection/microimage_lattice.h"
 #include "plenoptic/lens/pupil_bounds.h"
@@ -26,7 +27,6 @@ using detail::project_to_array;
 const int kCoarseSearch = 24;   // grid points a side when the start point is dark
 const int kMaxDoublings = 8;    // of the bracket, when a boundary lies beyond it
 const int kMaxBisections = 60;
-const int kRefractingAperturePoints = 24;  // a side, for lenses first-order optics does not describe
 
 // Area and first moments of light over the sensor, in pixels (corner convention: pixel (i, j)
 // spans [i, i + 1) x [j, j + 1)).
@@ -480,7 +480,7 @@ struct CellNode {
 
 // The cell points at which a lens's light is measured: the midpoint rule on the renderer's own
 // uniform map of the cell, aperture_points a side (refracting lenses: at least
-// kRefractingAperturePoints, as their regions differ from point to point); pinholes: the centre.
+// refracting_points, as their regions differ from point to point); pinholes: the centre.
 std::vector<CellNode> cell_nodes(const PlenopticCamera& m, const MicroimageOptions& options)
 {
     std::vector<CellNode> nodes;
@@ -490,7 +490,7 @@ std::vector<CellNode> cell_nodes(const PlenopticCamera& m, const MicroimageOptio
     }
     const int n = std::max(1, m.array.microlens->first_order_exact()
                                   ? options.aperture_points
-                                  : std::max(options.aperture_points, kRefractingAperturePoints));
+                                  : std::max(options.aperture_points, options.refracting_points));
     for (int j = 0; j < n; ++j)
         for (int i = 0; i < n; ++i)
             nodes.push_back(CellNode{(i + 0.5) / n, (j + 0.5) / n, double(n * n)});
@@ -507,56 +507,22 @@ MicroimageOptions default_microimage_options()
     options.aperture_points = 3;
     options.threads = 0;
     options.reuse_neighbours = true;
+    options.anchor_step = 16;
+    options.refracting_points = 24;
     return options;
 }
 
-std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const MicroimageOptions& options,
-                                              const MicroimageProgress& progress, const MicroimageCancel& cancelled,
-                                              const PlenopticCamera* through)
-{
-    // The lenses and their start points are this camera's; their light is traced through `through`.
-    const PlenopticCamera& light = through ? *through : m;
-    const int W = m.sensor.film.width, H = m.sensor.film.height;
-    std::vector<MicroimageTruth> out;
-    if (m.array.grid == GridType::None || !m.lens || W <= 0 || H <= 0)
-        return out;
-    double box[4];
-    if (!picture_on_array(m, box))
-        return out;
-    const double p = m.array.pitch_mm, rows = row_spacing(m.array.grid, p);
-    // Margins of lenses: a lattice centre in the picture may belong to a lens whose centre
-    // projects just outside the box of the corners (the centres project from the exit pupil).
-    const double l0 = std::floor(box[1] / rows) - 2, l1 = std::ceil(box[3] / rows) + 2;
-    const double k0 = std::floor(box[0] / p) - 3, k1 = std::ceil(box[2] / p) + 3;
-    if (!(l1 - l0 < 1e7 && k1 - k0 < 1e7))
-        return out;
-    // The lenses whose lattice centre is in the picture: counted first, so that the list takes no
-    // more memory than it holds (a Lytro-class raw has some 234,000).
-    auto in_picture = [&](LensIndex lens, Vec2* centre_px) {
-        const MicroimageCentre centre = microimage_centre_px(m, lens);
-        *centre_px = Vec2{centre.u, centre.v};
-        return centre.valid && centre.u >= -0.5 && centre.u < W - 0.5 && centre.v >= -0.5 && centre.v < H - 0.5;
-    };
-    for (int pass = 0; pass < 2; ++pass) {
-        std::size_t count = 0;
-        for (std::int64_t l = std::int64_t(l0); l <= std::int64_t(l1); ++l) {
-            for (std::int64_t k = std::int64_t(k0); k <= std::int64_t(k1); ++k) {
-                const LensIndex lens{k, l};
-                Vec2 centre;
-                if (!in_picture(lens, &centre))
-                    continue;  // the lattice centre is not in the picture
-                ++count;
-                if (pass == 1) {
-                    MicroimageTruth truth = MicroimageTruth();
-                    truth.lens = lens;
-                    out.push_back(truth);
-                }
-            }
-        }
-        if (pass == 0)
-            out.reserve(count);
-    }
+namespace {
 
+// Measures the lenses of `out` (their `lens` set, row by row), each through `light`'s rays; a run
+// of neighbours is lenses k, k + step, k + 2 step, ... of one row. Reports (now, out.size()) about
+// every tenth of the lenses; false when `cancelled` stopped it.
+bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, const MicroimageOptions& options,
+                    std::vector<MicroimageTruth>& out, std::int64_t step, const MicroimageProgress& progress,
+                    const MicroimageCancel& cancelled)
+{
+    if (out.empty())
+        return true;
     const std::vector<CellNode> nodes = cell_nodes(m, options);
     // Per cell point, the radii of its region in the last kHistory lenses of a run, newest first
     // (fewer at the run's start or after a lens without that region), and a prediction.
@@ -567,8 +533,8 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     };
     auto measure = [&](std::size_t index, Radii* radii) {
         MicroimageTruth& truth = out[index];
-        Vec2 centre;
-        in_picture(truth.lens, &centre);
+        const MicroimageCentre lattice = microimage_centre_px(m, truth.lens);
+        const Vec2 centre{lattice.u, lattice.v};
         Moments total{0, 0, 0};
         RadiusChange change;  // of this lens's regions from their predictions
         for (std::size_t point = 0; point < nodes.size(); ++point) {
@@ -648,7 +614,7 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     std::vector<std::size_t> runs;  // the first lens of each run, then out.size()
     for (std::size_t i = 0; i < out.size(); ++i)
         if (i == 0 || i - runs.back() >= kRun || out[i].lens.l != out[i - 1].lens.l ||
-            out[i].lens.k != out[i - 1].lens.k + 1)
+            out[i].lens.k != out[i - 1].lens.k + step)
             runs.push_back(i);
     runs.push_back(out.size());
     const bool reuse = options.reuse_neighbours;
@@ -684,8 +650,329 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     work(true);
     for (std::thread& worker : workers)
         worker.join();
-    if (stop)
+    return !stop;
+}
+
+// Refracting microlenses on an ideal array: every lens of the array sees its own part of the main
+// lens's light through the same glass, so its microimage's offset from its lattice centre and its
+// lit fraction are smooth functions of where the lens is. Those lenses are measured exactly at
+// anchors, every anchor_step-th lens of every anchor_step-th row, and interpolated between them
+// (a cubic in each direction, on the 4 x 4 anchors nearest the lens), wherever the anchors say the
+// cubic holds; the other lenses are measured. A lens's position in lattice units: X = k (+ 1/2 on
+// the odd rows of a hexagonal array), Y = l.
+double lattice_x(GridType grid, LensIndex lens)
+{
+    return double(lens.k) + (grid == GridType::Hexagonal && floor_mod(lens.l, 2) == 1 ? 0.5 : 0.0);
+}
+
+// The cubic through four anchors at 0, 1, 2, 3, at t: its weights.
+void cubic_weights(double t, double w[4])
+{
+    w[0] = -(t - 1) * (t - 2) * (t - 3) / 6;
+    w[1] = t * (t - 2) * (t - 3) / 2;
+    w[2] = -t * (t - 1) * (t - 3) / 2;
+    w[3] = t * (t - 1) * (t - 2) / 6;
+}
+
+// The cubic's error, from fourth differences of the anchors: the cubic through four points at unit
+// steps misses a function by f''''(xi) / 24 |t (t - 1) (t - 2) (t - 3)| at t (at most 0.023 f''''
+// between the middle two, 0.042 between the outer ones at the array's edge), and f'''' is about the
+// fourth difference of five anchors, the larger of the two windows that hold the four; the error of
+// the two directions' cubics add. kCubicMargin on that estimate.
+const double kCubicMargin = 1.5;
+double cubic_error(double t, double fourth_difference)
+{
+    return kCubicMargin * std::fabs(t * (t - 1) * (t - 2) * (t - 3)) / 24 * fourth_difference;
+}
+// The interpolation is used where that estimate is below these, half the accuracy the truth keeps (0.001 px, 1e-4 of lit fraction): the measured lenses themselves scatter about a
+// smooth field by some 1e-4 px and 3e-5 of lit fraction (small regions near the cell's edge found or
+// missed, the cell's band cut differently by the 24 x 24 cell points from lens to lens), which the
+// interpolation does not follow, and which gives fourth differences of up to about 1.5e-3 px and
+// 3e-4 where the field itself is smooth.
+const double kInterpolatedPx = 5e-4;
+const double kInterpolatedFraction = 5e-5;
+
+// One anchor: its lens's offset from its lattice centre (pixels) and its lit fraction.
+struct AnchorValue {
+    bool lit;
+    double value[3];  // du, dv, lit fraction
+};
+
+std::uint64_t anchor_key(LensIndex lens)
+{
+    return (std::uint64_t(lens.k) << 32) ^ (std::uint64_t(lens.l) & 0xffffffffull);
+}
+
+// The anchors of one level: lenses (K step, L step), K = k0 .. k1, L = l0 .. l1, those measured
+// in `values`.
+struct Anchors {
+    std::int64_t step = 0, k0 = 0, k1 = 0, l0 = 0, l1 = 0;
+    const std::unordered_map<std::uint64_t, AnchorValue>* values = nullptr;
+
+    // The first anchor (i0, j0) of the lens's 4 x 4, and where the lens lies in anchor units.
+    void stencil(GridType grid, LensIndex lens, std::int64_t* i0, std::int64_t* j0, double* x, double* y) const
+    {
+        *x = lattice_x(grid, lens) / double(step);
+        *y = double(lens.l) / double(step);
+        *i0 = std::max(k0, std::min(k1 - 3, std::int64_t(std::floor(*x)) - 1));
+        *j0 = std::max(l0, std::min(l1 - 3, std::int64_t(std::floor(*y)) - 1));
+    }
+    // Calls f(K, L) for each anchor the lens's interpolation reads: its 4 x 4 and the anchors one
+    // beyond them along its rows and columns (for the fourth differences), inside the range.
+    template <class F> void each(std::int64_t i0, std::int64_t j0, F f) const
+    {
+        for (std::int64_t j = std::max(l0, j0 - 1); j <= std::min(l1, j0 + 4); ++j)
+            for (std::int64_t i = std::max(k0, i0 - 1); i <= std::min(k1, i0 + 4); ++i)
+                if ((j >= j0 && j <= j0 + 3) || (i >= i0 && i <= i0 + 3))
+                    f(i, j);
+    }
+    LensIndex lens(std::int64_t K, std::int64_t L) const { return LensIndex{K * step, L * step}; }
+};
+
+// The lens's microimage from the anchors, or false where the anchors do not vouch for the cubic (a
+// dark anchor among those it reads, or a fourth difference too large).
+bool interpolate(const Anchors& a, GridType grid, MicroimageTruth* truth, Vec2 lattice_px)
+{
+    std::int64_t i0, j0;
+    double x, y;
+    a.stencil(grid, truth->lens, &i0, &j0, &x, &y);
+    // The anchors it reads, in a 6 x 6 block from (i0 - 1, j0 - 1); null where not read.
+    const AnchorValue* block[6][6] = {};
+    bool dark = false;
+    a.each(i0, j0, [&](std::int64_t i, std::int64_t j) {
+        const auto found = a.values->find(anchor_key(a.lens(i, j)));
+        if (found == a.values->end() || !found->second.lit)
+            dark = true;
+        else
+            block[j - j0 + 1][i - i0 + 1] = &found->second;
+    });
+    if (dark)
+        return false;
+    auto v = [&](std::int64_t i, std::int64_t j, int q) { return block[j - j0 + 1][i - i0 + 1]->value[q]; };
+    const double allowed[3] = {kInterpolatedPx, kInterpolatedPx, kInterpolatedFraction};
+    double wx[4], wy[4];
+    cubic_weights(x - double(i0), wx);
+    cubic_weights(y - double(j0), wy);
+    double result[3];
+    for (int q = 0; q < 3; ++q) {
+        // The largest fourth difference along each direction over the stencil's rows and columns,
+        // of each window of five anchors that holds the stencil's four.
+        double largest[2] = {0, 0};
+        for (int across = 0; across < 4; ++across)
+            for (std::int64_t first = -1; first <= 0; ++first) {
+                if (i0 + first >= a.k0 && i0 + first + 4 <= a.k1) {
+                    const std::int64_t i = i0 + first, j = j0 + across;
+                    const double d4 = v(i, j, q) - 4 * v(i + 1, j, q) + 6 * v(i + 2, j, q) - 4 * v(i + 3, j, q) +
+                                      v(i + 4, j, q);
+                    largest[0] = std::max(largest[0], std::fabs(d4));
+                }
+                if (j0 + first >= a.l0 && j0 + first + 4 <= a.l1) {
+                    const std::int64_t i = i0 + across, j = j0 + first;
+                    const double d4 = v(i, j, q) - 4 * v(i, j + 1, q) + 6 * v(i, j + 2, q) - 4 * v(i, j + 3, q) +
+                                      v(i, j + 4, q);
+                    largest[1] = std::max(largest[1], std::fabs(d4));
+                }
+            }
+        if (cubic_error(x - double(i0), largest[0]) + cubic_error(y - double(j0), largest[1]) > allowed[q])
+            return false;
+        double sum = 0;
+        for (int j = 0; j < 4; ++j) {
+            double row = 0;
+            for (int i = 0; i < 4; ++i)
+                row += wx[i] * v(i0 + i, j0 + j, q);
+            sum += wy[j] * row;
+        }
+        result[q] = sum;
+    }
+    truth->lit = true;
+    truth->u_px = lattice_px.x + result[0];
+    truth->v_px = lattice_px.y + result[1];
+    truth->lit_fraction = result[2];
+    return true;
+}
+
+// Whether the truth interpolates between anchors: refracting microlenses (measured at 24 x 24
+// cell points, 64 times a thin lens's cost) on an array without manufacturing errors.
+bool interpolates(const PlenopticCamera& m, const PlenopticCamera& light, const MicroimageOptions& options)
+{
+    return options.anchor_step >= 4 && options.anchor_step % 2 == 0 && m.array.microlens &&
+           m.array.microlens->forms_image() && !m.array.microlens->first_order_exact() && !m.array.errors &&
+           !light.array.errors && (m.array.grid == GridType::Hexagonal || m.array.grid == GridType::Rectangular);
+}
+
+} // namespace
+
+std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const MicroimageOptions& options,
+                                              const MicroimageProgress& progress, const MicroimageCancel& cancelled,
+                                              const PlenopticCamera* through, MicroimageWork* work)
+{
+    MicroimageWork unused;
+    MicroimageWork& counts = work ? *work : unused;
+    counts = MicroimageWork();
+    // The lenses and their start points are this camera's; their light is traced through `through`.
+    const PlenopticCamera& light = through ? *through : m;
+    const int W = m.sensor.film.width, H = m.sensor.film.height;
+    std::vector<MicroimageTruth> out;
+    if (m.array.grid == GridType::None || !m.lens || W <= 0 || H <= 0)
+        return out;
+    double box[4];
+    if (!picture_on_array(m, box))
+        return out;
+    const double p = m.array.pitch_mm, rows = row_spacing(m.array.grid, p);
+    // Margins of lenses: a lattice centre in the picture may belong to a lens whose centre
+    // projects just outside the box of the corners (the centres project from the exit pupil).
+    const double l0 = std::floor(box[1] / rows) - 2, l1 = std::ceil(box[3] / rows) + 2;
+    const double k0 = std::floor(box[0] / p) - 3, k1 = std::ceil(box[2] / p) + 3;
+    if (!(l1 - l0 < 1e7 && k1 - k0 < 1e7))
+        return out;
+    // The lenses whose lattice centre is in the picture: counted first, so that the list takes no
+    // more memory than it holds (a Lytro-class raw has some 234,000).
+    auto in_picture = [&](LensIndex lens, Vec2* centre_px) {
+        const MicroimageCentre centre = microimage_centre_px(m, lens);
+        *centre_px = Vec2{centre.u, centre.v};
+        return centre.valid && centre.u >= -0.5 && centre.u < W - 0.5 && centre.v >= -0.5 && centre.v < H - 0.5;
+    };
+    for (int pass = 0; pass < 2; ++pass) {
+        std::size_t count = 0;
+        for (std::int64_t l = std::int64_t(l0); l <= std::int64_t(l1); ++l) {
+            for (std::int64_t k = std::int64_t(k0); k <= std::int64_t(k1); ++k) {
+                const LensIndex lens{k, l};
+                Vec2 centre;
+                if (!in_picture(lens, &centre))
+                    continue;  // the lattice centre is not in the picture
+                ++count;
+                if (pass == 1) {
+                    MicroimageTruth truth = MicroimageTruth();
+                    truth.lens = lens;
+                    out.push_back(truth);
+                }
+            }
+        }
+        if (pass == 0)
+            out.reserve(count);
+    }
+
+    if (!interpolates(m, light, options) || out.empty()) {
+        counts.measured = out.size();
+        if (!measure_lenses(m, light, options, out, 1, progress, cancelled))
+            out.clear();
+        return out;
+    }
+    // Levels of anchors: anchor_step, then half of it, ... down to 4 lenses apart. At each level the
+    // lenses not yet interpolated get the anchors they read (those not measured yet are measured),
+    // and are interpolated where those vouch for the cubic; the rest go on to the next level (near
+    // where the main lens begins to vignette, the light changes too fast for the coarser anchors).
+    // The lenses left at the end are measured. Every decision depends on the lenses alone.
+    double x_lo = INFINITY, x_hi = -INFINITY;
+    for (const MicroimageTruth& t : out) {
+        x_lo = std::min(x_lo, lattice_x(m.array.grid, t.lens));
+        x_hi = std::max(x_hi, lattice_x(m.array.grid, t.lens));
+    }
+    const std::int64_t l_lo = out.front().lens.l, l_hi = out.back().lens.l;
+    const std::size_t total = out.size();
+    std::unordered_map<std::uint64_t, AnchorValue> values;
+    std::vector<std::size_t> pending(out.size());  // indices into `out` not yet found
+    for (std::size_t i = 0; i < out.size(); ++i)
+        pending[i] = i;
+    // Progress: the anchors are the first half of the work, the lenses measured after them the rest.
+    auto share = [&](std::size_t first) {
+        return progress ? MicroimageProgress([&progress, first, total](std::size_t now, std::size_t count) {
+            progress(first + now * (total / 4) / std::max<std::size_t>(1, count), total);
+        })
+                        : MicroimageProgress();
+    };
+    int level = 0;
+    for (std::int64_t step = options.anchor_step; step >= 4 && !pending.empty(); step /= 2, ++level) {
+        if (step % 2 != 0)
+            break;
+        Anchors anchors;
+        anchors.step = step;
+        anchors.values = &values;
+        anchors.k0 = std::int64_t(std::floor(x_lo / double(step))) - 1;
+        anchors.k1 = std::int64_t(std::floor(x_hi / double(step))) + 2;
+        anchors.l0 = floor_div(l_lo, step) - 1;
+        anchors.l1 = floor_div(l_hi, step) + 2;
+        if (anchors.k1 - anchors.k0 < 4 || anchors.l1 - anchors.l0 < 4)
+            break;  // fewer than five anchors a side
+        // The anchors the pending lenses read that are not measured yet, row by row.
+        std::vector<std::uint64_t> wanted;
+        std::vector<MicroimageTruth> measured;
+        {
+            std::unordered_map<std::uint64_t, char> seen;
+            for (std::size_t index : pending) {
+                std::int64_t i0, j0;
+                double x, y;
+                anchors.stencil(m.array.grid, out[index].lens, &i0, &j0, &x, &y);
+                anchors.each(i0, j0, [&](std::int64_t i, std::int64_t j) {
+                    const LensIndex lens = anchors.lens(i, j);
+                    const std::uint64_t key = anchor_key(lens);
+                    if (values.count(key) == 0 && seen.emplace(key, 1).second) {
+                        MicroimageTruth truth = MicroimageTruth();
+                        truth.lens = lens;
+                        measured.push_back(truth);
+                    }
+                });
+            }
+        }
+        // Anchors that cost more than measuring the lenses they serve: measure those lenses.
+        if (4 * measured.size() > pending.size())
+            break;
+        std::sort(measured.begin(), measured.end(), [](const MicroimageTruth& p, const MicroimageTruth& q) {
+            return p.lens.l != q.lens.l ? p.lens.l < q.lens.l : p.lens.k < q.lens.k;
+        });
+        if (!measure_lenses(m, light, options, measured, step, share(std::min(level, 1) * total / 4), cancelled)) {
+            out.clear();
+            return out;
+        }
+        counts.anchors += measured.size();
+        for (const MicroimageTruth& t : measured) {
+            const MicroimageCentre centre = microimage_centre_px(m, t.lens);
+            AnchorValue value;
+            value.lit = t.lit && centre.valid;
+            value.value[0] = value.lit ? t.u_px - centre.u : 0;
+            value.value[1] = value.lit ? t.v_px - centre.v : 0;
+            value.value[2] = t.lit_fraction;
+            values[anchor_key(t.lens)] = value;
+        }
+        // The lenses left, kept in place (the list is 8 bytes a lens of the picture at first).
+        std::size_t left = 0;
+        for (std::size_t index : pending) {
+            const MicroimageCentre centre = microimage_centre_px(m, out[index].lens);
+            if (!interpolate(anchors, m.array.grid, &out[index], Vec2{centre.u, centre.v}))
+                pending[left++] = index;
+        }
+        pending.resize(left);
+        pending.shrink_to_fit();
+    }
+    counts.interpolated = out.size() - pending.size();
+    counts.measured = pending.size();
+    if (counts.anchors == 0) {
+        // No level paid: every lens measured.
+        if (!measure_lenses(m, light, options, out, 1, progress, cancelled))
+            out.clear();
+        return out;
+    }
+    std::vector<MicroimageTruth> measured(pending.size(), MicroimageTruth());
+    for (std::size_t i = 0; i < pending.size(); ++i)
+        measured[i].lens = out[pending[i]].lens;
+    if (!measure_lenses(m, light, options, measured, 1, share(total / 2), cancelled)) {
         out.clear();
+        return out;
+    }
+    for (std::size_t i = 0; i < pending.size(); ++i)
+        out[pending[i]] = measured[i];
+    return out;
+}
+
+std::vector<MicroimageTruth> measured_microimages(const PlenopticCamera& m, const std::vector<LensIndex>& lenses,
+                                                  const MicroimageOptions& options, const PlenopticCamera* through)
+{
+    std::vector<MicroimageTruth> out(lenses.size(), MicroimageTruth());
+    for (std::size_t i = 0; i < lenses.size(); ++i)
+        out[i].lens = lenses[i];
+    if (m.array.grid == GridType::None || !m.lens)
+        return std::vector<MicroimageTruth>();
+    measure_lenses(m, through ? *through : m, options, out, 1, MicroimageProgress(), MicroimageCancel());
     return out;
 }
 

@@ -52,6 +52,16 @@ struct MicroimageOptions {
     // prediction checked by the renderer's rays, each answer as close to a crossing as without);
     // false: every lens from scratch (the reference the unit tests compare against).
     bool reuse_neighbours;
+    // Refracting microlenses on an array without manufacturing errors: the lenses k, l that are
+    // multiples of anchor_step (even, at least 4) are measured as anchors, and the others
+    // interpolated between them (a cubic each way through the 4 x 4 nearest) wherever the anchors'
+    // fourth differences put the cubic's error below 5e-4 px and 5e-5 of lit fraction; the lenses
+    // left try anchors at half the step, and so on down to 4; those left then, and pictures with
+    // too few lenses for anchors to pay, are measured. 0: every lens measured. Other microlenses
+    // and arrays with errors: every lens measured, whatever this is.
+    int anchor_step = 0;
+    // Refracting microlenses: cell points a side (at least aperture_points).
+    int refracting_points = 24;
 };
 
 // Called now and then (about every tenth of the lenses) with the lenses done and their number.
@@ -74,10 +84,23 @@ MicroimageOptions default_microimage_options();
 // With `through` (the same camera at another wavelength: at_wavelength), the lenses and their
 // start points are still this camera's, and the light is traced through `through`: the same lenses
 // in the same order, their microimages at that wavelength.
+// `work` (if given) receives how the lenses were found (anchors, MicroimageOptions::anchor_step).
+struct MicroimageWork {
+    std::size_t anchors = 0;       // lenses measured as anchors (0: no interpolation)
+    std::size_t interpolated = 0;  // lenses of the picture interpolated between anchors
+    std::size_t measured = 0;      // lenses of the picture measured each
+};
 std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& model, const MicroimageOptions& options,
                                               const MicroimageProgress& progress = MicroimageProgress(),
                                               const MicroimageCancel& cancelled = MicroimageCancel(),
-                                              const PlenopticCamera* through = nullptr);
+                                              const PlenopticCamera* through = nullptr,
+                                              MicroimageWork* work = nullptr);
+
+// The given lenses, each measured (never interpolated between anchors), in the given order: what
+// microimage_truth gives a lens with anchor_step 0, whichever lenses are measured with it.
+std::vector<MicroimageTruth> measured_microimages(const PlenopticCamera& model, const std::vector<LensIndex>& lenses,
+                                                  const MicroimageOptions& options,
+                                                  const PlenopticCamera* through = nullptr);
 
 // Least-squares lattice through the lit centres: (u, v) = origin + k_s a + l b in skew indices,
 // as the metadata's microimage_lattice, and how far the centres lie from it.
@@ -111,6 +134,9 @@ struct MicroimageSummary {
     double channel_wavelengths_nm[3] = {0, 0, 0};
     // The array has manufacturing errors: the file has each lens's (dx_mm ... tilt_azimuth_deg).
     bool lens_errors = false;
+    // How the lenses were found (set by the caller from microimage_truth's `work`): with anchors,
+    // the metadata's integration says so.
+    MicroimageWork work;
 };
 
 MicroimageSummary summarise_microimages(const PlenopticCamera& model, const std::vector<MicroimageTruth>& truth,

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <vector>
 
@@ -342,6 +343,139 @@ TEST(MicroimageTruth, ReusingNeighboursAgreesFromScratchForRefractingAndTiltedLe
         EXPECT_LT(largest, 1.5) << c.name;
         std::printf("%s: %zu lenses, largest difference %.2g px, lit fraction %.2g (lit fractions %.3f to %.3f)\n",
                     c.name, a.size(), worst_px, worst_fraction, smallest, largest);
+    }
+}
+
+// Refracting microlenses on an array without errors: the lenses between anchors (every fourth lens
+// of every fourth row here) are interpolated. Every lens checked must agree with measuring it
+// (measured_microimages, what anchor_step 0 gives) within 0.001 px and 1e-4 of lit fraction, with
+// either side of the caps towards the scene, over a field whose corners the triplet vignettes; the
+// answer is the same bits on 1 and 3 threads. With manufacturing errors every lens is measured: the
+// same bits as anchor_step 0.
+TEST(MicroimageTruth, RefractingLensesBetweenAnchorsAgreeWithMeasuringThem)
+{
+    const Prescription lens = vignetting_triplet();
+    const ImageDistance focus = paraxial_image_distance(lens, 3000);
+    ASSERT_TRUE(focus.real);
+    // Lenses a quarter of the other tests' (pitch 0.25 mm, 10 pixels of 0.025 mm), so that anchors
+    // four lenses apart are 1 mm apart in the triplet's field, as sixteen Lytro-class lenses are a
+    // thirtieth of that camera's field; the picture (240 x 208 pixels, 6 x 5.2 mm) lies towards
+    // the corner of the field, where the triplet vignettes.
+    CameraParams scene_side = plenoptic_camera(GridType::Hexagonal, 0.25, 0.85, 0.85, 50, 4, focus.mm);
+    scene_side.main.type = MainLensType::Prescription;
+    scene_side.main.has_focal_length = false;
+    scene_side.main.has_f_number = false;
+    scene_side.main.has_prescription = true;
+    scene_side.main.prescription = lens;
+    scene_side.sensor.pixel_size_mm[0] = scene_side.sensor.pixel_size_mm[1] = 0.025;
+    scene_side.sensor.offset_mm[0] = 9;
+    scene_side.sensor.offset_mm[1] = 7;
+    // Caps of the same paraxial focal length (R = f (n - 1)); the sensor at their back focal
+    // distance: f - L / n from the flat back (curved side to the scene), f from the caps' vertex
+    // plane (curved side to the sensor, whose principal plane is that vertex).
+    scene_side.array.lens = MicrolensType::Refracting;
+    scene_side.array.focal_length_count = 0;
+    scene_side.array.refracting.radius_mm = 0.425;
+    scene_side.array.refracting.ior = 1.5;
+    scene_side.array.refracting.cap_mm = 0.03;
+    scene_side.array.refracting.substrate_mm = 0.05;
+    scene_side.array.distance_mm = 0.85 - 0.08 / 1.5;
+    CameraParams sensor_side = scene_side;
+    sensor_side.array.refracting.curved_towards_scene = false;
+    sensor_side.array.distance_mm = 0.85;
+    struct Case {
+        const char* name;
+        CameraParams params;
+    };
+    const Case cases[] = {{"caps towards the scene", scene_side}, {"caps towards the sensor", sensor_side}};
+    for (const Case& c : cases) {
+        const PlenopticCamera camera = with_film(make_camera(c.params), 240, 208);
+        MicroimageOptions fast = default_microimage_options(), one_thread = fast;
+        fast.anchor_step = one_thread.anchor_step = 4;
+        fast.threads = 3;
+        one_thread.threads = 1;
+        MicroimageWork work;
+        const std::vector<MicroimageTruth> a = microimage_truth(camera, fast, MicroimageProgress(), MicroimageCancel(),
+                                                                nullptr, &work);
+        ASSERT_GE(a.size(), 500u) << c.name;
+        if (&c == &cases[0]) {
+            // The thread count does not matter (one orientation suffices: the path is the same).
+            MicroimageWork work_one;
+            const std::vector<MicroimageTruth> d = microimage_truth(camera, one_thread, MicroimageProgress(),
+                                                                    MicroimageCancel(), nullptr, &work_one);
+            ASSERT_EQ(a.size(), d.size()) << c.name;
+            for (std::size_t i = 0; i < a.size(); ++i) {
+                ASSERT_TRUE(a[i].lens == d[i].lens && a[i].lit == d[i].lit) << c.name << " " << i;
+                EXPECT_EQ(a[i].u_px, d[i].u_px);  // bit for bit
+                EXPECT_EQ(a[i].v_px, d[i].v_px);
+                EXPECT_EQ(a[i].lit_fraction, d[i].lit_fraction);
+            }
+            EXPECT_EQ(work.interpolated, work_one.interpolated) << c.name;
+        }
+        // Most lenses interpolated, and the anchors far fewer than the lenses.
+        EXPECT_EQ(work.interpolated + work.measured, a.size()) << c.name;
+        EXPECT_GT(work.interpolated, a.size() / 2) << c.name;
+        EXPECT_LT(4 * work.anchors, a.size()) << c.name;
+        // Lenses drawn across the picture, every lens of its first row (the picture's edge, where
+        // the stencils are one-sided) and the last lens (a corner), each measured.
+        std::vector<std::size_t> which;
+        std::uint64_t state = 12345;
+        for (int i = 0; i < 24; ++i) {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            which.push_back(std::size_t((state >> 33) % a.size()));
+        }
+        for (std::size_t i = 0; i < a.size() && a[i].lens.l == a[0].lens.l; ++i)
+            which.push_back(i);
+        which.push_back(a.size() - 1);
+        std::vector<LensIndex> lenses;
+        for (std::size_t i : which)
+            lenses.push_back(a[i].lens);
+        MicroimageOptions exact = one_thread;
+        exact.anchor_step = 0;
+        const std::vector<MicroimageTruth> b = measured_microimages(camera, lenses, exact);
+        ASSERT_EQ(b.size(), which.size());
+        double worst_px = 0, worst_fraction = 0, smallest = INFINITY, largest = 0;
+        for (std::size_t n = 0; n < which.size(); ++n) {
+            const MicroimageTruth& x = a[which[n]];
+            ASSERT_TRUE(x.lens == b[n].lens && x.lit == b[n].lit) << c.name << " " << which[n];
+            worst_fraction = std::max(worst_fraction, std::fabs(x.lit_fraction - b[n].lit_fraction));
+            if (!x.lit)
+                continue;
+            smallest = std::min(smallest, x.lit_fraction);
+            largest = std::max(largest, x.lit_fraction);
+            worst_px = std::max(worst_px, std::max(std::fabs(x.u_px - b[n].u_px), std::fabs(x.v_px - b[n].v_px)));
+        }
+        EXPECT_LT(worst_px, 1e-3) << c.name;
+        EXPECT_LT(worst_fraction, 1e-4) << c.name;
+        EXPECT_GT(smallest, 0.05) << c.name;
+        std::printf("%s: %zu lenses, %zu anchors, %zu interpolated, %zu measured; %zu checked: largest difference "
+                    "%.2g px, lit fraction %.2g (lit fractions %.3f to %.3f)\n",
+                    c.name, a.size(), work.anchors, work.interpolated, work.measured, which.size(), worst_px,
+                    worst_fraction, smallest, largest);
+    }
+    // With errors: every lens measured, as with anchor_step 0.
+    CameraParams errors = scene_side;
+    errors.array.has_errors = true;
+    errors.array.errors.position_sd_mm = 0.005;
+    errors.array.errors.focal_sd = 0.02;
+    errors.array.errors.rotation_deg = 1;
+    errors.array.errors.seed = 5;
+    const PlenopticCamera camera = with_film(make_camera(errors), 60, 50);
+    MicroimageOptions anchored = default_microimage_options(), every = anchored;
+    anchored.anchor_step = 4;
+    every.anchor_step = 0;
+    MicroimageWork work;
+    const std::vector<MicroimageTruth> a = microimage_truth(camera, anchored, MicroimageProgress(), MicroimageCancel(),
+                                                            nullptr, &work);
+    const std::vector<MicroimageTruth> b = microimage_truth(camera, every);
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_EQ(work.anchors, 0u);
+    EXPECT_EQ(work.measured, a.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        EXPECT_TRUE(a[i].lens == b[i].lens && a[i].lit == b[i].lit);
+        EXPECT_EQ(a[i].u_px, b[i].u_px);
+        EXPECT_EQ(a[i].v_px, b[i].v_px);
+        EXPECT_EQ(a[i].lit_fraction, b[i].lit_fraction);
     }
 }
 

@@ -27,7 +27,9 @@ public:
             if (total >= 20000)
                 std::fprintf(stderr, "plenoptic camera: microimage centres: %zu of %zu lenses\n", done, total);
         };
-        const std::vector<MicroimageTruth> truth = microimage_truth(model, options, progress, image.cancelled);
+        MicroimageWork work;
+        const std::vector<MicroimageTruth> truth =
+            microimage_truth(model, options, progress, image.cancelled, nullptr, &work);
         const std::string path = image.beside(".microimages.csv");
         if (image.cancelled()) {
             std::fprintf(stderr, "plenoptic camera: cancelled: no microimage centres written (%s); the metadata says "
@@ -35,6 +37,7 @@ public:
             return true;
         }
         MicroimageSummary summary = summarise_microimages(model, truth, options, base_name(path));
+        summary.work = work;
         // With spectral sampling, the same lenses at each channel's wavelength.
         std::vector<std::vector<MicroimageTruth>> channels;
         if (model.spectral) {
