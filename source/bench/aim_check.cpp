@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_camera.h"
 #include "plenoptic/camera/params.h"
 #include "plenoptic/camera/pixel.h"
 #include "plenoptic/camera/plenoptic_camera.h"
@@ -91,31 +92,16 @@ bool parse(int argc, char** argv, Options* o)
 
 CameraParams camera(const Options& o, const Prescription& lens, double focal_mm)
 {
-    CameraParams p;
-    p.main.given = true;
-    p.main.type = o.thick ? MainLensType::ThickLens : MainLensType::Prescription;
-    p.main.has_prescription = true;
-    p.main.prescription = lens;
-    p.main.lens_file = o.lens_file;
-    p.main.has_f_number = true;
-    p.main.f_number = o.f_number;
-    p.main.has_focus_distance = true;
-    p.main.focus_distance_units = o.focus_distance;
-    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = o.pixel_mm;
-    if (focal_mm > 0) {
-        p.array.given = true;
-        p.array.grid = GridType::Hexagonal;
-        p.array.has_pitch = true;
-        p.array.pitch_mm = o.pitch_mm;
-        p.array.has_lens = true;
-        p.array.lens = MicrolensType::ThinLens;
-        p.array.focal_length_count = 1;
-        p.array.focal_lengths_mm[0] = focal_mm;
-        p.array.has_distance = true;
-        p.array.distance_mm = focal_mm;
-    }
-    p.sampling.samples = o.samples;
-    return p;
+    bench::LensFileCamera c;
+    c.lens_file = o.lens_file;
+    c.thick = o.thick;
+    c.f_number = o.f_number;
+    c.focus_distance = o.focus_distance;
+    c.pixel_mm = o.pixel_mm;
+    c.pitch_mm = o.pitch_mm;
+    c.focal_mm = c.distance_mm = focal_mm;
+    c.samples = o.samples;
+    return bench::camera_params(c, lens);
 }
 
 struct Stat {

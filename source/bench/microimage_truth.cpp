@@ -37,6 +37,7 @@
 
 #include <sys/resource.h>
 
+#include "bench/bench_camera.h"
 #include "plenoptic/camera/params.h"
 #include "plenoptic/camera/plenoptic_camera.h"
 #include "plenoptic/lens/prescription.h"
@@ -158,27 +159,17 @@ int main(int argc, char** argv)
                      parsed.error.message.c_str());
         return 1;
     }
-    CameraParams p;
-    p.main.given = true;
-    p.main.type = MainLensType::Prescription;
-    p.main.has_prescription = true;
-    p.main.prescription = parsed.prescription;
-    p.main.lens_file = o.lens_file;
-    p.main.has_f_number = true;
-    p.main.f_number = o.f_number;
-    p.main.has_focus_distance = true;
-    p.main.focus_distance_units = o.focus_distance;
-    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = o.pixel_mm;
+    bench::LensFileCamera camera;
+    camera.lens_file = o.lens_file;
+    camera.f_number = o.f_number;
+    camera.focus_distance = o.focus_distance;
+    camera.pixel_mm = o.pixel_mm;
+    camera.pitch_mm = o.pitch_mm;
+    camera.focal_mm = o.focal_mm;
+    camera.distance_mm = o.distance_mm;
+    CameraParams p = bench::camera_params(camera, parsed.prescription);
     p.sensor.offset_mm[0] = o.offset_mm[0];
     p.sensor.offset_mm[1] = o.offset_mm[1];
-    p.array.given = true;
-    p.array.grid = GridType::Hexagonal;
-    p.array.has_pitch = true;
-    p.array.pitch_mm = o.pitch_mm;
-    p.array.has_lens = true;
-    p.array.lens = MicrolensType::ThinLens;
-    p.array.focal_length_count = 1;
-    p.array.focal_lengths_mm[0] = o.focal_mm;
     if (o.refracting) {
         p.array.lens = MicrolensType::Refracting;
         p.array.focal_length_count = 0;
@@ -188,8 +179,6 @@ int main(int argc, char** argv)
         p.array.refracting.ior = o.refracting_values[3];
         p.array.refracting.curved_towards_scene = !o.caps_to_sensor;
     }
-    p.array.has_distance = true;
-    p.array.distance_mm = o.distance_mm;
     if (o.errors) {
         p.array.has_errors = true;
         p.array.errors.position_sd_mm = o.error_values[0];

@@ -38,6 +38,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_camera.h"
 #include "plenoptic/lens/main_lens.h"
 #include "plenoptic/camera/plenoptic_camera.h"
 #include "plenoptic/optics.h"
@@ -119,31 +120,17 @@ bool parse(int argc, char** argv, Options* o)
 // focus_distance [thick_lens] }, sensor { pixel_size }, optionally the matched array).
 CameraParams camera(const Options& o, const Prescription& lens, double array_focal_mm, double array_distance_mm)
 {
-    CameraParams p;
-    p.main.given = true;
-    p.main.type = o.thick ? MainLensType::ThickLens : MainLensType::Prescription;
-    p.main.has_prescription = true;
-    p.main.prescription = lens;
-    p.main.lens_file = o.lens_file;
-    p.main.has_f_number = true;
-    p.main.f_number = o.f_number;
-    p.main.has_focus_distance = true;
-    p.main.focus_distance_units = o.focus_distance;
-    p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = o.pixel_mm;
-    if (array_focal_mm > 0) {
-        p.array.given = true;
-        p.array.grid = GridType::Hexagonal;
-        p.array.has_pitch = true;
-        p.array.pitch_mm = o.array_pitch_mm;
-        p.array.has_lens = true;
-        p.array.lens = MicrolensType::ThinLens;
-        p.array.focal_length_count = 1;
-        p.array.focal_lengths_mm[0] = array_focal_mm;
-        p.array.has_distance = true;
-        p.array.distance_mm = array_distance_mm;
-    }
-    p.sampling.samples = o.samples;
-    return p;
+    bench::LensFileCamera c;
+    c.lens_file = o.lens_file;
+    c.thick = o.thick;
+    c.f_number = o.f_number;
+    c.focus_distance = o.focus_distance;
+    c.pixel_mm = o.pixel_mm;
+    c.pitch_mm = o.array_pitch_mm;
+    c.focal_mm = array_focal_mm;
+    c.distance_mm = array_distance_mm;
+    c.samples = o.samples;
+    return bench::camera_params(c, lens);
 }
 
 // Image-side f-number: exit pupil to the plane D behind the rear vertex, over the pupil's diameter
