@@ -111,7 +111,8 @@ def main():
     poller.start()
     log = open(args.log, "wb") if args.log else None
     pending = b""
-    trace_time = None
+    trace_time = trace_cpu = None
+    after_trace_time = False  # the line after "Trace Time" gives its CPU seconds
     while True:
         chunk = proc.stdout.read1(65536)
         if not chunk:
@@ -124,6 +125,10 @@ def main():
         for part in parts:
             text = part.decode("utf-8", errors="replace")
             m = re.search(r"Trace Time:.*\(([\d.]+) seconds\)", text)
+            c = re.search(r"with ([\d.]+) CPU-seconds total", text) if after_trace_time else None
+            if c:
+                trace_cpu = float(c.group(1))
+            after_trace_time = bool(m)
             if m:
                 trace_time = float(m.group(1))
             profile.line(text)
@@ -138,12 +143,12 @@ def main():
         log.close()
     rows = profile.finish(wall, cpu)
     result = {"command": command, "status": status, "wall_s": round(wall, 2), "cpu_s": round(cpu, 2),
-              "peak_rss_mib": round(hwm, 1), "povray_trace_time_s": trace_time, "stages": rows}
+              "peak_rss_mib": round(hwm, 1), "povray_trace_time_s": trace_time, "povray_trace_cpu_s": trace_cpu, "stages": rows}
     print("%-12s %9s %9s %11s" % ("stage", "wall s", "CPU s", "peak MiB"))
     for r in rows:
         print("%-12s %9.1f %9.1f %11.1f" % (r["stage"], r["wall_s"], r["cpu_s"], r["peak_rss_mib"]))
-    print("%-12s %9.1f %9.1f %11s   (POV-Ray's trace time %s s; status %d)" % (
-        "whole run", wall, cpu, "%.1f" % hwm if hwm else "?", trace_time, status))
+    print("%-12s %9.1f %9.1f %11s   (POV-Ray's trace time %s s, %s CPU s; status %d)" % (
+        "whole run", wall, cpu, "%.1f" % hwm if hwm else "?", trace_time, trace_cpu, status))
     if args.json:
         with open(args.json, "w") as f:
             json.dump(result, f, indent=1)

@@ -80,20 +80,29 @@ void TracePixel::TracePlenopticPixel(Colour& colour, DBL x, DBL y, DBL width, DB
 	}
 
 	POV_ULONG traced = 0;  // camera rays into the scene, for the render statistics' "Samples"
-	plenoptic::Rgbt value = plenoptic::shade_pixel(model, i, j,
-		[&](const plenoptic::OpticsRay& optics_ray) -> plenoptic::Rgbt
-		{
-			traced++;
-			Ray ray;
-			ray.SetFlags(Ray::PrimaryRay, false, false, false, false, pretrace);
-			To_Scene(render, optics_ray, ray);
-			// As the perspective camera: the containing interiors are those at the main lens.
-			InitRayContainerState(ray);
-			Colour col;
-			Trace::TraceTicket ticket(maxTraceLevel, adcBailout, sceneData->outputAlpha);
-			TraceRay(ray, col, 1.0, ticket, false, camera.Max_Ray_Distance);
-			return plenoptic::Rgbt{col[pRED], col[pGREEN], col[pBLUE], col[pTRANSM]};
-		});
+	auto trace = [&](const plenoptic::OpticsRay& optics_ray) -> plenoptic::Rgbt
+	{
+		traced++;
+		Ray ray;
+		ray.SetFlags(Ray::PrimaryRay, false, false, false, false, pretrace);
+		To_Scene(render, optics_ray, ray);
+		// As the perspective camera: the containing interiors are those at the main lens.
+		InitRayContainerState(ray);
+		Colour col;
+		Trace::TraceTicket ticket(maxTraceLevel, adcBailout, sceneData->outputAlpha);
+		TraceRay(ray, col, 1.0, ticket, false, camera.Max_Ray_Distance);
+		return plenoptic::Rgbt{col[pRED], col[pGREEN], col[pBLUE], col[pTRANSM]};
+	};
+	plenoptic::Rgbt value;
+	if (render.keeps_white() && !pretrace)
+	{
+		// The white image's value of this pixel from the same samples (no second trace of the camera).
+		double white = 0;
+		value = plenoptic::shade_pixel_and_white(model, i, j, trace, &white);
+		render.pixel_white(i, j, white);
+	}
+	else
+		value = plenoptic::shade_pixel(model, i, j, trace);
 	threadData->Stats()[Number_Of_Samples] += traced;
 	colour = Colour(value.r, value.g, value.b, 0.0, value.t);
 }

@@ -73,12 +73,14 @@ def test_a_cached_white_image_is_the_computed_one_for_any_scene(args, sensor):
     fresh, _ = render(args, "fresh", scene(SKY, sensor=sensor), None)
     first, log = render(args, "first", scene(SKY, sensor=sensor), cache)
     assert "computed, and cached" in log and "the cached one" not in log, log[-1500:]
+    assert "from the render's own samples" in log, log[-1500:]  # kept by the render, then stored
     assert first == fresh  # storing changes nothing
     assert len(entries(cache)) == 1, entries(cache)
     # Another scene through the same camera: the white image comes from the cache, and is the one
     # a render without the cache computes.
     second, log = render(args, "second", scene(SPHERES, sensor=sensor), cache)
     assert "the cached one" in log and "computed, and cached" not in log, log[-1500:]
+    assert "from the render's own samples" not in log, log[-1500:]  # the cache held it: not kept
     assert second == fresh
     assert len(entries(cache)) == 1
 

@@ -21,30 +21,65 @@ const int kVignettingProbesPerSample = 4;
 
 namespace detail {
 
-// The colour a ray brings, scaled by its weight (the sampled area of a real lens's exit pupil
-// relative to its paraxial pupil; 1 for every other ray).
-template <class TraceFn>
-Rgbt traced(TraceFn& trace, const OpticsRay& ray)
+// What the sample loop adds up for a pixel: r, g, b and t of the light the traced rays bring and,
+// with N = 5, a white channel: each passing ray brings 1 there, so that channel is what the pixel
+// would be in a world of radiance 1 (its white image value) from the very same samples.
+template <int N>
+struct Channels {
+    double v[N];
+};
+
+template <int N>
+inline Channels<N> zero_channels()
+{
+    Channels<N> c;
+    for (int ch = 0; ch < N; ++ch)
+        c.v[ch] = 0;
+    return c;
+}
+
+// What `trace` returns for `ray`, as channels (the white channel 1).
+template <int N, class TraceFn>
+Channels<N> traced_plain(TraceFn& trace, const OpticsRay& ray)
 {
     const Rgbt c = trace(ray);
+    Channels<N> out;
+    out.v[0] = c.r;
+    out.v[1] = c.g;
+    out.v[2] = c.b;
+    out.v[3] = c.t;
+    if (N == 5)
+        out.v[N - 1] = 1;
+    return out;
+}
+
+// The colour a ray brings, scaled by its weight (the sampled area of a real lens's exit pupil
+// relative to its paraxial pupil; 1 for every other ray).
+template <int N, class TraceFn>
+Channels<N> traced(TraceFn& trace, const OpticsRay& ray)
+{
+    Channels<N> c = traced_plain<N>(trace, ray);
     if (ray.weight == 1)
         return c;
-    return Rgbt{c.r * ray.weight, c.g * ray.weight, c.b * ray.weight, c.t * ray.weight};
+    for (int ch = 0; ch < N; ++ch)
+        c.v[ch] *= ray.weight;
+    return c;
 }
 
 // Running sums of one lens's samples.
+template <int N>
 struct SampleSums {
-    double sum[4];
-    double sum_sq[4];
+    double sum[N];
+    double sum_sq[N];
     int count;
 };
 
-inline void add_sample(SampleSums* s, const Rgbt& c)
+template <int N>
+inline void add_sample(SampleSums<N>* s, const Channels<N>& c)
 {
-    const double v[4] = {c.r, c.g, c.b, c.t};
-    for (int ch = 0; ch < 4; ++ch) {
-        s->sum[ch] += v[ch];
-        s->sum_sq[ch] += v[ch] * v[ch];
+    for (int ch = 0; ch < N; ++ch) {
+        s->sum[ch] += c.v[ch];
+        s->sum_sq[ch] += c.v[ch] * c.v[ch];
     }
     ++s->count;
 }
@@ -52,17 +87,18 @@ inline void add_sample(SampleSums* s, const Rgbt& c)
 // The pixel value and, per channel, the variance of that estimate. One lens: the mean of its
 // samples. Several lenses: the sum over lenses of the mean over each lens's samples (irradiance
 // adds), scaled up when fewer samples than lenses left some lens without a sample.
-inline void estimate(const SampleSums* sums, int lenses, double value[4], double variance[4])
+template <int N>
+inline void estimate(const SampleSums<N>* sums, int lenses, double value[N], double variance[N])
 {
     int sampled = 0;
-    for (int ch = 0; ch < 4; ++ch)
+    for (int ch = 0; ch < N; ++ch)
         value[ch] = variance[ch] = 0;
     for (int s = 0; s < lenses; ++s) {
         const int n = sums[s].count;
         if (n == 0)
             continue;
         ++sampled;
-        for (int ch = 0; ch < 4; ++ch) {
+        for (int ch = 0; ch < N; ++ch) {
             const double mean = sums[s].sum[ch] / n;
             value[ch] += mean;
             // Variance of the mean, as focal_blur computes it: (E[x^2] - E[x]^2) / n.
@@ -72,10 +108,20 @@ inline void estimate(const SampleSums* sums, int lenses, double value[4], double
     if (sampled == 0)
         return;
     const double scale = double(lenses) / sampled;
-    for (int ch = 0; ch < 4; ++ch) {
+    for (int ch = 0; ch < N; ++ch) {
         value[ch] *= scale;
         variance[ch] *= scale * scale;
     }
+}
+
+// `sum` scaled by `scale`, as channels.
+template <int N>
+inline Channels<N> scaled(const double sum[N], double scale)
+{
+    Channels<N> c;
+    for (int ch = 0; ch < N; ++ch)
+        c.v[ch] = sum[ch] * scale;
+    return c;
 }
 
 // Sample n of `count` samples of pixel (i, j) whose light comes through `lenses` lenses (overlap
@@ -126,9 +172,9 @@ inline int passing_samples(const PlenopticCamera& model, int i, int j, int from,
 // as many sample points (a ratio estimate: the vignetting is known far better than the scene).
 // `sum` holds the sums of the `passed` traced colours of samples 0 .. n-1. With none passed but
 // some probe passing, that probe's sample is traced so the pixel is not black where light lands.
-template <class TraceFn>
-Rgbt vignetted_value(const PlenopticCamera& model, int i, int j, int n, int passed, double sum[4], TraceFn& trace,
-                     int stream)
+template <int N, class TraceFn>
+Channels<N> vignetted_value(const PlenopticCamera& model, int i, int j, int n, int passed, double sum[N], TraceFn& trace,
+                            int stream)
 {
     const int probes = n * kVignettingProbesPerSample;
     int first_untraced;
@@ -136,17 +182,14 @@ Rgbt vignetted_value(const PlenopticCamera& model, int i, int j, int n, int pass
     const int passing = passed + passing_samples(model, i, j, n, probes, &first_untraced, stream);
     if (passed == 0 && first_untraced >= 0) {
         const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, first_untraced, probes, stream));
-        const Rgbt c = detail::traced(trace, ray);
-        sum[0] = c.r;
-        sum[1] = c.g;
-        sum[2] = c.b;
-        sum[3] = c.t;
+        const Channels<N> c = detail::traced<N>(trace, ray);
+        for (int ch = 0; ch < N; ++ch)
+            sum[ch] = c.v[ch];
         passed = 1;
     }
     if (passed == 0)
-        return Rgbt{0, 0, 0, 0};
-    const double scale = double(passing) / probes / passed;
-    return Rgbt{sum[0] * scale, sum[1] * scale, sum[2] * scale, sum[3] * scale};
+        return zero_channels<N>();
+    return scaled<N>(sum, double(passing) / probes / passed);
 }
 
 // Points a side of the grid over which a pixel's lit area is averaged (lit_area_value).
@@ -171,31 +214,30 @@ inline double mean_lit_area(const PlenopticCamera& model, int i, int j)
 // mean is the lit light's mean colour; the table knows the lit area everywhere, so the pixel's
 // vignetting costs look-ups, not traces. With none passed, the first passing point of
 // kVignettingProbesPerSample n points of its sample sequence is traced for the colour.
-template <class TraceFn>
-Rgbt lit_area_value(const PlenopticCamera& model, int i, int j, int n, int passed, const double plain[4], TraceFn& trace,
-                    int stream)
+template <int N, class TraceFn>
+Channels<N> lit_area_value(const PlenopticCamera& model, int i, int j, int n, int passed, const double plain[N],
+                           TraceFn& trace, int stream)
 {
     const double lit = mean_lit_area(model, i, j);
     if (!(lit > 0))
-        return Rgbt{0, 0, 0, 0};
-    if (passed > 0) {
-        const double scale = lit / passed;
-        return Rgbt{plain[0] * scale, plain[1] * scale, plain[2] * scale, plain[3] * scale};
-    }
+        return zero_channels<N>();
+    if (passed > 0)
+        return scaled<N>(plain, lit / passed);
     const int points = n * kVignettingProbesPerSample;
     for (int k = n; k < points; ++k) {
         const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, k, points, stream));
         if (ray.passed) {
-            const Rgbt c = trace(ray);
-            return Rgbt{c.r * lit, c.g * lit, c.b * lit, c.t * lit};
+            const Channels<N> c = traced_plain<N>(trace, ray);
+            return scaled<N>(c.v, lit);
         }
     }
-    return Rgbt{0, 0, 0, 0};
+    return zero_channels<N>();
 }
 
-// shade_pixel's work for one camera and one budget of samples (see shade_pixel below).
-template <class TraceFn>
-Rgbt shade_samples(const PlenopticCamera& model, int i, int j, TraceFn& trace, const SampleBudget& budget)
+// shade_pixel's work for one camera and one budget of samples (see shade_pixel below), in N
+// channels (r, g, b, t and, with N = 5, white). Adaptive stopping looks at r, g, b and t only.
+template <int N, class TraceFn>
+Channels<N> shade_samples(const PlenopticCamera& model, int i, int j, TraceFn& trace, const SampleBudget& budget)
 {
     const int count = std::max(1, budget.max);
     const int stream = budget.stream;
@@ -203,29 +245,32 @@ Rgbt shade_samples(const PlenopticCamera& model, int i, int j, TraceFn& trace, c
         // Fixed count through the own lens: the plain mean, without the variance bookkeeping
         // (the common case, and the one whose cost is compared with the stock cameras).
         const bool lit_area = model.lit_area && budget.pixel_count > 1;
-        double sum[4] = {0, 0, 0, 0};
+        double sum[N];
+        for (int ch = 0; ch < N; ++ch)
+            sum[ch] = 0;
         int passed = 0;
         for (int n = 0; n < count; ++n) {
             const OpticsRay ray = model.generate_ray(i, j, make_sample(i, j, n, budget.pixel_count, stream));
             if (ray.passed) {
                 // With a lit-area table the colours are summed without the ray weight: the
                 // pixel's lit area scales their mean (detail::lit_area_value).
-                const Rgbt c = lit_area ? trace(ray) : detail::traced(trace, ray);
-                sum[0] += c.r;
-                sum[1] += c.g;
-                sum[2] += c.b;
-                sum[3] += c.t;
+                const Channels<N> c = lit_area ? traced_plain<N>(trace, ray) : detail::traced<N>(trace, ray);
+                for (int ch = 0; ch < N; ++ch)
+                    sum[ch] += c.v[ch];
                 ++passed;
             }
         }
         if (lit_area)
-            return lit_area_value(model, i, j, count, passed, sum, trace, stream);
+            return lit_area_value<N>(model, i, j, count, passed, sum, trace, stream);
         // Aimed samples (camera/aim.h) carry weights, and choosing the probes' ratio estimate only
         // when some sample was blocked would bias the pixel by the weights that passed: their plain
         // mean is unbiased, and few of them are blocked.
         if (budget.pixel_count > 1 && passed < count && !model.sampling.aim)
-            return vignetted_value(model, i, j, count, passed, sum, trace, stream);
-        return Rgbt{sum[0] / count, sum[1] / count, sum[2] / count, sum[3] / count};
+            return vignetted_value<N>(model, i, j, count, passed, sum, trace, stream);
+        Channels<N> mean;
+        for (int ch = 0; ch < N; ++ch)
+            mean.v[ch] = sum[ch] / count;
+        return mean;
     }
 
     LensIndex lenses[kMaxOverlapLenses];
@@ -233,34 +278,38 @@ Rgbt shade_samples(const PlenopticCamera& model, int i, int j, TraceFn& trace, c
     if (model.overlap.modelled) {
         lens_count = overlap_lenses(model, i, j, lenses, kMaxOverlapLenses);
         if (lens_count == 0)
-            return Rgbt{0, 0, 0, 0};
+            return zero_channels<N>();
     }
-    SampleSums sums[kMaxOverlapLenses];
-    for (int s = 0; s < lens_count; ++s)
-        sums[s] = SampleSums{{0, 0, 0, 0}, {0, 0, 0, 0}, 0};
+    SampleSums<N> sums[kMaxOverlapLenses];
+    for (int s = 0; s < lens_count; ++s) {
+        for (int ch = 0; ch < N; ++ch)
+            sums[s].sum[ch] = sums[s].sum_sq[ch] = 0;
+        sums[s].count = 0;
+    }
 
     int batch = model.sampling.adaptive ? std::max(1, budget.min) : count;
-    double value[4], variance[4];
+    double value[N], variance[N];
     int n = 0;
     int passed = 0;  // samples that passed the apertures so far
-    double plain[4] = {0, 0, 0, 0};  // their colours without the ray weight (for lit_area_value)
+    double plain[N];  // their colours without the ray weight (for lit_area_value)
+    for (int ch = 0; ch < N; ++ch)
+        plain[ch] = 0;
     for (;;) {
         const int stop = std::min(count, n + batch);
         for (; n < stop; ++n) {
             int slot = 0;
             const CameraSample sample = lens_sample(i, j, n, budget.pixel_count, lens_count, &slot, stream);
             const OpticsRay ray = generate_ray(model, i, j, sample, model.overlap.modelled ? &lenses[slot] : nullptr);
-            Rgbt colour{0, 0, 0, 0};
+            Channels<N> colour = zero_channels<N>();
             if (ray.passed) {
-                const Rgbt raw = trace(ray);
-                colour = Rgbt{raw.r * ray.weight, raw.g * ray.weight, raw.b * ray.weight, raw.t * ray.weight};
-                plain[0] += raw.r;
-                plain[1] += raw.g;
-                plain[2] += raw.b;
-                plain[3] += raw.t;
+                const Channels<N> raw = traced_plain<N>(trace, ray);
+                for (int ch = 0; ch < N; ++ch) {
+                    colour.v[ch] = raw.v[ch] * ray.weight;
+                    plain[ch] += raw.v[ch];
+                }
                 ++passed;
             }
-            add_sample(&sums[slot], colour);
+            add_sample<N>(&sums[slot], colour);
         }
         if (!model.sampling.adaptive || n >= count)
             break;
@@ -273,19 +322,23 @@ Rgbt shade_samples(const PlenopticCamera& model, int i, int j, TraceFn& trace, c
         // The variance of the plain mean, blocked samples as zeros: the pass/block noise in it keeps
         // rim pixels sampling (tried: leaving it out to the vignetting probes stopped them too early;
         // on the benchmark's plenoptic 1.0 scene that took 1.6-2x the time for the same error).
-        estimate(sums, lens_count, value, variance);
+        estimate<N>(sums, lens_count, value, variance);
         const double threshold = model.sampling.thresholds[n - 1];
         if (std::fabs(variance[0]) < threshold && std::fabs(variance[1]) < threshold &&
             std::fabs(variance[2]) < threshold && std::fabs(variance[3]) < threshold)
             break;
     }
     if (lens_count == 1 && budget.pixel_count > 1 && model.lit_area)
-        return lit_area_value(model, i, j, n, passed, plain, trace, stream);
+        return lit_area_value<N>(model, i, j, n, passed, plain, trace, stream);
     if (lens_count == 1 && budget.pixel_count > 1 && passed < n && !model.sampling.aim)
-        return vignetted_value(model, i, j, n, passed, sums[0].sum, trace, stream);
-    estimate(sums, lens_count, value, variance);
-    const double t = lens_count > 1 ? std::min(1.0, std::max(0.0, value[3])) : value[3];
-    return Rgbt{value[0], value[1], value[2], t};
+        return vignetted_value<N>(model, i, j, n, passed, sums[0].sum, trace, stream);
+    estimate<N>(sums, lens_count, value, variance);
+    Channels<N> out;
+    for (int ch = 0; ch < N; ++ch)
+        out.v[ch] = value[ch];
+    if (lens_count > 1)
+        out.v[3] = std::min(1.0, std::max(0.0, value[3]));
+    return out;
 }
 
 
@@ -310,15 +363,18 @@ inline int band_offset(int i, int j, int bands)
 // threshold keeps the weighted sum's below it: the weights are at most 1 and sum to 1). The value
 // of channel c is (N / S) sum_b w_c(b) v_b,c over the S bands that got samples: their weighted sum
 // when every band got some, and an unbiased estimate of it when fewer samples than bands leave some
-// out (each band is left out of as many pixels' sets as any other); t is the mean over them.
-template <class TraceFn>
-Rgbt spectral_pixel(const PlenopticCamera& model, int i, int j, TraceFn& trace)
+// out (each band is left out of as many pixels' sets as any other); t is the mean over them. The
+// white channel (C = 5) is weighted as r is (a white image is the r channel of a white world).
+template <int C, class TraceFn>
+Channels<C> spectral_pixel(const PlenopticCamera& model, int i, int j, TraceFn& trace)
 {
     const SpectralCameras& spectral = *model.spectral;
     const int bands = int(spectral.bands.size());
     const int count = std::max(1, model.sampling.samples_max);
     const int offset = band_offset(i, j, bands);
-    double sum[4] = {0, 0, 0, 0};
+    double sum[C];
+    for (int ch = 0; ch < C; ++ch)
+        sum[ch] = 0;
     int sampled = 0;
     for (int b = 0; b < bands; ++b) {
         SampleBudget budget{0, 0, count, (b + 1) * kBandStreamStride};
@@ -331,18 +387,38 @@ Rgbt spectral_pixel(const PlenopticCamera& model, int i, int j, TraceFn& trace)
         }
         if (budget.max == 0)
             continue;
-        const Rgbt v = shade_samples(spectral.cameras[size_t(b)], i, j, trace, budget);
+        const Channels<C> v = shade_samples<C>(spectral.cameras[size_t(b)], i, j, trace, budget);
         const double* w = spectral.bands[size_t(b)].weight;
-        sum[0] += w[0] * v.r;
-        sum[1] += w[1] * v.g;
-        sum[2] += w[2] * v.b;
-        sum[3] += v.t;
+        sum[0] += w[0] * v.v[0];
+        sum[1] += w[1] * v.v[1];
+        sum[2] += w[2] * v.v[2];
+        sum[3] += v.v[3];
+        if (C == 5)
+            sum[C - 1] += w[0] * v.v[C - 1];
         ++sampled;
     }
     if (sampled == 0)
-        return Rgbt{0, 0, 0, 0};
+        return zero_channels<C>();
     const double scale = double(bands) / sampled;
-    return Rgbt{sum[0] * scale, sum[1] * scale, sum[2] * scale, sum[3] / sampled};
+    Channels<C> out;
+    out.v[0] = sum[0] * scale;
+    out.v[1] = sum[1] * scale;
+    out.v[2] = sum[2] * scale;
+    out.v[3] = sum[3] / sampled;
+    if (C == 5)
+        out.v[C - 1] = sum[C - 1] * scale;
+    return out;
+}
+
+// The channels of pixel (i, j) (see shade_pixel).
+template <int N, class TraceFn>
+Channels<N> pixel_channels(const PlenopticCamera& model, int i, int j, TraceFn& trace)
+{
+    if (model.spectral)
+        return spectral_pixel<N>(model, i, j, trace);
+    const SampleBudget budget{model.sampling.samples_min, model.sampling.samples_max,
+                              std::max(1, model.sampling.samples_max), 0};
+    return shade_samples<N>(model, i, j, trace, budget);
 }
 
 } // namespace detail
@@ -367,11 +443,21 @@ Rgbt spectral_pixel(const PlenopticCamera& model, int i, int j, TraceFn& trace)
 template <class TraceFn>
 Rgbt shade_pixel(const PlenopticCamera& model, int i, int j, TraceFn trace)
 {
-    if (model.spectral)
-        return detail::spectral_pixel(model, i, j, trace);
-    const detail::SampleBudget budget{model.sampling.samples_min, model.sampling.samples_max,
-                                      std::max(1, model.sampling.samples_max), 0};
-    return detail::shade_samples(model, i, j, trace, budget);
+    const detail::Channels<4> c = detail::pixel_channels<4>(model, i, j, trace);
+    return Rgbt{c.v[0], c.v[1], c.v[2], c.v[3]};
+}
+
+// shade_pixel, and in *white what the same samples give in a world of radiance 1: the pixel's
+// white image value (white_image.h), equal to shade_pixel(model, i, j, [](...) { return {1, 1, 1,
+// 1}; }).r operation for operation, when the samples do not depend on the colours traced, i.e. with
+// a fixed count (model.sampling.adaptive false; adaptive stopping looks at the scene's colours).
+// A render that writes its white image keeps it this way instead of tracing the camera again.
+template <class TraceFn>
+Rgbt shade_pixel_and_white(const PlenopticCamera& model, int i, int j, TraceFn trace, double* white)
+{
+    const detail::Channels<5> c = detail::pixel_channels<5>(model, i, j, trace);
+    *white = c.v[4];
+    return Rgbt{c.v[0], c.v[1], c.v[2], c.v[3]};
 }
 
 // Whether any of the sample points shade_pixel looks at for pixel (i, j) passes the apertures

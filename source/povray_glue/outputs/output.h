@@ -100,6 +100,12 @@ public:
     // pixel traced (not during the pretrace), on the thread that traces it, before it is shaded.
     virtual bool traces_pixels() const { return false; }
     virtual void pixel_traced(int column, int row, SceneProbe& scene) { (void)column, (void)row, (void)scene; }
+    // During the render: whether the output keeps each pixel's white value (what the pixel's own
+    // samples give in a world of radiance 1: shade_pixel_and_white, camera/pixel.h), and the hook
+    // that receives it, called once for every pixel shaded (not during the pretrace), on the thread
+    // that shades it. At most one output of a render keeps it.
+    virtual bool keeps_white() const { return false; }
+    virtual void pixel_white(int column, int row, double white) { (void)column, (void)row, (void)white; }
 
     // Before the front end writes the image: may change the picture. false (with a message on
     // stderr): no image may be written; the later stages do not run.

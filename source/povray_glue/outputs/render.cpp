@@ -38,6 +38,8 @@ Render::Render(std::shared_ptr<const CameraSetup> setup, const CameraFrame& fram
             continue;
         if (output->traces_pixels())
             pixel_outputs_.push_back(output.get());
+        if (output->keeps_white() && white_output_ == nullptr)
+            white_output_ = output.get();
         outputs_.push_back(std::move(output));
         names_.push_back(kind.name);
     }

@@ -60,6 +60,11 @@ public:
             o->pixel_traced(column, row, scene);
     }
 
+    // During the render, for pixel (column, row) on the thread that shades it: its white value, for
+    // the output that keeps it (Output::keeps_white). keeps_white(): whether one does.
+    bool keeps_white() const { return white_output_ != nullptr; }
+    void pixel_white(int column, int row, double white) const { white_output_->pixel_white(column, row, white); }
+
 private:
     std::shared_ptr<const CameraSetup> setup_;
     PlenopticCamera model_;
@@ -69,6 +74,7 @@ private:
     std::vector<std::unique_ptr<Output> > outputs_;
     std::vector<const char*> names_;
     std::vector<Output*> pixel_outputs_;
+    Output* white_output_ = nullptr;
 };
 
 // The hand-over to the front end, by the view that rendered (POV-Ray's view id: unique in the

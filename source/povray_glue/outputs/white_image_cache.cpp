@@ -166,22 +166,43 @@ std::string WhiteImageCache::png_path(const std::string& description) const
     return folder_ + "/" + white_image_key(description) + ".png";
 }
 
+namespace {
+
+// The entry of `description` in `folder` (its JSON, with the fields copy_out reads) into *entry;
+// false when there is none or it is not this description's.
+bool read_entry(const std::string& folder, const std::string& description, nlohmann::json* entry)
+{
+    std::string text;
+    if (!read_file(folder + "/" + white_image_key(description) + ".json", &text))
+        return false;
+    *entry = nlohmann::json::parse(text, nullptr, false);
+    if (entry->is_discarded() || !entry->is_object())
+        return false;
+    const auto d = entry->find("description"), s = entry->find("scale"), n = entry->find("png_bytes"),
+               h = entry->find("png_hash");
+    if (d == entry->end() || !d->is_string() || d->get<std::string>() != description)
+        return false;
+    return s != entry->end() && s->is_number() && n != entry->end() && n->is_number_unsigned() && h != entry->end() &&
+           h->is_string();
+}
+
+} // namespace
+
+bool WhiteImageCache::holds(const std::string& description) const
+{
+    nlohmann::json entry;
+    return enabled() && read_entry(folder_, description, &entry);
+}
+
 bool WhiteImageCache::copy_out(const std::string& description, const std::string& path, double* scale) const
 {
     if (!enabled())
         return false;
     const std::string stem = folder_ + "/" + white_image_key(description);
-    std::string text;
-    if (!read_file(stem + ".json", &text))
+    nlohmann::json entry;
+    if (!read_entry(folder_, description, &entry))
         return false;
-    const nlohmann::json entry = nlohmann::json::parse(text, nullptr, false);
-    if (entry.is_discarded() || !entry.is_object())
-        return false;
-    const auto d = entry.find("description"), s = entry.find("scale"), n = entry.find("png_bytes"), h = entry.find("png_hash");
-    if (d == entry.end() || !d->is_string() || d->get<std::string>() != description)
-        return false;
-    if (s == entry.end() || !s->is_number() || n == entry.end() || !n->is_number_unsigned() || h == entry.end() || !h->is_string())
-        return false;
+    const auto s = entry.find("scale"), n = entry.find("png_bytes"), h = entry.find("png_hash");
     std::FILE* in = std::fopen((stem + ".png").c_str(), "rb");
     if (in == nullptr)
         return false;

@@ -53,6 +53,9 @@ public:
     const std::string& executable() const { return executable_; }
     std::string png_path(const std::string& description) const;
 
+    // Whether an entry of `description` is there (its PNG is checked only when copied out: a
+    // damaged one is then not used, and the white image is computed).
+    bool holds(const std::string& description) const;
     // Writes the entry of `description` to `path` (atomically, copied piece by piece) and its
     // scale (what the linear values were divided by, WhiteImageFile::scale) to *scale; false, and
     // `path` untouched, when there is none, or its description or files do not match (a damaged

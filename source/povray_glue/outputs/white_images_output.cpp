@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 
 #include "plenoptic/sensor/diffraction.h"
 #include "plenoptic/sensor/sensor_chain.h"
@@ -32,12 +33,13 @@ PlenopticCamera camera_at_f_number(const PlenopticCamera& camera, double f_numbe
 const int kWhiteBandRows = 64;
 
 // White image index k of `optics` written to `path` as a PNG, band by band of rows (memory: a few
-// bands, whatever the sensor's size): the grey irradiance per pixel (white_image_rows); with
+// bands, whatever the sensor's size): the grey irradiance per pixel (`kept`, W x H values from the
+// top, when the render kept them, else white_image_rows); with
 // diffraction, as R, G and B (diffraction differs by colour) convolved band by band; through the
 // read-out when `raw`, else linear, divided by `scale`. false: cancelled (nothing written, no
 // message) or a file could not be written (with a message).
 bool write_white_png(const PlenopticCamera& optics, const CameraParams& params, bool raw, int k, const std::string& path,
-                     CancelQuery cancelled, double& scale)
+                     CancelQuery cancelled, const float* kept, double& scale)
 {
     const int W = optics.sensor.film.width, H = optics.sensor.film.height;
     const SensorChainParams& chain = params.sensor.chain;
@@ -47,7 +49,7 @@ bool write_white_png(const PlenopticCamera& optics, const CameraParams& params, 
     const int channels = diffraction.applied || raw ? 3 : 1;
 
     // Minutes for a large sensor (it is traced as the picture is): say how far, every tenth.
-    const bool large = size_t(W) * H >= 4000000;
+    const bool large = size_t(W) * H >= 4000000 && kept == nullptr;
     if (large)
         std::fprintf(stderr, "plenoptic camera: white image %s: %d x %d pixels\n", base_name(path).c_str(), W, H);
     int tenths = 0;
@@ -55,7 +57,9 @@ bool write_white_png(const PlenopticCamera& optics, const CameraParams& params, 
     std::vector<float> grey;
     const RowReader white_rows = [&](int first, int count, float* to) {
         grey.resize(size_t(count) * W);
-        if (!white_image_rows(optics, first, count, grey.data(), cancelled))
+        if (kept != nullptr)
+            std::copy(kept + size_t(first) * W, kept + size_t(first + count) * W, grey.begin());
+        else if (!white_image_rows(optics, first, count, grey.data(), cancelled))
             return false;
         if (large && (first + count) * 10 >= (tenths + 1) * H) {
             tenths = (first + count) * 10 / H;
@@ -151,9 +155,37 @@ bool write_white_png(const PlenopticCamera& optics, const CameraParams& params, 
     return written;
 }
 
+// Whether `area` is the whole of `camera`'s film, every block traced (no +SR/+ER, no +C).
+bool whole_render(const PlenopticCamera& camera, const RenderArea& area)
+{
+    const PixelRect& a = area.area;
+    return area.untraced.empty() && a.left == 0 && a.top == 0 && a.right == camera.sensor.film.width - 1 &&
+           a.bottom == camera.sensor.film.height - 1;
+}
+
 class WhiteImagesOutput : public Output {
 public:
-    explicit WhiteImagesOutput(const Render& render) : render_(render), cache_(WhiteImageCache::from_environment()) {}
+    WhiteImagesOutput(const Render& render, const RenderArea& area)
+        : render_(render), cache_(WhiteImageCache::from_environment())
+    {
+        // The white image at the camera's own aperture is what the render's own samples give in a
+        // world of radiance 1 (shade_pixel_and_white), so a whole render with a fixed sample count
+        // keeps it as it goes (a float a pixel) instead of tracing the camera a second time; unless
+        // the cache holds it already.
+        const WhiteImageRequest& white = render.setup().white_image;
+        const PlenopticCamera& model = render.model();
+        if (!white.f_numbers.empty() || model.sampling.adaptive || !whole_render(model, area))
+            return;
+        if (cache_.enabled() && cache_.holds(description(model, 0, model.f_number())))
+            return;
+        kept_.assign(size_t(model.sensor.film.width) * model.sensor.film.height, std::numeric_limits<float>::quiet_NaN());
+    }
+
+    bool keeps_white() const override { return !kept_.empty(); }
+    void pixel_white(int column, int row, double white) override
+    {
+        kept_[size_t(row) * render_.width() + size_t(column)] = float(white);
+    }
 
     bool write(const WrittenImage& image, SidecarFiles& files) override
     {
@@ -174,15 +206,18 @@ public:
             const bool raw = params.sensor.chain.given && !white.noise_free;
             const std::string path = image.beside(white_image_suffix(white, k));
             double scale = 1;
-            const std::string description =
-                cache_.enabled() ? white_image_description(optics, params, f_number, k, raw, cache_.executable()) : "";
+            const std::string description = cache_.enabled() ? this->description(optics, k, f_number) : "";
             bool written = false;
             if (cache_.enabled() && cache_.copy_out(description, path, &scale)) {
                 std::fprintf(stderr, "plenoptic camera: white image %s: the cached one, %s\n", base_name(path).c_str(),
                              cache_.png_path(description).c_str());
                 written = true;
             } else {
-                written = write_white_png(optics, params, raw, k, path, image.cancelled, scale);
+                const float* kept = own ? kept_white(image) : nullptr;
+                if (kept != nullptr)
+                    std::fprintf(stderr, "plenoptic camera: white image %s: from the render's own samples\n",
+                                 base_name(path).c_str());
+                written = write_white_png(optics, params, raw, k, path, image.cancelled, kept, scale);
                 if (image.cancelled())
                     break;
                 if (written && cache_.enabled() && cache_.store(description, path, scale))
@@ -200,24 +235,46 @@ public:
                 ok = false;
             }
         }
+        std::vector<float>().swap(kept_);  // its memory back for the outputs after this one
         if (image.cancelled())
             std::fprintf(stderr, "plenoptic camera: cancelled: white images not all written.\n");
         return ok;
     }
 
 private:
+    // The cache's description of white image k (at f-number N) of `optics`.
+    std::string description(const PlenopticCamera& optics, int k, double f_number) const
+    {
+        const CameraParams& params = render_.setup().params;
+        const bool raw = params.sensor.chain.given && !render_.setup().white_image.noise_free;
+        return white_image_description(optics, params, f_number, k, raw, cache_.executable());
+    }
+
+    // The values the render kept, when it kept every pixel of `image`'s film; else nullptr.
+    const float* kept_white(const WrittenImage& image) const
+    {
+        const Film& film = image.camera.sensor.film;
+        if (kept_.empty() || film.width != render_.width() || film.height != render_.height())
+            return nullptr;
+        for (float v : kept_)
+            if (std::isnan(v))
+                return nullptr;
+        return kept_.data();
+    }
+
     const Render& render_;
     const WhiteImageCache cache_;  // PLENOPTIC_WHITE_IMAGE_CACHE's folder, or disabled
+    std::vector<float> kept_;      // the render's own white values (W x H from the top), or empty
     std::vector<WhiteImageFile> written_;  // what the metadata lists
 };
 
 } // namespace
 
-std::unique_ptr<Output> start_white_images(const Render& render, const RenderArea&)
+std::unique_ptr<Output> start_white_images(const Render& render, const RenderArea& area)
 {
     if (!render.setup().white_image.given)
         return nullptr;
-    return std::unique_ptr<Output>(new WhiteImagesOutput(render));
+    return std::unique_ptr<Output>(new WhiteImagesOutput(render, area));
 }
 
 } // namespace plenoptic
