@@ -25,8 +25,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -44,11 +42,8 @@ namespace {
 using namespace plenoptic;
 
 struct Options {
-    std::string lens_file;
-    double f_number = 0, focus_distance = 0;
-    int width = 0, height = 0;
-    double pixel_mm = 0, pitch_mm = 0;
-    bool thick = false;
+    bench::CameraOptions camera;
+    double pitch_mm = 0;
     int samples = 16, reference = 1024, patch = 48;
     bool stripes = false;
 };
@@ -58,20 +53,10 @@ bool parse(int argc, char** argv, Options* o)
     for (int a = 1; a < argc; ++a) {
         const std::string arg = argv[a];
         const int left = argc - a - 1;
-        if (arg == "--lens-file" && left >= 1)
-            o->lens_file = argv[++a];
-        else if (arg == "--f-number" && left >= 1)
-            o->f_number = std::atof(argv[++a]);
-        else if (arg == "--focus-distance" && left >= 1)
-            o->focus_distance = std::atof(argv[++a]);
-        else if (arg == "--sensor" && left >= 3) {
-            o->width = std::atoi(argv[++a]);
-            o->height = std::atoi(argv[++a]);
-            o->pixel_mm = std::atof(argv[++a]);
-        } else if (arg == "--array-matched" && left >= 1)
+        if (bench::read_camera_option(argc, argv, &a, &o->camera))
+            continue;
+        if (arg == "--array-matched" && left >= 1)
             o->pitch_mm = std::atof(argv[++a]);
-        else if (arg == "--thick")
-            o->thick = true;
         else if (arg == "--samples" && left >= 1)
             o->samples = std::atoi(argv[++a]);
         else if (arg == "--reference" && left >= 1)
@@ -86,18 +71,13 @@ bool parse(int argc, char** argv, Options* o)
         } else
             return false;
     }
-    return !o->lens_file.empty() && o->f_number > 0 && o->focus_distance > 0 && o->width > 0 && o->height > 0 &&
-           o->pixel_mm > 0 && o->pitch_mm > 0 && o->samples >= 2 && o->reference >= 2 && o->patch > 0;
+    return o->camera.complete() && o->pitch_mm > 0 && o->samples >= 2 && o->reference >= 2 && o->patch > 0;
 }
 
 CameraParams camera(const Options& o, const Prescription& lens, double focal_mm)
 {
     bench::LensFileCamera c;
-    c.lens_file = o.lens_file;
-    c.thick = o.thick;
-    c.f_number = o.f_number;
-    c.focus_distance = o.focus_distance;
-    c.pixel_mm = o.pixel_mm;
+    c.options = o.camera;
     c.pitch_mm = o.pitch_mm;
     c.focal_mm = c.distance_mm = focal_mm;
     c.samples = o.samples;
@@ -142,27 +122,22 @@ int main(int argc, char** argv)
                              "[--scene white|stripes]\n");
         return 2;
     }
-    std::ifstream file(o.lens_file);
-    std::stringstream text;
-    text << file.rdbuf();
-    const ParsedPrescription parsed = parse_lens_file(text.str());
-    if (!file || parsed.error.any()) {
-        std::fprintf(stderr, "plenoptic_aim_check: cannot read %s\n", o.lens_file.c_str());
+    Prescription lens;
+    if (!bench::read_lens_file("plenoptic_aim_check", o.camera.lens_file, &lens))
         return 1;
-    }
     double focal_mm;
     {
-        const PlenopticCamera first = make_camera(camera(o, parsed.prescription, 0));
+        const PlenopticCamera first = make_camera(camera(o, lens, 0));
         const double exit_pupil_z = first.lens_length_mm() - first.paraxial().exit_pupil_z;
         focal_mm = o.pitch_mm * (exit_pupil_z + first.distance_mm) / first.paraxial().exit_pupil_mm;
     }
-    const CameraParams params = camera(o, parsed.prescription, focal_mm);
+    const CameraParams params = camera(o, lens, focal_mm);
     const std::string error = check_camera(params);
     if (!error.empty()) {
         std::fprintf(stderr, "plenoptic_aim_check: %s\n", error.c_str());
         return 1;
     }
-    const PlenopticCamera aimed = with_film(make_camera(params), o.width, o.height);
+    const PlenopticCamera aimed = with_film(make_camera(params), o.camera.width, o.camera.height);
     PlenopticCamera unaimed = aimed;
     unaimed.sampling.aim = false;
     const bool stripes = o.stripes;
@@ -176,7 +151,7 @@ int main(int argc, char** argv)
         const double v = radiance(ray);
         return Rgbt{v, v, v, 0};
     };
-    const int W = o.width, H = o.height, side = std::min(o.patch, std::min(W, H));
+    const int W = o.camera.width, H = o.camera.height, side = std::min(o.patch, std::min(W, H));
     struct Place {
         const char* name;
         int i0, j0;
@@ -186,7 +161,7 @@ int main(int argc, char** argv)
                             {"corner", W - side, H - side}};
     std::printf("{\"lens_file\": \"%s\", \"thick_lens\": %s, \"scene\": \"%s\", \"samples\": %d, \"reference\": %d, "
                 "\"patch\": %d, \"aiming\": %s,\n \"places\": [\n",
-                o.lens_file.c_str(), o.thick ? "true" : "false", stripes ? "stripes" : "white", o.samples, o.reference,
+                o.camera.lens_file.c_str(), o.camera.thick ? "true" : "false", stripes ? "stripes" : "white", o.samples, o.reference,
                 side, aimed.sampling.aim ? "true" : "false");
     for (int k = 0; k < 3; ++k) {
         const Place& p = places[k];

@@ -8,6 +8,10 @@
 #ifndef PLENOPTIC_BENCH_CAMERA_H
 #define PLENOPTIC_BENCH_CAMERA_H
 
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "plenoptic/camera/params.h"
@@ -16,16 +20,74 @@
 namespace plenoptic {
 namespace bench {
 
-struct LensFileCamera {
+// What the bench programs' shared options say: --lens-file FILE --f-number N --focus-distance Z
+// --sensor W H PIXEL_MM [--thick].
+struct CameraOptions {
     std::string lens_file;
     bool thick = false;  // thick_lens: the prescription's paraxial equivalent, not traced
-    double f_number = 0, focus_distance = 0, pixel_mm = 0;
+    double f_number = 0, focus_distance = 0;
+    int width = 0, height = 0;
+    double pixel_mm = 0;
+
+    // Every option given, with a value in range.
+    bool complete() const
+    {
+        return !lens_file.empty() && f_number > 0 && focus_distance > 0 && width > 0 && height > 0 && pixel_mm > 0;
+    }
+};
+
+// When argv[*a] is one of the shared options with its values after it: reads them into *o, leaves
+// *a at the last of them and returns true; else false (*a and *o unchanged).
+inline bool read_camera_option(int argc, char** argv, int* a, CameraOptions* o)
+{
+    const std::string arg = argv[*a];
+    const int left = argc - *a - 1;
+    if (arg == "--lens-file" && left >= 1)
+        o->lens_file = argv[++*a];
+    else if (arg == "--f-number" && left >= 1)
+        o->f_number = std::atof(argv[++*a]);
+    else if (arg == "--focus-distance" && left >= 1)
+        o->focus_distance = std::atof(argv[++*a]);
+    else if (arg == "--sensor" && left >= 3) {
+        o->width = std::atoi(argv[++*a]);
+        o->height = std::atoi(argv[++*a]);
+        o->pixel_mm = std::atof(argv[++*a]);
+    } else if (arg == "--thick")
+        o->thick = true;
+    else
+        return false;
+    return true;
+}
+
+// The prescription of `path` (a lens file) into *lens; false, with "<program>: <what went wrong>"
+// on stderr, when it cannot be read or parsed.
+inline bool read_lens_file(const char* program, const std::string& path, Prescription* lens)
+{
+    std::ifstream file(path);
+    if (!file) {
+        std::fprintf(stderr, "%s: cannot read %s\n", program, path.c_str());
+        return false;
+    }
+    std::stringstream text;
+    text << file.rdbuf();
+    const ParsedPrescription parsed = parse_lens_file(text.str());
+    if (parsed.error.any()) {
+        std::fprintf(stderr, "%s: %s, line %d: %s\n", program, path.c_str(), parsed.error.line, parsed.error.message.c_str());
+        return false;
+    }
+    *lens = parsed.prescription;
+    return true;
+}
+
+struct LensFileCamera {
+    CameraOptions options;
     double pitch_mm = 0, focal_mm = 0, distance_mm = 0;  // focal_mm 0: no array
     int samples = 1;
 };
 
-inline CameraParams camera_params(const LensFileCamera& c, const Prescription& lens)
+inline CameraParams camera_params(const LensFileCamera& camera, const Prescription& lens)
 {
+    const CameraOptions& c = camera.options;
     CameraParams p;
     p.main.given = true;
     p.main.type = c.thick ? MainLensType::ThickLens : MainLensType::Prescription;
@@ -37,19 +99,19 @@ inline CameraParams camera_params(const LensFileCamera& c, const Prescription& l
     p.main.has_focus_distance = true;
     p.main.focus_distance_units = c.focus_distance;
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = c.pixel_mm;
-    if (c.focal_mm > 0) {
+    if (camera.focal_mm > 0) {
         p.array.given = true;
         p.array.grid = GridType::Hexagonal;
         p.array.has_pitch = true;
-        p.array.pitch_mm = c.pitch_mm;
+        p.array.pitch_mm = camera.pitch_mm;
         p.array.has_lens = true;
         p.array.lens = MicrolensType::ThinLens;
         p.array.focal_length_count = 1;
-        p.array.focal_lengths_mm[0] = c.focal_mm;
+        p.array.focal_lengths_mm[0] = camera.focal_mm;
         p.array.has_distance = true;
-        p.array.distance_mm = c.distance_mm;
+        p.array.distance_mm = camera.distance_mm;
     }
-    p.sampling.samples = c.samples;
+    p.sampling.samples = camera.samples;
     return p;
 }
 

@@ -7,7 +7,7 @@
 // writes the microimages CSV as the render would (the lattice fit's residuals included).
 //
 //   plenoptic_microimage_truth --lens-file FILE --f-number N --focus-distance Z
-//       --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--offset X_MM Y_MM] [--threads T]
+//       --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--thick] [--offset X_MM Y_MM] [--threads T]
 //       [--errors S F R SEED] [--refracting R CAP SUBSTRATE IOR] [--caps-to-sensor] [--reference]
 //       [--every-lens] [--check N] [--csv OUT]
 //
@@ -32,7 +32,6 @@
 #include <cstdlib>
 #include <ctime>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include <sys/resource.h>
@@ -49,11 +48,7 @@ namespace {
 using namespace plenoptic;
 
 struct Options {
-    std::string lens_file;
-    double f_number = 0;
-    double focus_distance = 0;
-    int width = 0, height = 0;
-    double pixel_mm = 0;
+    bench::CameraOptions camera;
     double pitch_mm = 0, focal_mm = 0, distance_mm = 0;
     double offset_mm[2] = {0, 0};
     int threads = 0;
@@ -75,17 +70,9 @@ bool parse(int argc, char** argv, Options* o)
     for (int a = 1; a < argc; ++a) {
         const std::string arg = argv[a];
         const int left = argc - a - 1;
-        if (arg == "--lens-file" && left >= 1)
-            o->lens_file = argv[++a];
-        else if (arg == "--f-number" && left >= 1)
-            o->f_number = std::atof(argv[++a]);
-        else if (arg == "--focus-distance" && left >= 1)
-            o->focus_distance = std::atof(argv[++a]);
-        else if (arg == "--sensor" && left >= 3) {
-            o->width = std::atoi(argv[++a]);
-            o->height = std::atoi(argv[++a]);
-            o->pixel_mm = std::atof(argv[++a]);
-        } else if (arg == "--array" && left >= 3) {
+        if (bench::read_camera_option(argc, argv, &a, &o->camera))
+            continue;
+        if (arg == "--array" && left >= 3) {
             o->pitch_mm = std::atof(argv[++a]);
             o->focal_mm = std::atof(argv[++a]);
             o->distance_mm = std::atof(argv[++a]);
@@ -122,8 +109,7 @@ bool parse(int argc, char** argv, Options* o)
         else
             return false;
     }
-    return !o->lens_file.empty() && o->f_number > 0 && o->focus_distance > 0 && o->width > 0 && o->height > 0 &&
-           o->pixel_mm > 0 && o->pitch_mm > 0 && o->focal_mm > 0 && o->distance_mm > 0 && o->threads >= 0 && o->check >= 0;
+    return o->camera.complete() && o->pitch_mm > 0 && o->focal_mm > 0 && o->distance_mm > 0 && o->threads >= 0 && o->check >= 0;
 }
 
 double cpu_seconds()
@@ -141,33 +127,20 @@ int main(int argc, char** argv)
     Options o;
     if (!parse(argc, argv, &o)) {
         std::fprintf(stderr, "usage: plenoptic_microimage_truth --lens-file FILE --f-number N --focus-distance Z\n"
-                             "         --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--offset X_MM Y_MM]\n"
+                             "         --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--thick] [--offset X_MM Y_MM]\n"
                              "         [--threads T] [--errors S F R SEED] [--refracting R CAP SUBSTRATE IOR]\n"
                              "         [--caps-to-sensor] [--reference] [--every-lens] [--check N] [--csv OUT]\n");
         return 2;
     }
-    std::ifstream file(o.lens_file);
-    if (!file) {
-        std::fprintf(stderr, "plenoptic_microimage_truth: cannot read %s\n", o.lens_file.c_str());
+    Prescription lens;
+    if (!bench::read_lens_file("plenoptic_microimage_truth", o.camera.lens_file, &lens))
         return 1;
-    }
-    std::stringstream text;
-    text << file.rdbuf();
-    const ParsedPrescription parsed = parse_lens_file(text.str());
-    if (parsed.error.any()) {
-        std::fprintf(stderr, "plenoptic_microimage_truth: %s, line %d: %s\n", o.lens_file.c_str(), parsed.error.line,
-                     parsed.error.message.c_str());
-        return 1;
-    }
     bench::LensFileCamera camera;
-    camera.lens_file = o.lens_file;
-    camera.f_number = o.f_number;
-    camera.focus_distance = o.focus_distance;
-    camera.pixel_mm = o.pixel_mm;
+    camera.options = o.camera;
     camera.pitch_mm = o.pitch_mm;
     camera.focal_mm = o.focal_mm;
     camera.distance_mm = o.distance_mm;
-    CameraParams p = bench::camera_params(camera, parsed.prescription);
+    CameraParams p = bench::camera_params(camera, lens);
     p.sensor.offset_mm[0] = o.offset_mm[0];
     p.sensor.offset_mm[1] = o.offset_mm[1];
     if (o.refracting) {
@@ -191,7 +164,7 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "plenoptic_microimage_truth: %s\n", error.c_str());
         return 1;
     }
-    const PlenopticCamera m = with_film(make_camera(p), o.width, o.height);
+    const PlenopticCamera m = with_film(make_camera(p), o.camera.width, o.camera.height);
     MicroimageOptions options = default_microimage_options();
     options.threads = o.threads;
     options.reuse_neighbours = !o.reference;
@@ -280,7 +253,7 @@ int main(int argc, char** argv)
     std::printf("{\"size\": [%d, %d], \"offset_mm\": [%.9g, %.9g], \"lenses\": %zu, \"lit_lenses\": %zu, "
                 "\"threads\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"peak_rss_mib\": %.1f, \"anchors\": %zu, "
                 "\"interpolated\": %zu, \"measured\": %zu}\n",
-                o.width, o.height, o.offset_mm[0], o.offset_mm[1], truth.size(), lit, o.threads, wall, cpu,
+                o.camera.width, o.camera.height, o.offset_mm[0], o.offset_mm[1], truth.size(), lit, o.threads, wall, cpu,
                 usage.ru_maxrss / 1024.0, work.anchors, work.interpolated, work.measured);
     return 0;
 }

@@ -33,8 +33,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -52,15 +50,10 @@ namespace {
 using namespace plenoptic;
 
 struct Options {
-    std::string lens_file;
-    double f_number = 0;
-    double focus_distance = 0;
-    int width = 0, height = 0;
-    double pixel_mm = 0;
+    bench::CameraOptions camera;
     double array_pitch_mm = 0;  // 0: no array
     double array_focal_mm = 0;  // given with --array; 0 with --array-matched (computed)
     double array_distance_mm = 0;
-    bool thick = false;
     int samples = 256;
     int patch = 0;
     bool unaimed = false;
@@ -80,26 +73,15 @@ bool parse(int argc, char** argv, Options* o)
     for (int a = 1; a < argc; ++a) {
         const std::string arg = argv[a];
         const int left = argc - a - 1;
-        if (arg == "--lens-file" && left >= 1)
-            o->lens_file = argv[++a];
-        else if (arg == "--f-number" && left >= 1)
-            o->f_number = std::atof(argv[++a]);
-        else if (arg == "--focus-distance" && left >= 1)
-            o->focus_distance = std::atof(argv[++a]);
-        else if (arg == "--sensor" && left >= 3) {
-            o->width = std::atoi(argv[++a]);
-            o->height = std::atoi(argv[++a]);
-            o->pixel_mm = std::atof(argv[++a]);
-        } else if (arg == "--array-matched" && left >= 1)
+        if (bench::read_camera_option(argc, argv, &a, &o->camera))
+            continue;
+        if (arg == "--array-matched" && left >= 1)
             o->array_pitch_mm = std::atof(argv[++a]);
         else if (arg == "--array" && left >= 3) {
             o->array_pitch_mm = std::atof(argv[++a]);
             o->array_focal_mm = std::atof(argv[++a]);
             o->array_distance_mm = std::atof(argv[++a]);
-        }
-        else if (arg == "--thick")
-            o->thick = true;
-        else if (arg == "--samples" && left >= 1)
+        } else if (arg == "--samples" && left >= 1)
             o->samples = std::atoi(argv[++a]);
         else if (arg == "--patch" && left >= 1)
             o->patch = std::atoi(argv[++a]);
@@ -112,8 +94,7 @@ bool parse(int argc, char** argv, Options* o)
     }
     if (o->array_focal_mm > 0 && !(o->array_distance_mm > 0))
         return false;
-    return !o->lens_file.empty() && o->f_number > 0 && o->focus_distance > 0 && o->width > 0 && o->height > 0 &&
-           o->pixel_mm > 0 && o->samples >= 2 && o->patch >= 0 && o->lit_patch >= 0 && o->array_pitch_mm >= 0;
+    return o->camera.complete() && o->samples >= 2 && o->patch >= 0 && o->lit_patch >= 0 && o->array_pitch_mm >= 0;
 }
 
 // The camera a scene with these keywords would give (main_lens { lens_file f_number
@@ -121,11 +102,7 @@ bool parse(int argc, char** argv, Options* o)
 CameraParams camera(const Options& o, const Prescription& lens, double array_focal_mm, double array_distance_mm)
 {
     bench::LensFileCamera c;
-    c.lens_file = o.lens_file;
-    c.thick = o.thick;
-    c.f_number = o.f_number;
-    c.focus_distance = o.focus_distance;
-    c.pixel_mm = o.pixel_mm;
+    c.options = o.camera;
     c.pitch_mm = o.array_pitch_mm;
     c.focal_mm = array_focal_mm;
     c.distance_mm = array_distance_mm;
@@ -232,25 +209,15 @@ int main(int argc, char** argv)
         usage();
         return 2;
     }
-    std::ifstream file(o.lens_file);
-    if (!file) {
-        std::fprintf(stderr, "plenoptic_pass_fractions: cannot read %s\n", o.lens_file.c_str());
+    Prescription lens;
+    if (!bench::read_lens_file("plenoptic_pass_fractions", o.camera.lens_file, &lens))
         return 1;
-    }
-    std::stringstream text;
-    text << file.rdbuf();
-    const ParsedPrescription parsed = parse_lens_file(text.str());
-    if (parsed.error.any()) {
-        std::fprintf(stderr, "plenoptic_pass_fractions: %s, line %d: %s\n", o.lens_file.c_str(), parsed.error.line,
-                     parsed.error.message.c_str());
-        return 1;
-    }
 
     // The array's focal length depends on D, which the model computes: a first model without it.
     double array_focal_mm = 0;
     double working_n = 0;
     {
-        const CameraParams first = camera(o, parsed.prescription, 0, 0);
+        const CameraParams first = camera(o, lens, 0, 0);
         const std::string error = check_camera(first);
         if (!error.empty()) {
             std::fprintf(stderr, "plenoptic_pass_fractions: %s\n", error.c_str());
@@ -262,21 +229,21 @@ int main(int argc, char** argv)
             array_focal_mm = o.array_focal_mm > 0 ? o.array_focal_mm : o.array_pitch_mm * working_n;
     }
     const double array_distance_mm = o.array_focal_mm > 0 ? o.array_distance_mm : array_focal_mm;
-    const CameraParams params = camera(o, parsed.prescription, array_focal_mm, array_distance_mm);
+    const CameraParams params = camera(o, lens, array_focal_mm, array_distance_mm);
     const std::string error = check_camera(params);
     if (!error.empty()) {
         std::fprintf(stderr, "plenoptic_pass_fractions: %s\n", error.c_str());
         return 1;
     }
-    PlenopticCamera m = with_film(make_camera(params), o.width, o.height);
+    PlenopticCamera m = with_film(make_camera(params), o.camera.width, o.camera.height);
     PlenopticCamera uniform = m;
     uniform.sampling.aim = false;
     if (o.unaimed)
         m.sampling.aim = false;
-    const int W = o.width, H = o.height;
+    const int W = o.camera.width, H = o.camera.height;
     int patch = o.patch;
     if (patch == 0)
-        patch = o.array_pitch_mm > 0 ? int(std::ceil(2 * o.array_pitch_mm / o.pixel_mm)) : 16;
+        patch = o.array_pitch_mm > 0 ? int(std::ceil(2 * o.array_pitch_mm / o.camera.pixel_mm)) : 16;
     patch = std::min(patch, std::min(W, H));
     const double rear_radius = 0.5 * m.prescription().surfaces.back().aperture_mm;
     const bool unbounded = m.array.grid == GridType::None && m.lens && m.lens->traced();
@@ -293,7 +260,7 @@ int main(int argc, char** argv)
     };
 
     std::printf("{\n \"lens_file\": \"%s\", \"thick_lens\": %s, \"f_number\": %.9g, \"focus_distance\": %.9g,\n",
-                o.lens_file.c_str(), o.thick ? "true" : "false", m.f_number(), o.focus_distance);
+                o.camera.lens_file.c_str(), o.camera.thick ? "true" : "false", m.f_number(), o.camera.focus_distance);
     std::printf(" \"effective_focal_length_mm\": %.9g, \"distance_mm\": %.9g, \"working_f_number\": %.9g,\n",
                 m.focal_length_mm(), m.distance_mm, working_n);
     std::printf(" \"exit_pupil_radius_mm\": %.9g, \"rear_aperture_radius_mm\": %.9g, \"light_field_radius_mm\": %.9g,\n",
@@ -304,7 +271,7 @@ int main(int argc, char** argv)
     else
         std::printf(" \"array\": null,\n");
     std::printf(" \"sensor\": {\"width\": %d, \"height\": %d, \"pixel_size_mm\": %.9g}, \"samples\": %d, "
-                "\"patch\": %d, \"aimed\": %s,\n \"places\": [\n", W, H, o.pixel_mm, o.samples, patch,
+                "\"patch\": %d, \"aimed\": %s,\n \"places\": [\n", W, H, o.camera.pixel_mm, o.samples, patch,
                 m.sampling.aim ? "true" : "false");
     for (int k = 0; k < 3; ++k) {
         const Place& p = places[k];
