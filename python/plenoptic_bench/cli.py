@@ -13,6 +13,7 @@ from .build import section_build
 from .dark import section_dark
 from .spectral import section_spectral
 from .arrays import section_arrays
+from .refracting import section_refracting
 from .dataset import section_dataset
 from .fullsize import section_fullsize
 from .lenses import section_lenses
@@ -51,7 +52,7 @@ def main():
         return 2
     runs = 1 if args.quick else args.runs
     sections = args.only or ["overhead", "lenses", "trade", "dark", "threads", "fullsize", "real_lens",
-                             "fullsize_real_lens", "realism", "spectral", "arrays", "dataset"]
+                             "fullsize_real_lens", "realism", "spectral", "arrays", "refracting", "dataset"]
     os.makedirs(args.out, exist_ok=True)
     work = tempfile.mkdtemp(prefix="plenoptic-bench-")
     b = Bench(os.path.abspath(args.povray), work, runs)
@@ -141,6 +142,11 @@ def main():
                            (32, 24) if args.quick else (96, 64), results)
             save()
             done("arrays")
+        if "refracting" in sections:
+            section_refracting(b, (64, 48) if args.quick else (480, 320), (64, 48) if args.quick else (966, 671),
+                               1 if args.quick else max(runs, 5), (32, 24) if args.quick else (96, 64), results)
+            save()
+            done("refracting")
         if "dataset" in sections:
             section_dataset(b, args.quick, runs, results)
             save()

@@ -353,6 +353,9 @@ def write_report(results, path, plots, results_path):
     if results.get("arrays"):
         from .arrays import arrays_report
         arrays_report(L, results)
+    if results.get("refracting"):
+        from .refracting import refracting_report
+        refracting_report(L, results)
     if results.get("dataset"):
         dataset_report(L, results)
     analysis = os.path.join(ROOT, "benchmarks", "analysis.md")

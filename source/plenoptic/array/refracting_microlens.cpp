@@ -4,7 +4,9 @@
 
 #include "plenoptic/array/refracting_microlens.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
 #include "plenoptic/array/microlens_array.h"
@@ -208,6 +210,119 @@ namespace {
 
 ArrayRay no_ray() { return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false, Vec3{0, 0, 0}}; }
 
+// Most cells a path crosses inside the array (its entry lens's included) before it meets a surface;
+// one that would cross more travels nearly along the array and is blocked.
+const int kMaxCells = 8;
+
+// Where a path inside the array is: in the glass, or in the air between the caps and the sensor
+// (caps facing the sensor only).
+enum class Medium { Glass, AirUnderCaps };
+
+// The surface a path meets: the lens whose surface it is, the point and the direction of travel
+// (unit) in that lens's frame, and whether it is the cap or the flat face.
+struct SurfaceHit {
+    LensIndex lens;
+    LensFrame frame;
+    RefractingShape shape;
+    Vec3 q;
+    Vec3 dir;
+    bool on_cap;
+};
+
+// The lens's frame: array-local points and directions to it and back.
+Vec3 to_lens(const LensFrame& frame, Vec3 local)
+{
+    const Vec3 rel = local - frame.centre;
+    return frame.tilted ? mul_transposed(frame.axes, rel) : rel;
+}
+Vec3 to_lens_direction(const LensFrame& frame, Vec3 v) { return frame.tilted ? mul_transposed(frame.axes, v) : v; }
+Vec3 from_lens(const LensFrame& frame, Vec3 v) { return frame.tilted ? mul(frame.axes, v) : v; }
+Vec3 from_lens_point(const LensFrame& frame, Vec3 q) { return frame.centre + from_lens(frame, q); }
+
+// Whether a point of a lens (its frame) lies in the lens's cell.
+bool in_cell(const MicrolensArray& array, LensIndex lens, const LensFrame& frame, Vec3 q)
+{
+    const Vec3 local = from_lens_point(frame, q);
+    return array.nearest(local.x, local.y) == lens;
+}
+
+// Whether the point P of a lens's column (its frame) lies in the medium there: the glass between
+// the flat face and the cap, or the air under a cap facing the sensor.
+bool in_medium(const RefractingShape& s, Medium medium, Vec3 P)
+{
+    const double tolerance = 1e-9 * s.thickness_mm();
+    const double sag = s.sag(P.x * P.x + P.y * P.y);
+    if (!(sag == sag))
+        return false;
+    if (medium == Medium::AirUnderCaps)
+        return P.z <= sag + tolerance;
+    if (s.curved_towards_scene)
+        return P.z >= -tolerance && P.z <= s.thickness_mm() - sag + tolerance;
+    return P.z >= sag - tolerance && P.z <= s.thickness_mm() + tolerance;
+}
+
+// The first surface of a lens ahead of P along unit D (its frame) in the medium: in the glass the
+// cap or the flat face (not the point P itself, where the path may just have entered), under a cap
+// the cap. Infinity when there is none.
+double surface_ahead(const RefractingShape& s, Medium medium, Vec3 P, Vec3 D, bool* on_cap)
+{
+    double t[2];
+    const int hits = cap_hits(s, P, D, t);
+    const double tolerance = 1e-9 * s.thickness_mm();
+    double best = std::numeric_limits<double>::infinity();
+    *on_cap = true;
+    if (medium == Medium::AirUnderCaps) {
+        for (int i = 0; i < hits; ++i)
+            if (t[i] >= -tolerance)
+                return t[i];
+        return best;
+    }
+    for (int i = 0; i < hits; ++i) {
+        if (t[i] > tolerance) {
+            best = t[i];
+            break;
+        }
+    }
+    const double flat_z = s.curved_towards_scene ? 0.0 : s.thickness_mm();
+    if (D.z != 0) {
+        const double t_flat = (flat_z - P.z) / D.z;
+        if (t_flat > tolerance && t_flat < best) {
+            best = t_flat;
+            *on_cap = false;
+        }
+    }
+    return best;
+}
+
+// Where the line X + t V (array-local) leaves the cell of `lens` ahead (t >= 0): the first
+// bisector with a neighbour's actual centre that it crosses (the cells are those of
+// MicrolensArray::nearest, whose neighbours these are); `next` is that neighbour.
+double cell_exit(const MicrolensArray& array, LensIndex lens, Vec3 X, Vec3 V, LensIndex* next)
+{
+    const Vec2 c = array.centre_local(lens);
+    const std::int64_t skew = skew_k(array.grid, lens);
+    const bool hexagonal = array.grid == GridType::Hexagonal;
+    double best = std::numeric_limits<double>::infinity();
+    for (int dl = -1; dl <= 1; ++dl) {
+        for (int dk = -1; dk <= 1; ++dk) {
+            if ((dk == 0 && dl == 0) || (hexagonal && std::abs(dk + dl) > 1))
+                continue;
+            const LensIndex n = from_skew(array.grid, skew + dk, lens.l + dl);
+            const Vec2 cn = array.centre_local(n);
+            const double ex = cn.x - c.x, ey = cn.y - c.y;
+            const double along = V.x * ex + V.y * ey;
+            if (!(along > 0))
+                continue;
+            const double t = ((0.5 * (c.x + cn.x) - X.x) * ex + (0.5 * (c.y + cn.y) - X.y) * ey) / along;
+            if (t < best) {
+                best = t;
+                *next = n;
+            }
+        }
+    }
+    return std::max(best, 0.0);
+}
+
 class RefractingMicrolens : public Microlens {
 public:
     explicit RefractingMicrolens(const RefractingShape& shape) : shape_(shape) {}
@@ -227,63 +342,118 @@ public:
     }
 
     // The cell point (u, v) in the lens's plane (the face nearest the sensor, or the caps' vertex
-    // plane), the line from p through it traced through the lens, in the lens's own frame (its
-    // actual centre and axis, array/microlens_array.h: LensFrame; a focal-length error scales the
-    // cap's radius). The ray is returned from where its line in the scene-side air crosses the
-    // lens's plane (nothing lies between that point and where it leaves the glass), so that users
-    // that take rays to leave from the array's plane (the pupil bounds) hold for it; `sampled` is
-    // the cell point.
+    // plane), the line from p through it traced through the array, starting in the lens's own frame
+    // (its actual centre and axis, array/microlens_array.h: LensFrame; a focal-length error scales
+    // the cap's radius). The lines from p are shared out among the lenses by where they cross that
+    // plane. Without baffles a path that leaves the lens's cell before it meets a surface goes on
+    // in the neighbour's column (in the glass, or in the air under caps facing the sensor) and
+    // leaves through whatever surface of the neighbour's it meets (walk); with baffles it is
+    // blocked. The ray is returned from where its line in the scene-side air crosses the plane of
+    // the lens it leaves (nothing lies between that point and where it leaves the glass), so that
+    // users that take rays to leave from the array's plane (the pupil bounds) hold for it;
+    // `sampled` is the cell point.
     ArrayRay sample_ray(const MicrolensArray& array, const Vec3& p, LensIndex lens, double u, double v) const override
     {
         const LensFrame frame = array.frame(lens);
         const Vec2 offset = array.cell_point(u, v);
         const Vec3 h0{offset.x, offset.y, 0};
         const Vec3 d = h0 - to_lens(frame, array.to_local(p));
-        const RefractingPath path = trace_to_scene(shape_of(frame), h0, d);
-        if (!path.passed || !in_cell(array, lens, frame, path.sensor_face) || !in_cell(array, lens, frame, path.scene_face))
+        if (!(d.z > 0))
             return no_ray();
-        const Vec3 dir = path.scene_side_dir;
-        const Vec3 origin = path.scene_face - (path.scene_face.z / dir.z) * dir;
-        return ArrayRay{array.to_optics(from_lens_point(frame, origin)), mul(array.pose.rotation, from_lens(frame, dir)),
-                        true, array.to_optics(from_lens_point(frame, h0))};
+        // With errors the cell point (of the lattice's cell shape about the actual centre) may lie
+        // in a neighbour's cell, whose own samples cover that line.
+        if (array.errors && !in_cell(array, lens, frame, h0))
+            return no_ray();
+        const Vec3 start = from_lens_point(frame, h0);
+        const Vec3 air = normalized(d);
+        const double n = shape_.ior;
+        SurfaceHit leave;
+        Vec3 out;
+        if (shape_.curved_towards_scene) {
+            // Into the flat back at h0, through the glass to a cap, out into the air.
+            Vec3 inside;
+            if (!refract(air, kAxis, 1 / n, &inside))
+                return no_ray();
+            if (!walk(array, Medium::Glass, lens, frame, start, from_lens(frame, inside), &leave) || !leave.on_cap)
+                return no_ray();
+            if (!refract(leave.dir, cap_normal(leave.shape, leave.q), n, &out) || !(out.z > 0))
+                return no_ray();
+        } else {
+            // Up through the air to a cap, into the glass, up to the flat front, out.
+            SurfaceHit cap;
+            if (!walk(array, Medium::AirUnderCaps, lens, frame, start, from_lens(frame, air), &cap))
+                return no_ray();
+            Vec3 inside;
+            if (!refract(cap.dir, cap_normal(cap.shape, cap.q), 1 / n, &inside) || !(inside.z > 0))
+                return no_ray();
+            if (!walk(array, Medium::Glass, cap.lens, cap.frame, from_lens_point(cap.frame, cap.q),
+                      from_lens(cap.frame, inside), &leave) ||
+                leave.on_cap)
+                return no_ray();
+            if (!refract(leave.dir, kAxis, n, &out))
+                return no_ray();
+        }
+        const Vec3 origin = leave.q - (leave.q.z / out.z) * out;
+        return ArrayRay{array.to_optics(from_lens_point(leave.frame, origin)),
+                        mul(array.pose.rotation, from_lens(leave.frame, out)), true, array.to_optics(start)};
     }
 
     // Refused at parse time with a pinhole main lens (camera/params.cpp): there is no closed form.
     ArrayRay ray_through(const MicrolensArray&, const Vec3&, LensIndex, Vec3, bool) const override { return no_ray(); }
 
-    // The light's incoming line through h, traced through the lens; the ray is returned from where
-    // it leaves the lens's sensor-side face.
+    // The light's incoming line through h meets the lens's face nearest the scene (its cap, or its
+    // flat front) inside the lens's cell: traced on through the array (as sample_ray, a path that
+    // leaves the cell in the glass goes on in the neighbour's unless there are baffles); the ray
+    // is returned from where it leaves the face nearest the sensor.
     ArrayRay towards_sensor(const MicrolensArray& array, LensIndex lens, Vec3 h, Vec3 direction) const override
     {
         const LensFrame frame = array.frame(lens);
+        const RefractingShape shape = shape_of(frame);
         const Vec3 w = to_lens_direction(frame, mul_transposed(array.pose.rotation, direction));
         if (!(w.z < 0))
             return no_ray();
-        const RefractingPath path = trace_to_sensor(shape_of(frame), to_lens(frame, array.to_local(h)), -w);
-        if (!path.passed || !in_cell(array, lens, frame, path.sensor_face) || !in_cell(array, lens, frame, path.scene_face))
-            return no_ray();
-        const Vec3 leave = array.to_optics(from_lens_point(frame, path.sensor_face));
-        return ArrayRay{leave, mul(array.pose.rotation, from_lens(frame, -path.sensor_side_dir)), true, leave};
+        const Vec3 hl = to_lens(frame, array.to_local(h));
+        const Vec3 v = normalized(-w);
+        const Vec3 a = -v;  // the direction of travel
+        const double n = shape.ior;
+        SurfaceHit leave;
+        Vec3 out;
+        if (shape.curved_towards_scene) {
+            // The cap where the line meets it first coming from the scene, into the glass, down to
+            // a flat back, out.
+            double t[2];
+            const int hits = cap_hits(shape, hl, v, t);
+            if (hits == 0 || !(t[hits - 1] > 0))
+                return no_ray();
+            const Vec3 q = hl + t[hits - 1] * v;
+            Vec3 inside;
+            if (!in_cell(array, lens, frame, q) || !refract(a, cap_normal(shape, q), 1 / n, &inside) || !(inside.z < 0))
+                return no_ray();
+            if (!walk(array, Medium::Glass, lens, frame, from_lens_point(frame, q), from_lens(frame, inside), &leave) ||
+                leave.on_cap)
+                return no_ray();
+            if (!refract(leave.dir, kAxis, n, &out))
+                return no_ray();
+        } else {
+            // The flat front, into the glass, down to a cap, out.
+            const Vec3 front = hl + ((shape.thickness_mm() - hl.z) / v.z) * v;
+            Vec3 inside;
+            if (!in_cell(array, lens, frame, front) || !refract(a, kAxis, 1 / n, &inside) || !(inside.z < 0))
+                return no_ray();
+            if (!walk(array, Medium::Glass, lens, frame, from_lens_point(frame, front), from_lens(frame, inside),
+                      &leave) ||
+                !leave.on_cap)
+                return no_ray();
+            if (!refract(leave.dir, cap_normal(leave.shape, leave.q), n, &out) || !(out.z < 0))
+                return no_ray();
+        }
+        const Vec3 at = array.to_optics(from_lens_point(leave.frame, leave.q));
+        return ArrayRay{at, mul(array.pose.rotation, from_lens(leave.frame, out)), true, at};
     }
 
     const RefractingShape& shape() const { return shape_; }
 
 private:
-    // The lens's frame: array-local points and directions to it and back.
-    static Vec3 to_lens(const LensFrame& frame, Vec3 local)
-    {
-        const Vec3 rel = local - frame.centre;
-        return frame.tilted ? mul_transposed(frame.axes, rel) : rel;
-    }
-    static Vec3 to_lens_direction(const LensFrame& frame, Vec3 v) { return frame.tilted ? mul_transposed(frame.axes, v) : v; }
-    static Vec3 from_lens(const LensFrame& frame, Vec3 v) { return frame.tilted ? mul(frame.axes, v) : v; }
-    static Vec3 from_lens_point(const LensFrame& frame, Vec3 q) { return frame.centre + from_lens(frame, q); }
-    // Whether a point of the lens (its frame) lies in the lens's cell.
-    static bool in_cell(const MicrolensArray& array, LensIndex lens, const LensFrame& frame, Vec3 q)
-    {
-        const Vec3 local = from_lens_point(frame, q);
-        return array.nearest(local.x, local.y) == lens;
-    }
     // The shape of a lens whose focal length has an error: its cap's radius scaled with it.
     RefractingShape shape_of(const LensFrame& frame) const
     {
@@ -291,6 +461,45 @@ private:
         if (frame.focal_mm != shape_.focal_length_mm())
             shape.radius_mm = frame.focal_mm * (shape_.ior - 1);
         return shape;
+    }
+
+    // A path in `medium` from the array-local point X (in lens `lens`'s column, whose frame is
+    // given) along the unit direction V, to the first surface it meets. While that surface's point
+    // lies outside the current lens's cell the path leaves the cell first: without baffles it goes
+    // on in the neighbour's column, in the neighbour's frame (where lenses with errors do not meet,
+    // a path that steps out of the medium is blocked); with baffles it is blocked, as after
+    // kMaxCells cells.
+    bool walk(const MicrolensArray& array, Medium medium, LensIndex lens, LensFrame frame, Vec3 X, Vec3 V,
+              SurfaceHit* hit) const
+    {
+        for (int cells = 0; cells < kMaxCells; ++cells) {
+            if (cells > 0)
+                frame = array.frame(lens);
+            const RefractingShape shape = shape_of(frame);
+            const Vec3 P = to_lens(frame, X), D = to_lens_direction(frame, V);
+            if (cells > 0 && !in_medium(shape, medium, P))
+                return false;
+            bool on_cap;
+            const double t = surface_ahead(shape, medium, P, D, &on_cap);
+            if (!(t < std::numeric_limits<double>::infinity()))
+                return false;
+            const Vec3 q = P + t * D;
+            LensIndex next = lens;
+            if (!in_cell(array, lens, frame, q)) {
+                if (array.baffles)
+                    return false;
+                const double exit = cell_exit(array, lens, X, V, &next);
+                if (exit < t) {
+                    X = X + exit * V;
+                    lens = next;
+                    continue;
+                }
+                // On the cell's border within rounding: the surface is this lens's.
+            }
+            *hit = SurfaceHit{lens, frame, shape, q, D, on_cap};
+            return true;
+        }
+        return false;
     }
 
     RefractingShape shape_;

@@ -251,57 +251,105 @@ bool in_hexagon(double x, double y, double p)
     return true;
 }
 
-TEST(RefractingMicrolens, RaysLeavingTheCellAreBlocked)
+// This file's trace of the line from sensor point p through cell point h0 of `lens` (optics frame,
+// an unrotated ideal array): with `baffles` the path must cross both faces inside the lens's own
+// cell; without, the glass's surface is each lens's cap inside that lens's cell (the caps meet at
+// the cells' borders), and the path leaves through the first of them it meets. Returns whether it
+// passes, where it leaves the glass towards the scene and its direction there; *crossed: whether
+// it crossed a face outside its own cell.
+bool test_trace_array(const MicrolensArray& array, LensIndex lens, Vec3 p, Vec3 h0, bool baffles, Vec3* exit_point,
+                      Vec3* out, bool* crossed)
 {
-    for (bool scene_side : {true, false}) {
-        const MicrolensArray array = refracting_array(scene_side);
-        const RefractingShape& s = *refracting_shape(*array.microlens);
-        const LensIndex lens{2, 1};
-        const Vec3 c = array.centre_mm(lens);
-        std::mt19937 rng(7);
-        std::uniform_real_distribution<double> uni(0, 1);
-        int blocked_by_cell = 0, passed = 0;
-        for (int i = 0; i < 4000; ++i) {
-            // Sensor points far off the lens's axis: steep rays that cross into the neighbours' cells.
-            const Vec3 p{c.x + (uni(rng) - 0.5) * 0.6, c.y + (uni(rng) - 0.5) * 0.6, c.z - array.distance_mm};
-            const double u = uni(rng), v = uni(rng);
-            const ArrayRay ray = array.microlens->sample_ray(array, p, lens, u, v);
-            // This file's trace of the same line, in the lens's frame.
-            const Vec2 off = array.cell_point(u, v);
-            const Vec3 h0{off.x, off.y, 0};
-            const Vec3 d = normalized(h0 - (p - c));
-            const Sphere sp = cap_sphere(s);
-            Vec3 q, inside, out;
-            bool ok;
-            Vec3 scene_face, sensor_face;
-            if (scene_side) {
-                ok = snell(d, Vec3{0, 0, 1}, 1, s.ior, &inside) && hit_sphere(sp, TestRay{h0, inside, true}, &q) &&
-                     snell(inside, q - sp.centre, s.ior, 1, &out);
-                sensor_face = h0;
-                scene_face = q;
-            } else {
-                ok = hit_sphere(sp, TestRay{h0 - 1.0 * d, d, true}, &q) && snell(d, q - sp.centre, 1, s.ior, &inside);
-                const double L = s.cap_mm + s.substrate_mm;
-                scene_face = q + ((L - q.z) / inside.z) * inside;
-                ok = ok && snell(inside, Vec3{0, 0, 1}, s.ior, 1, &out);
-                sensor_face = q;
-            }
-            const bool in_cell = in_hexagon(sensor_face.x, sensor_face.y, array.pitch_mm) &&
-                                 in_hexagon(scene_face.x, scene_face.y, array.pitch_mm);
-            EXPECT_EQ(ray.passed, ok && in_cell) << i;
-            if (ok && !in_cell)
-                ++blocked_by_cell;
-            if (ray.passed) {
-                ++passed;
-                // The ray leaves along the test's direction, on the test's line.
-                EXPECT_NEAR(length(normalized(ray.direction) - out), 0, 1e-9);
-                const Vec3 exit_optics = scene_face + c;
-                EXPECT_NEAR(length(cross(exit_optics - ray.origin, normalized(ray.direction))), 0, 1e-10);
-                EXPECT_NEAR(length(ray.sampled - (h0 + c)), 0, 1e-12);
+    const RefractingShape& s = *refracting_shape(*array.microlens);
+    const double L = s.cap_mm + s.substrate_mm, n = s.ior;
+    const Vec3 c = array.centre_mm(lens);
+    const Vec3 d = normalized(h0 - p);
+    // The first point ahead on the line where it meets some lens's cap inside that lens's cell.
+    auto first_cap = [&](Vec3 from, Vec3 dir, double after, Vec3* q, Vec3* centre) {
+        double best = INFINITY;
+        for (int dl = -6; dl <= 6; ++dl) {
+            for (int dk = -6; dk <= 6; ++dk) {
+                const Vec3 cj = array.centre_mm(LensIndex{lens.k + dk, lens.l + dl});
+                Sphere sp = cap_sphere(s);
+                sp.centre = sp.centre + cj;
+                Vec3 x;
+                const Vec3 o = from - sp.centre;
+                const double b = dot(o, dir), cc = dot(o, o) - sp.radius * sp.radius, disc = b * b - cc;
+                if (disc < 0)
+                    continue;
+                for (double t : {-b - std::sqrt(disc), -b + std::sqrt(disc)}) {
+                    x = from + t * dir;
+                    if (t > after && t < best && (x.z - sp.centre.z) * sp.side > 0 &&
+                        in_hexagon(x.x - cj.x, x.y - cj.y, array.pitch_mm)) {
+                        best = t;
+                        *q = x;
+                        *centre = sp.centre;
+                    }
+                }
             }
         }
-        EXPECT_GT(blocked_by_cell, 50);
-        EXPECT_GT(passed, 500);
+        return best < INFINITY;
+    };
+    Vec3 q, centre, inside;
+    if (s.curved_towards_scene) {
+        if (!snell(d, Vec3{0, 0, 1}, 1, n, &inside) || !first_cap(h0, inside, 1e-12, &q, &centre))
+            return false;
+        *crossed = !in_hexagon(q.x - c.x, q.y - c.y, array.pitch_mm);
+        *exit_point = q;
+        return !(baffles && *crossed) && snell(inside, q - centre, n, 1, out);
+    }
+    if (!first_cap(h0 - 1.0 * d, d, 0, &q, &centre) || !snell(d, q - centre, 1, n, &inside))
+        return false;
+    const Vec3 front = q + ((c.z + L - q.z) / inside.z) * inside;
+    Vec3 again, again_centre;
+    if (first_cap(q, inside, 1e-12, &again, &again_centre) && again.z < front.z)
+        return false;  // back out through a cap: not towards the scene
+    *crossed = !in_hexagon(q.x - c.x, q.y - c.y, array.pitch_mm) || !in_hexagon(front.x - c.x, front.y - c.y, array.pitch_mm);
+    *exit_point = front;
+    return !(baffles && *crossed) && snell(inside, Vec3{0, 0, 1}, n, 1, out);
+}
+
+TEST(RefractingMicrolens, RaysLeavingTheCellGoOnInTheNeighboursUnlessBaffled)
+{
+    for (bool scene_side : {true, false}) {
+        for (bool baffles : {false, true}) {
+            MicrolensArray array = refracting_array(scene_side);
+            array.baffles = baffles;
+            const LensIndex lens{2, 1};
+            const Vec3 c = array.centre_mm(lens);
+            std::mt19937 rng(7);
+            std::uniform_real_distribution<double> uni(0, 1);
+            int crossed_passed = 0, crossed_blocked = 0, passed = 0;
+            for (int i = 0; i < 4000; ++i) {
+                // Sensor points far off the lens's axis: steep rays that cross into the neighbours' cells.
+                const Vec3 p{c.x + (uni(rng) - 0.5) * 0.6, c.y + (uni(rng) - 0.5) * 0.6, c.z - array.distance_mm};
+                const double u = uni(rng), v = uni(rng);
+                const ArrayRay ray = array.microlens->sample_ray(array, p, lens, u, v);
+                const Vec2 off = array.cell_point(u, v);
+                const Vec3 h0{c.x + off.x, c.y + off.y, c.z};
+                Vec3 exit_point, out;
+                bool crossed = false;
+                const bool ok = test_trace_array(array, lens, p, h0, baffles, &exit_point, &out, &crossed);
+                EXPECT_EQ(ray.passed, ok) << i << (scene_side ? " scene" : " sensor") << (baffles ? " baffles" : "");
+                if (crossed)
+                    ++(ray.passed ? crossed_passed : crossed_blocked);
+                if (ray.passed && ok) {
+                    ++passed;
+                    // The ray leaves along the test's direction, on the test's line.
+                    EXPECT_NEAR(length(normalized(ray.direction) - out), 0, 1e-9) << i;
+                    EXPECT_NEAR(length(cross(exit_point - ray.origin, normalized(ray.direction))), 0, 1e-10) << i;
+                    EXPECT_NEAR(length(ray.sampled - h0), 0, 1e-12);
+                }
+            }
+            // Without baffles light crosses into the neighbours' glass and passes; with them none.
+            if (baffles) {
+                EXPECT_EQ(crossed_passed, 0);
+                EXPECT_GT(crossed_blocked, 50);
+            } else {
+                EXPECT_GT(crossed_passed, 50);
+            }
+            EXPECT_GT(passed, 500);
+        }
     }
 }
 
@@ -322,8 +370,21 @@ TEST(RefractingMicrolens, TowardsSensorInvertsSampleRay)
             ++passed;
             // The ray leaves from the array's plane: light coming back along it reaches p.
             EXPECT_NEAR(up.origin.z, c.z, 1e-12);
-            const ArrayRay down = array.microlens->towards_sensor(array, lens, up.origin, -1.0 * up.direction);
-            ASSERT_TRUE(down.passed) << i;
+            // Light coming back enters through the face of exactly one lens (the sample's own or,
+            // where the path crossed cells in the glass, a neighbour's).
+            ArrayRay down{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false, Vec3{0, 0, 0}};
+            int entries = 0;
+            for (int dl = -2; dl <= 2; ++dl) {
+                for (int dk = -2; dk <= 2; ++dk) {
+                    const ArrayRay through = array.microlens->towards_sensor(array, LensIndex{lens.k + dk, lens.l + dl},
+                                                                             up.origin, -1.0 * up.direction);
+                    if (through.passed) {
+                        ++entries;
+                        down = through;
+                    }
+                }
+            }
+            ASSERT_EQ(entries, 1) << i;
             const Vec3 d = normalized(down.direction);
             const double travel = (p.z - down.origin.z) / d.z;
             EXPECT_NEAR(length(down.origin + travel * d - p), 0, 1e-10) << i;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plenoptic/array/refracting_microlens.h"
 #include "plenoptic/core/json.h"
 #include "plenoptic/core/lattice.h"
 #include "plenoptic/camera/radiometry.h"
@@ -24,11 +25,64 @@ struct OverlapGeometry {
     double blur_inradius_mm; // same with the cell's inradius (a round lens of diameter p)
     double cell_mm;        // inradius of a microimage cell on the sensor
     double shift_mm;       // how far manufacturing errors can move a microimage from its cell
+    double traced_mm;      // refracting lenses: the traced reach (traced_reach_mm), else 0
 };
+
+// Refracting lenses: how far from the microimage centre of a sample's lens (the lens whose cell holds
+// the point where the sample's line crosses the array's plane on the sensor side) its light can land
+// on the sensor. A path may cross into a neighbour's glass and leave through its surface, and the
+// caps' spherical aberration is not first-order optics, so the reach is traced: light from a grid
+// over the exit pupil's disc (at the array's centre) through the lens at the array's centre, over
+// its cell grown by the glass's thickness (towards_sensor), landed on the sensor, measured from the
+// microimage centre of the lens its sensor-side line enters; with a margin for the grids' spacing
+// (the rings it gives are checked against brute force in the unit tests). 0 for other lenses.
+const int kReachPupilGrid = 12, kReachCellGrid = 32;
+
+double traced_reach_mm(const PlenopticCamera& m)
+{
+    if (!refracting_shape(*m.array.microlens) || !m.lens)
+        return 0;
+    const LensIndex lens{0, 0};
+    const Vec3 c = m.array.centre_mm(lens);
+    const Vec3 e = m.lens->exit_pupil_centre();
+    PupilDisc disc{e, m.lens->exit_pupil_radius()};
+    if (m.pupil_bounds)
+        disc = m.pupil_bounds->disc_for(c);
+    if (!(disc.radius > 0))
+        return 0;
+    const double grown = m.array.cell_circumradius_mm + m.array.microlens->thickness_mm();
+    double reach = 0;
+    for (int a = 0; a <= kReachPupilGrid; ++a) {
+        for (int b = 0; b <= kReachPupilGrid; ++b) {
+            const Vec2 on = concentric_disc(double(a) / kReachPupilGrid, double(b) / kReachPupilGrid);
+            const Vec3 q{disc.centre.x + disc.radius * on.x, disc.centre.y + disc.radius * on.y, disc.centre.z};
+            for (int i = 0; i <= kReachCellGrid; ++i) {
+                for (int j = 0; j <= kReachCellGrid; ++j) {
+                    const Vec3 local{grown * (2.0 * i / kReachCellGrid - 1), grown * (2.0 * j / kReachCellGrid - 1), 0};
+                    const Vec3 h = m.array.to_optics(m.array.centre_local3(lens) + local);
+                    const ArrayRay ray = m.array.microlens->towards_sensor(m.array, lens, h, h - q);
+                    if (!ray.passed || !(ray.direction.z < 0))
+                        continue;
+                    const Vec3 s = ray.origin + ((m.sensor.z_mm - ray.origin.z) / ray.direction.z) * ray.direction;
+                    const Vec3 from = m.array.to_local(ray.origin);
+                    const Vec3 along = mul_transposed(m.array.pose.rotation, ray.direction);
+                    const Vec3 cross = from - (from.z / along.z) * along;
+                    const Vec3 entry = m.array.centre_mm(m.array.nearest(cross.x, cross.y));
+                    const Vec3 centre = e + ((m.sensor.z_mm - e.z) / (entry.z - e.z)) * (entry - e);
+                    const double distance = std::hypot(s.x - centre.x, s.y - centre.y);
+                    if (std::isfinite(distance))
+                        reach = std::max(reach, distance);
+                }
+            }
+        }
+    }
+    const double step = 2 * grown / kReachCellGrid * (m.sensor.z_mm - e.z) / (c.z - e.z);
+    return reach > 0 ? 1.05 * reach + step : 0;
+}
 
 OverlapGeometry overlap_geometry(const PlenopticCamera& m)
 {
-    OverlapGeometry g{0, 0, 0, 0, 0, 0};
+    OverlapGeometry g{0, 0, 0, 0, 0, 0, 0};
     const double main_distance = effective_main_distance_mm(m);
     const double array_distance = effective_array_distance_mm(m);
     g.magnification = array_distance / main_distance;
@@ -52,6 +106,8 @@ OverlapGeometry overlap_geometry(const PlenopticCamera& m)
             reach = std::max(reach, 1 + g.magnification);  // light through a clear gap is not bent
         g.blur_mm = m.array.cell_circumradius_mm * reach;
         g.blur_inradius_mm = m.array.cell_inradius_mm * worst;
+        g.traced_mm = m.array.baffles ? 0 : traced_reach_mm(m);
+        g.blur_mm = std::max(g.blur_mm, g.traced_mm - g.disc_mm);
     }
     // Displaced lenses move their microimages by up to this relative to their cells.
     if (m.array.errors)
@@ -84,6 +140,8 @@ Overlap overlap_of(const PlenopticCamera& m)
     if (!(reach > g.cell_mm))
         return overlap;
     overlap.modelled = true;
+    if (g.traced_mm > 0)
+        overlap.reach_mm = g.traced_mm + g.shift_mm;
     const double pixel_reach = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]);
     const double lattice_reach = (reach + pixel_reach) / (1 + g.magnification) + m.array.cell_circumradius_mm;
     // Ring r of the lattice is at least r times this far from the own lens.
@@ -252,6 +310,7 @@ PlenopticCamera at_wavelength(const PlenopticCamera& camera, double wavelength_n
     m.overlap.modelled = own.modelled || camera.overlap.modelled;
     m.overlap.rings = std::max(own.rings, camera.overlap.rings);
     m.overlap.rings_capped = own.rings_capped || camera.overlap.rings_capped;
+    m.overlap.reach_mm = std::max(own.reach_mm, camera.overlap.reach_mm);
     return m;
 }
 

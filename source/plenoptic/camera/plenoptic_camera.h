@@ -42,6 +42,10 @@ struct Overlap {
     bool modelled = false;
     int rings = 0;  // rings of neighbours a pixel may receive light through
     bool rings_capped = false;  // the bound asked for more than kMaxOverlapRings
+    // Refracting lenses: how far from a lens's microimage centre its light lands on the sensor
+    // (traced, see plenoptic_camera.cpp: traced_reach_mm), by which a pixel's lenses are pruned;
+    // 0 for the other lenses, whose first-order bound prunes them.
+    double reach_mm = 0;
 };
 
 // A point of the picture in the centre convention used by the metadata (pixel (i, j)'s centre is

@@ -159,6 +159,20 @@ bool trace_sensor_point(const PlenopticCamera& m, Vec3 p, const LensIndex* force
 // lens reaches the pixel iff that region meets the aperture disc. Conservative: circumradius for
 // the cell, half the pixel diagonal for the pixel; for a slightly tilted array the spread terms get
 // a margin that grows with the tilt (validated against brute force in the unit tests).
+// Refracting lenses have no first-order bound: their light lands within the traced reach
+// (Overlap::reach_mm) of the lens's microimage centre (the lens centre seen from the exit pupil's
+// centre). Not pruned (true) without that reach, or where the array or a lens is tilted.
+bool refracting_lens_reaches_pixel(const PlenopticCamera& m, LensIndex lens, Vec3 p)
+{
+    if (!(m.overlap.reach_mm > 0) || m.array.pose.tilted || (m.array.errors && m.array.errors->tilts()))
+        return true;
+    const Vec3 c = lens_centre_mm(m, lens);
+    const Vec3 e = m.lens->exit_pupil_centre();
+    const Vec3 centre = e + ((m.sensor.z_mm - e.z) / (c.z - e.z)) * (c - e);
+    const double pixel = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]);
+    return std::hypot(p.x - centre.x, p.y - centre.y) <= (m.overlap.reach_mm + pixel) * (1 + 1e-9);
+}
+
 bool lens_reaches_pixel(const PlenopticCamera& m, LensIndex lens, Vec3 p)
 {
     if (!m.lens)
@@ -175,7 +189,7 @@ bool lens_reaches_pixel(const PlenopticCamera& m, LensIndex lens, Vec3 p)
     double spread = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]) * k;
     if (m.array.microlens->forms_image()) {
         if (!m.array.microlens->first_order_exact())
-            return true;  // no first-order bound for a refracting lens: every lens may reach the pixel
+            return refracting_lens_reaches_pixel(m, lens, p);
         double blur = std::fabs(1 + k - main_distance / m.array.focal_length_mm(lens));
         if (m.array.fill_factor < 1 && !m.array.mask)
             blur = std::max(blur, 1 + k);  // light through a clear gap is not bent
