@@ -83,7 +83,7 @@ def snell(d, normal, n1, n2):
         return np.where(t2 <= 1, tangential + np.sqrt(1 - t2) * nn, np.nan)
 
 
-def first_cap(side, origin, d, lenses, after):
+def first_cap(side, origin, d, lenses, after, L=L):
     """The first point ahead (t > after) where the lines meet some lens's cap inside that lens's
     cell: (t, the sphere's centre there, the index into `lenses`); t is inf where none."""
     best = np.full(origin.shape[:-1], np.inf)
@@ -108,10 +108,10 @@ def first_cap(side, origin, d, lenses, after):
     return best, sphere, which
 
 
-def passes(side, baffles, p, h0, entry):
+def passes(side, baffles, p, h0, entry, L=L, main=(0.0, 0.0)):
     """Whether the lines from sensor points p through cell points h0 of lens `entry` (array frame:
     the sensor-side plane z = 0, the main lens at z = D on the axis) pass the array and the main
-    lens's aperture."""
+    lens's aperture (its centre at `main`)."""
     lenses = around(entry[0], entry[1], 2)
     own = lenses.index(tuple(entry))
     c = centre(*entry)
@@ -120,7 +120,7 @@ def passes(side, baffles, p, h0, entry):
     with np.errstate(invalid="ignore", divide="ignore"):
         if side == "scene":
             inside = snell(d, z, 1.0, IOR)
-            t, sphere, which = first_cap(side, h0, inside, lenses, 1e-12)
+            t, sphere, which = first_cap(side, h0, inside, lenses, 1e-12, L)
             q = h0 + np.where(np.isfinite(t), t, 0)[..., None] * inside
             out = snell(inside, q - sphere, IOR, 1.0)
             ok = np.isfinite(t)
@@ -129,18 +129,18 @@ def passes(side, baffles, p, h0, entry):
             leave = q
         else:
             start = h0 - d
-            t, sphere, which = first_cap(side, start, d, lenses, 0)
+            t, sphere, which = first_cap(side, start, d, lenses, 0, L)
             q = start + np.where(np.isfinite(t), t, 0)[..., None] * d
             inside = snell(d, q - sphere, 1.0, IOR)
             front = q + ((L - q[..., 2]) / inside[..., 2])[..., None] * inside
-            again, _, _ = first_cap(side, q, inside, lenses, 1e-12)
+            again, _, _ = first_cap(side, q, inside, lenses, 1e-12, L)
             ok = np.isfinite(t) & (inside[..., 2] > 0) & ~(again < (L - q[..., 2]) / inside[..., 2])
             if baffles:
                 ok &= (which == own) & in_cell(front[..., 0], front[..., 1], c)
             out = snell(inside, z, IOR, 1.0)
             leave = front
         at_main = leave + ((D - leave[..., 2]) / out[..., 2])[..., None] * out
-        radial = np.hypot(at_main[..., 0], at_main[..., 1])
+        radial = np.hypot(at_main[..., 0] - main[0], at_main[..., 1] - main[1])
         return ok & np.isfinite(out).all(-1) & (out[..., 2] > 0) & (radial <= F / N / 2)
 
 

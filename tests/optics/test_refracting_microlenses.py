@@ -4,8 +4,9 @@ substrate T curved_side ... } }): rendered microimages against a tracer written 
 
 A white world behind a thin main lens (f/3.5), a hexagonal array of plano-convex caps, both ways
 round. The tracer below is this file's own: the cap's sphere found from its centre, Snell's law in
-tangential form, the cap's clear aperture the hexagonal cell (a path must cross both faces inside
-it), the main lens's aperture disc; each pixel's value is the share of (pixel point, cell point)
+tangential form, the cap's clear aperture the hexagonal cell, the main lens's aperture disc (for the
+microimages, test_refracting_cross_cells.py's tracer: a path that leaves its cell inside the glass
+goes on to the neighbour's cap, as without baffles); each pixel's value is the share of (pixel point, cell point)
 pairs whose ray passes, integrated on a grid. Rendered microimage centroids must agree within
 0.05 px and their lit areas (the sum of the pixel values) within 1 %. The metadata must carry the
 shape and the paraxial data worked out here from the thick-lens formulas; <image>.microimages.csv
@@ -18,6 +19,7 @@ import numpy as np
 import pytest
 
 import plenoptic_testing as pt
+import test_refracting_cross_cells as cross
 
 F, N = 50.0, 3.5
 D = 50.0                      # main lens -> array's plane (mm)
@@ -86,28 +88,12 @@ def in_cell(q):
 
 def passes(side, p, h0, main_centre):
     """Whether the ray from sensor point p (lens frame) through cell point h0 (z = 0) passes the
-    lens and the main lens's aperture (its plane z = D, its centre at main_centre)."""
-    L = CAP + SUBSTRATE
-    d = normalise(h0 - p)
-    if side == "scene":
-        inside = snell(d, np.array([0.0, 0.0, 1.0]), 1.0, IOR)
-        centre = np.array([0.0, 0.0, L - R])
-        q = sphere_hit(h0, inside, centre, True)
-        out = snell(inside, q - centre, IOR, 1.0)
-        lit = in_cell(h0) & in_cell(q)
-        exit_point = q
-    else:
-        centre = np.array([0.0, 0.0, R])
-        q = sphere_hit(h0 - d, d, centre, False)
-        inside = snell(d, q - centre, 1.0, IOR)
-        front = q + ((L - q[..., 2]) / inside[..., 2])[..., None] * inside
-        out = snell(inside, np.array([0.0, 0.0, 1.0]), IOR, 1.0)
-        lit = in_cell(q) & in_cell(front)
-        exit_point = front
-    with np.errstate(invalid="ignore"):
-        at_main = exit_point + ((D - exit_point[..., 2]) / out[..., 2])[..., None] * out
-        radial = np.hypot(at_main[..., 0] - main_centre[0], at_main[..., 1] - main_centre[1])
-        return lit & (out[..., 2] > 0) & (radial <= F / N / 2)
+    array and the main lens's aperture (its plane z = D, its centre at main_centre). Without
+    baffles a path that leaves the lens's cell inside the glass (or under caps facing the sensor)
+    goes on and leaves through the neighbour's cap it meets: test_refracting_cross_cells.py's
+    tracer (the array's surface is each lens's cap inside that lens's cell; the lattice seen from
+    this lens, placed at (0, 0))."""
+    return cross.passes(side, False, p, h0, (0, 0), CAP + SUBSTRATE, main_centre)
 
 
 def cell_points(m):

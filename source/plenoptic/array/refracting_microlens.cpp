@@ -481,11 +481,12 @@ private:
                 return false;
             bool on_cap;
             const double t = surface_ahead(shape, medium, P, D, &on_cap);
-            if (!(t < std::numeric_limits<double>::infinity()))
-                return false;
-            const Vec3 q = P + t * D;
+            const bool ahead = t < std::numeric_limits<double>::infinity();
+            const Vec3 q = P + (ahead ? t : 0.0) * D;
             LensIndex next = lens;
-            if (!in_cell(array, lens, frame, q)) {
+            // No surface of this lens ahead (the line misses its cap), or the surface's point lies
+            // outside the cell: the path leaves the cell first.
+            if (!ahead || !in_cell(array, lens, frame, q)) {
                 if (array.baffles)
                     return false;
                 const double exit = cell_exit(array, lens, X, V, &next);
@@ -494,6 +495,8 @@ private:
                     lens = next;
                     continue;
                 }
+                if (!ahead)
+                    return false;
                 // On the cell's border within rounding: the surface is this lens's.
             }
             *hit = SurfaceHit{lens, frame, shape, q, D, on_cap};

@@ -223,7 +223,7 @@ TEST(RefractingMicrolens, TotalInternalReflectionBlocks)
     EXPECT_GT(checked, 0);
 }
 
-MicrolensArray refracting_array(bool scene_side, double pitch = 0.1)
+MicrolensArray refracting_array(bool scene_side, double pitch = 0.1, double substrate = 0.03)
 {
     ArrayParams a;
     a.given = true;
@@ -232,7 +232,7 @@ MicrolensArray refracting_array(bool scene_side, double pitch = 0.1)
     a.pitch_mm = pitch;
     a.has_lens = true;
     a.lens = MicrolensType::Refracting;
-    a.refracting = shape(scene_side, 0.08, 1.5, 0.025, 0.03);
+    a.refracting = shape(scene_side, 0.08, 1.5, 0.025, substrate);
     a.has_distance = true;
     a.distance_mm = 0.2;
     return make_microlens_array(a, -50);
@@ -313,7 +313,8 @@ TEST(RefractingMicrolens, RaysLeavingTheCellGoOnInTheNeighboursUnlessBaffled)
 {
     for (bool scene_side : {true, false}) {
         for (bool baffles : {false, true}) {
-            MicrolensArray array = refracting_array(scene_side);
+            // A thick substrate (0.15 mm under a 0.1 mm pitch): paths cross cells both ways round.
+            MicrolensArray array = refracting_array(scene_side, 0.1, 0.15);
             array.baffles = baffles;
             const LensIndex lens{2, 1};
             const Vec3 c = array.centre_mm(lens);
@@ -348,7 +349,7 @@ TEST(RefractingMicrolens, RaysLeavingTheCellGoOnInTheNeighboursUnlessBaffled)
             } else {
                 EXPECT_GT(crossed_passed, 50);
             }
-            EXPECT_GT(passed, 500);
+            EXPECT_GT(passed, 200);
         }
     }
 }
