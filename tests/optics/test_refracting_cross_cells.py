@@ -108,11 +108,12 @@ def first_cap(side, origin, d, lenses, after, L=L):
     return best, sphere, which
 
 
-def passes(side, baffles, p, h0, entry, L=L, main=(0.0, 0.0)):
+def passes(side, baffles, p, h0, entry, L=L, main=(0.0, 0.0), rings=2):
     """Whether the lines from sensor points p through cell points h0 of lens `entry` (array frame:
     the sensor-side plane z = 0, the main lens at z = D on the axis) pass the array and the main
-    lens's aperture (its centre at `main`)."""
-    lenses = around(entry[0], entry[1], 2)
+    lens's aperture (its centre at `main`); the caps of the lenses within `rings` rings of the
+    entry lens are searched."""
+    lenses = around(entry[0], entry[1], rings)
     own = lenses.index(tuple(entry))
     c = centre(*entry)
     d = normalise(h0 - p)
