@@ -452,8 +452,8 @@ TEST(Optics, OverlapPruningNeverDropsALensThatDeliversLight)
     check_overlap_pruning("traced triplet, lenses with errors", real, 0.8);
     // Refracting caps on a thick substrate (light crosses into the neighbours' glass), either side
     // facing the main lens, and with errors: the rings and the pruning come from the traced reach.
-    // The point here is that no lens that delivers light is dropped; these caps' aberration spreads
-    // a lens's light so far that the pruning keeps most candidates (tilted lenses: all of them).
+    // The point here is that no lens that delivers light is dropped; how many candidates the
+    // pruning keeps is not asserted (with tilted lenses it keeps all of them).
     for (bool scene_side : {true, false}) {
         CameraParams refracting = plenoptic_camera(GridType::Hexagonal, 0.1, 0.16, 0.2, 50, 2.5, 50);
         refracting.array.lens = MicrolensType::Refracting;
