@@ -227,7 +227,11 @@ def test_microimages_match_an_independent_tracer(args, side):
 
 def trace_down(side, point, a):
     """Light travelling along unit directions a (..., 3) on lines through `point` (lens frame),
-    through the lens: (where it leaves towards the sensor, its direction, whether it passed)."""
+    through the lens whose face nearest the scene it meets inside its cell: (where it leaves
+    towards the sensor, its direction, whether it passed). Without baffles a path that leaves the
+    cell in the glass goes on and leaves through the face it meets: the flat back, common to all
+    lenses (caps facing the scene), or the first cap of the lenses around that it meets inside
+    that cap's cell (caps facing the sensor; test_refracting_cross_cells.first_cap)."""
     L = CAP + SUBSTRATE
     z = np.array([0.0, 0.0, 1.0])
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -238,17 +242,17 @@ def trace_down(side, point, a):
             inside = snell(a, q - centre, 1.0, IOR)
             back = q + (-q[..., 2] / inside[..., 2])[..., None] * inside
             out = snell(inside, z, IOR, 1.0)
-            ok = in_cell(q) & in_cell(back)
+            ok = in_cell(q)
             leave = back
         else:
             front = point + ((L - point[..., 2]) / a[..., 2])[..., None] * a
             inside = snell(a, z, 1.0, IOR)
-            centre = np.array([0.0, 0.0, R])
-            q = sphere_hit(front, inside, centre, False)
-            out = snell(inside, q - centre, IOR, 1.0)
-            ok = in_cell(front) & in_cell(q)
+            t, sphere, _ = cross.first_cap(side, front, inside, cross.around(0, 0, 1), 1e-12, L)
+            q = front + np.where(np.isfinite(t), t, 0)[..., None] * inside
+            out = snell(inside, q - sphere, IOR, 1.0)
+            ok = in_cell(front) & np.isfinite(t)
             leave = q
-        ok = ok & np.isfinite(out).all(-1) & np.isfinite(leave).all(-1)
+        ok = ok & np.isfinite(out).all(-1) & np.isfinite(leave).all(-1) & (out[..., 2] < 0)
     return leave, out, ok
 
 
