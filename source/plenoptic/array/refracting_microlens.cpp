@@ -354,6 +354,13 @@ public:
     // `sampled` is the cell point.
     ArrayRay sample_ray(const MicrolensArray& array, const Vec3& p, LensIndex lens, double u, double v) const override
     {
+        return trace_sample(array, p, lens, u, v, nullptr);
+    }
+
+    // sample_ray's path; `crossed` (if given) is set when the path goes on in a neighbour's column.
+    ArrayRay trace_sample(const MicrolensArray& array, const Vec3& p, LensIndex lens, double u, double v,
+                          bool* crossed) const
+    {
         const LensFrame frame = array.frame(lens);
         const Vec2 offset = array.cell_point(u, v);
         const Vec3 h0{offset.x, offset.y, 0};
@@ -374,20 +381,21 @@ public:
             Vec3 inside;
             if (!refract(air, kAxis, 1 / n, &inside))
                 return no_ray();
-            if (!walk(array, Medium::Glass, lens, frame, start, from_lens(frame, inside), &leave) || !leave.on_cap)
+            if (!walk(array, Medium::Glass, lens, frame, start, from_lens(frame, inside), &leave, crossed) ||
+                !leave.on_cap)
                 return no_ray();
             if (!refract(leave.dir, cap_normal(leave.shape, leave.q), n, &out) || !(out.z > 0))
                 return no_ray();
         } else {
             // Up through the air to a cap, into the glass, up to the flat front, out.
             SurfaceHit cap;
-            if (!walk(array, Medium::AirUnderCaps, lens, frame, start, from_lens(frame, air), &cap))
+            if (!walk(array, Medium::AirUnderCaps, lens, frame, start, from_lens(frame, air), &cap, crossed))
                 return no_ray();
             Vec3 inside;
             if (!refract(cap.dir, cap_normal(cap.shape, cap.q), 1 / n, &inside) || !(inside.z > 0))
                 return no_ray();
             if (!walk(array, Medium::Glass, cap.lens, cap.frame, from_lens_point(cap.frame, cap.q),
-                      from_lens(cap.frame, inside), &leave) ||
+                      from_lens(cap.frame, inside), &leave, crossed) ||
                 leave.on_cap)
                 return no_ray();
             if (!refract(leave.dir, kAxis, n, &out))
@@ -470,7 +478,7 @@ private:
     // a path that steps out of the medium is blocked); with baffles it is blocked, as after
     // kMaxCells cells.
     bool walk(const MicrolensArray& array, Medium medium, LensIndex lens, LensFrame frame, Vec3 X, Vec3 V,
-              SurfaceHit* hit) const
+              SurfaceHit* hit, bool* crossed = nullptr) const
     {
         for (int cells = 0; cells < kMaxCells; ++cells) {
             if (cells > 0)
@@ -493,6 +501,8 @@ private:
                 if (exit < t) {
                     X = X + exit * V;
                     lens = next;
+                    if (crossed)
+                        *crossed = true;
                     continue;
                 }
                 if (!ahead)
@@ -519,6 +529,15 @@ const RefractingShape* refracting_shape(const Microlens& microlens)
 {
     const RefractingMicrolens* refracting = dynamic_cast<const RefractingMicrolens*>(&microlens);
     return refracting ? &refracting->shape() : nullptr;
+}
+
+bool refracting_sample_crosses_cells(const MicrolensArray& array, const Vec3& p, LensIndex lens, double u, double v)
+{
+    const RefractingMicrolens* refracting = dynamic_cast<const RefractingMicrolens*>(array.microlens.get());
+    if (!refracting)
+        return false;
+    bool crossed = false;
+    return refracting->trace_sample(array, p, lens, u, v, &crossed).passed && crossed;
 }
 
 } // namespace plenoptic

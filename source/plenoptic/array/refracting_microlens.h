@@ -66,6 +66,10 @@ std::shared_ptr<const Microlens> make_refracting_microlens(const RefractingShape
 // The shape of refracting microlenses; nullptr for the other kinds.
 const RefractingShape* refracting_shape(const Microlens& microlens);
 
+// Whether the path of the array's sample_ray for these arguments passes the array after going on
+// in a neighbour's column (it left its lens's cell inside the array); false for other lenses.
+bool refracting_sample_crosses_cells(const MicrolensArray& array, const Vec3& p, LensIndex lens, double u, double v);
+
 } // namespace plenoptic
 
 #endif

@@ -13,6 +13,7 @@
 #include <unordered_map>
 
 #include "plenoptic/projection/microimage_lattice.h"
+#include "plenoptic/array/refracting_microlens.h"
 #include "plenoptic/lens/pupil_bounds.h"
 #include "plenoptic/camera/rays.h"
 #include "plenoptic/camera/rays_internal.h"
@@ -54,6 +55,13 @@ public:
         // Without overlap modelling the renderer gives a sensor point the light of its own lens only.
         const OwnLens own = own_lens(m_, m_.sensor.point(u, v));
         return own.found && own.lens == lens_;
+    }
+
+    // Whether the light sensor point (u, v) receives through the lens at that aperture sample
+    // passes the array after crossing into a neighbour's column (refracting lenses without baffles).
+    bool crosses_cells(double u, double v) const
+    {
+        return refracting_sample_crosses_cells(m_.array, m_.sensor.point(u, v), lens_, lens_u_, lens_v_);
     }
 
 private:
@@ -228,16 +236,21 @@ struct RadiusChange {
 // the same region of the previous lenses of the row, per direction, as seen from `reference`) each
 // radius is sought near its prediction, corrected by `change` (in: the lens's previous region's;
 // out: this region's, fitted as the directions are measured); `radii` (if given) receives this
-// region's radii as seen from `reference` (empty when there is no region).
+// region's radii as seen from `reference` (empty when there is no region). `lobe` (if given) is
+// set when the region is a lobe of light that crossed into a neighbour's column in the array,
+// found apart from the light that stays in the lens's own column: its start point came from the
+// coarse search (the guess was dark) and receives such light.
 Moments region_moments(const LensProbe& probe, double gu, double gv, double search, double reach,
                        const MicroimageOptions& options, Vec2 reference, const std::vector<double>* predicted,
-                       RadiusChange* change, std::vector<double>* radii)
+                       RadiusChange* change, std::vector<double>* radii, bool* lobe = nullptr)
 {
     if (radii)
         radii->clear();
     double su, sv;
     if (!start_point(probe, gu, gv, search, &su, &sv))
         return Moments{0, 0, 0};
+    if (lobe)
+        *lobe = !(su == gu && sv == gv) && probe.crosses_cells(su, sv);
     const bool near = predicted && int(predicted->size()) == options.azimuths && change;
     const RadiusChange start = change ? *change : RadiusChange();
     RadiusChange now = start;
@@ -516,10 +529,11 @@ namespace {
 
 // Measures the lenses of `out` (their `lens` set, row by row), each through `light`'s rays; a run
 // of neighbours is lenses k, k + step, k + 2 step, ... of one row. Reports (now, out.size()) about
-// every tenth of the lenses; false when `cancelled` stopped it.
+// every tenth of the lenses; false when `cancelled` stopped it. `lobes` (if given): per lens,
+// whether a region of its microimage is a lobe of light that crossed cells (region_moments).
 bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, const MicroimageOptions& options,
                     std::vector<MicroimageTruth>& out, std::int64_t step, const MicroimageProgress& progress,
-                    const MicroimageCancel& cancelled)
+                    const MicroimageCancel& cancelled, std::vector<char>* lobes = nullptr)
 {
     if (out.empty())
         return true;
@@ -531,8 +545,11 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
         std::vector<std::vector<std::vector<double>>> history;
         std::vector<double> predicted, now;
     };
+    if (lobes)
+        lobes->assign(out.size(), 0);
     auto measure = [&](std::size_t index, Radii* radii) {
         MicroimageTruth& truth = out[index];
+        bool found_lobe = false;
         const MicroimageCentre lattice = microimage_centre_px(m, truth.lens);
         const Vec2 centre{lattice.u, lattice.v};
         Moments total{0, 0, 0};
@@ -578,8 +595,11 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
             if (predicted && stretched)
                 for (std::size_t a = 0; a < radii->predicted.size(); ++a)
                     radii->predicted[a] *= stretch_along(int(a));
+            bool lobe = false;
             const Moments region =
-                region_moments(probe, guess.u, guess.v, search, reach, options, reference, predicted, &change, now);
+                region_moments(probe, guess.u, guess.v, search, reach, options, reference, predicted, &change, now,
+                               lobes ? &lobe : nullptr);
+            found_lobe = found_lobe || (lobe && region.area > 0);
             if (radii && stretched)
                 for (std::size_t a = 0; a < now->size(); ++a)
                     (*now)[a] /= stretch_along(int(a));
@@ -604,6 +624,8 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
         truth.v_px = truth.lit ? total.mv / total.area - 0.5 : 0;
         const double cell = microimage_cell_area_px(m, truth.lens);
         truth.lit_fraction = cell > 0 ? total.area / cell : 0;
+        if (lobes)
+            (*lobes)[index] = found_lobe;
     };
 
     // Runs of up to kRun neighbouring lenses of one row (k, k + 1, ...): the first lens of a run is
@@ -696,6 +718,9 @@ const double kInterpolatedFraction = 5e-5;
 struct AnchorValue {
     bool lit;
     double value[3];  // du, dv, lit fraction
+    // A region of its microimage is a lobe of light that crossed into a neighbour's column
+    // (region_moments).
+    bool lobe;
 };
 
 std::uint64_t anchor_key(LensIndex lens)
@@ -730,7 +755,14 @@ struct Anchors {
 };
 
 // The lens's microimage from the anchors, or false where the anchors do not vouch for the cubic (a
-// dark anchor among those it reads, or a fourth difference too large).
+// dark anchor among those it reads, an anchor with a lobe of light that crossed cells, or a fourth
+// difference too large). Lobes (refracting lenses without baffles, light that left its cell in
+// the glass and then a neighbour's cap): thin regions apart from the lens's own light, each about
+// a thousandth of a pixel of the centre for one of the 24 x 24 cell points, counted only at the
+// cell points whose own light is gone; where a row of cell points begins to count them the
+// centre moves by several thousandths of a pixel from one lens to the next (a step between
+// anchors, which neither the cubic nor its fourth differences see), so lenses whose anchors count
+// any are measured.
 bool interpolate(const Anchors& a, GridType grid, MicroimageTruth* truth, Vec2 lattice_px)
 {
     std::int64_t i0, j0;
@@ -739,14 +771,17 @@ bool interpolate(const Anchors& a, GridType grid, MicroimageTruth* truth, Vec2 l
     // The anchors it reads, in a 6 x 6 block from (i0 - 1, j0 - 1); null where not read.
     const AnchorValue* block[6][6] = {};
     bool dark = false;
+    bool lobe = false;
     a.each(i0, j0, [&](std::int64_t i, std::int64_t j) {
         const auto found = a.values->find(anchor_key(a.lens(i, j)));
-        if (found == a.values->end() || !found->second.lit)
+        if (found == a.values->end() || !found->second.lit) {
             dark = true;
-        else
+        } else {
             block[j - j0 + 1][i - i0 + 1] = &found->second;
+            lobe = lobe || found->second.lobe;
+        }
     });
-    if (dark)
+    if (dark || lobe)
         return false;
     auto v = [&](std::int64_t i, std::int64_t j, int q) { return block[j - j0 + 1][i - i0 + 1]->value[q]; };
     const double allowed[3] = {kInterpolatedPx, kInterpolatedPx, kInterpolatedFraction};
@@ -920,14 +955,18 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         std::sort(measured.begin(), measured.end(), [](const MicroimageTruth& p, const MicroimageTruth& q) {
             return p.lens.l != q.lens.l ? p.lens.l < q.lens.l : p.lens.k < q.lens.k;
         });
-        if (!measure_lenses(m, light, options, measured, step, share(std::min(level, 1) * total / 4), cancelled)) {
+        std::vector<char> lobes;
+        if (!measure_lenses(m, light, options, measured, step, share(std::min(level, 1) * total / 4), cancelled,
+                            &lobes)) {
             out.clear();
             return out;
         }
         counts.anchors += measured.size();
-        for (const MicroimageTruth& t : measured) {
+        for (std::size_t n = 0; n < measured.size(); ++n) {
+            const MicroimageTruth& t = measured[n];
             const MicroimageCentre centre = microimage_centre_px(m, t.lens);
             AnchorValue value;
+            value.lobe = lobes[n] != 0;
             value.lit = t.lit && centre.valid;
             value.value[0] = value.lit ? t.u_px - centre.u : 0;
             value.value[1] = value.lit ? t.v_px - centre.v : 0;

@@ -380,14 +380,23 @@ TEST(MicroimageTruth, RefractingLensesBetweenAnchorsAgreeWithMeasuringThem)
     scene_side.array.refracting.cap_mm = 0.03;
     scene_side.array.refracting.substrate_mm = 0.05;
     scene_side.array.distance_mm = 0.85 - 0.08 / 1.5;
-    CameraParams sensor_side = scene_side;
-    sensor_side.array.refracting.curved_towards_scene = false;
-    sensor_side.array.distance_mm = 0.85;
+    // Without baffles light that leaves a cell in the glass goes on in the neighbour's; with caps
+    // towards the scene thin lobes of it, apart from the lens's own light, are counted at the cell
+    // points near the cell's edge whose own light is gone, and the lenses whose anchors count any
+    // are measured. With baffles (no such light) most lenses are interpolated.
+    CameraParams scene_baffled = scene_side;
+    scene_baffled.array.baffles = true;
+    CameraParams sensor_baffled = scene_baffled;
+    sensor_baffled.array.refracting.curved_towards_scene = false;
+    sensor_baffled.array.distance_mm = 0.85;
     struct Case {
         const char* name;
         CameraParams params;
+        bool mostly_interpolated;
     };
-    const Case cases[] = {{"caps towards the scene", scene_side}, {"caps towards the sensor", sensor_side}};
+    const Case cases[] = {{"caps towards the scene", scene_side, false},
+                          {"caps towards the scene, baffles", scene_baffled, true},
+                          {"caps towards the sensor, baffles", sensor_baffled, true}};
     for (const Case& c : cases) {
         const PlenopticCamera camera = with_film(make_camera(c.params), 240, 208);
         MicroimageOptions fast = default_microimage_options(), one_thread = fast;
@@ -414,7 +423,8 @@ TEST(MicroimageTruth, RefractingLensesBetweenAnchorsAgreeWithMeasuringThem)
         }
         // Most lenses interpolated, and the anchors far fewer than the lenses.
         EXPECT_EQ(work.interpolated + work.measured, a.size()) << c.name;
-        EXPECT_GT(work.interpolated, a.size() / 2) << c.name;
+        if (c.mostly_interpolated)
+            EXPECT_GT(work.interpolated, a.size() / 2) << c.name;
         EXPECT_LT(4 * work.anchors, a.size()) << c.name;
         // Lenses drawn across the picture, every lens of its first row (the picture's edge, where
         // the stencils are one-sided) and the last lens (a corner), each measured.
