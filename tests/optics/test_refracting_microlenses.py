@@ -347,10 +347,9 @@ def trace_down(side, point, a):
     return leave, out, ok
 
 
-# The brute force's grid over the main lens's aperture (a side, from the centre) and the tolerance
-# on the projected centroids (px), per side (see the end of the test).
+# The brute force's grid over the main lens's aperture (a side, from the centre), each point
+# jittered within its step (see the end of the test).
 PROJECTION_GRID = {"scene": 420, "sensor": 1000}
-PROJECTION_TOLERANCE = {"scene": 0.15, "sensor": 0.5}
 
 
 @pytest.mark.parametrize("side", ["scene", "sensor"])
@@ -376,6 +375,9 @@ def test_forward_projection_matches_a_brute_force_trace(args, side):
     step = F / N / 2 / grid
     g = (np.arange(-grid, grid + 1)) * step
     mx, my = np.meshgrid(g, g)
+    rng = np.random.default_rng(11)
+    mx = mx + rng.uniform(-0.5, 0.5, mx.shape) * step
+    my = my + rng.uniform(-0.5, 0.5, my.shape) * step
     inside = mx ** 2 + my ** 2 <= (F / N / 2) ** 2
     m = np.stack([mx[inside], my[inside], np.zeros(inside.sum())], axis=1)
     a = normalise(image - m)
@@ -423,13 +425,14 @@ def test_forward_projection_matches_a_brute_force_trace(args, side):
         worst = max(worst, error)
         worst_fraction = max(worst_fraction, abs(gf / fraction - 1))
     print("%s: worst %.4f px, fraction %.2f %%" % (side, worst, 100 * worst_fraction))
-    # The projection samples the light on a grid (96 a side over where it passes); measured with
-    # caps facing the scene 0.02 px, fractions within 0.8 %. With caps facing the sensor a sparse tail
-    # of light bent at the caps' rims lands up to 3 rings from its lens and weighs on the centroid:
-    # the brute force's own centroid of lens (0, -1) moved 52.39, 51.62, 51.98, 51.87 px with
-    # aperture grids of 420, 700, 1000 and 1400 a side, and the projection (52.24) lies 0.27 to 0.38
-    # px from the last two; fractions within 0.6 %. Hence 0.5 px there (PROJECTION_TOLERANCE).
-    assert worst <= PROJECTION_TOLERANCE[side]
+    # With caps facing the sensor about 1.5 % of a lens's light meets a cap near its rim (or goes on
+    # through a neighbour's glass and cap) and lands 27 to 50 px from the rest, from thin bands of
+    # the cell: a regular grid counts them by chance (lens (0, -1)'s centroid, this brute force
+    # unjittered: 52.39, 51.62, 51.98, 51.87 px at 420, 700, 1000, 1400 a side; jittered 51.82 to
+    # 51.85 at 700 to 1400), hence the jitter here and the projection's refinement at such jumps
+    # (project_through_traced_lens; its 96 a side alone gave 52.24). The projection samples the
+    # light on a grid, 96 a side over where it passes: measured 0.02 px with caps facing the scene.
+    assert worst <= 0.15
     assert worst_fraction <= 0.02
 
 
