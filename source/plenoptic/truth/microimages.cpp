@@ -757,12 +757,11 @@ struct Anchors {
 // The lens's microimage from the anchors, or false where the anchors do not vouch for the cubic (a
 // dark anchor among those it reads, an anchor with a lobe of light that crossed cells, or a fourth
 // difference too large). Lobes (refracting lenses without baffles, light that left its cell in
-// the glass and then a neighbour's cap): thin regions apart from the lens's own light, each about
-// a thousandth of a pixel of the centre for one of the 24 x 24 cell points, counted only at the
-// cell points whose own light is gone; where a row of cell points begins to count them the
-// centre moves by several thousandths of a pixel from one lens to the next (a step between
-// anchors, which neither the cubic nor its fourth differences see), so lenses whose anchors count
-// any are measured.
+// the glass and then a neighbour's cap): thin regions apart from the lens's own light, counted
+// only at the cell points whose own light is gone (each moved the centre by about 1e-3 px in the
+// unit test); where a row of the 24 x 24 cell points begins to count them the centre steps by
+// several thousandths of a pixel from one lens to the next (a step between anchors, which neither
+// the cubic nor its fourth differences see), so lenses whose anchors count any are measured.
 bool interpolate(const Anchors& a, GridType grid, MicroimageTruth* truth, Vec2 lattice_px)
 {
     std::int64_t i0, j0;
