@@ -71,20 +71,11 @@ def scene(side):
 # ---- the test's tracer, in the frame of one lens: its centre at the origin, +z to the scene,
 # z = 0 the array's plane (its face nearest the sensor) ----
 
-def normalise(v):
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
-
-
-def snell(d, normal, n1, n2):
-    """Unit directions d (..., 3) through surfaces of normal `normal` (either sign); NaN rows on
-    total internal reflection."""
-    nn = normalise(normal)
-    nn = np.where((d * nn).sum(-1, keepdims=True) < 0, -nn, nn)
-    along = (d * nn).sum(-1, keepdims=True)
-    tangential = (n1 / n2) * (d - along * nn)
-    t2 = (tangential ** 2).sum(-1, keepdims=True)
-    with np.errstate(invalid="ignore"):
-        return np.where(t2 <= 1, tangential + np.sqrt(1 - t2) * nn, np.nan)
+# The same vector helpers as the crossing tracer's (one definition, in test_refracting_cross_cells.py):
+# unit vectors, and Snell's law for unit directions d (..., 3) through surfaces of normal `normal`
+# (either sign), NaN rows on total internal reflection.
+normalise = cross.normalise
+snell = cross.snell
 
 
 def sphere_hit(origin, d, centre, upper):
