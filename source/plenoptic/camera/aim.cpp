@@ -17,9 +17,11 @@ namespace plenoptic {
 
 namespace {
 
-// Relative widening of every disc: its centre and radius come from sums of terms up to this many
-// times larger than rounding (1e-16 of them), so the disc still holds what the exact one holds.
-const double kRoundingMargin = 1e-9;
+// Relative widening of every region: its centre and radius come from sums of terms whose rounding
+// is ~1e-16 of them, so widened by 1e-12 of them it still holds what the exact one holds. (1e-9,
+// as first written, left a band that held 2e-5 of a rim pixel's aimed samples where a microimage's
+// rim cuts a sliver of a 0.5 mm cell: the cell disc's radius there is ~6 mm.)
+const double kRoundingMargin = 1e-12;
 const double kSqrt3 = 1.7320508075688772935;
 
 } // namespace
@@ -67,6 +69,8 @@ bool lens_aim(const PlenopticCamera& m, LensIndex lens, LensAim* out)
     out->c = Vec2{c.x, c.y};
     out->z = c.z;
     out->f = m.array.focal_length_mm(lens);
+    out->grid = m.array.grid;
+    out->pitch = m.array.pitch_mm;
     out->circumradius = circumradius;
     out->Z = d.z - c.z;
     out->m = Vec2{d.x, d.y};
@@ -75,19 +79,160 @@ bool lens_aim(const PlenopticCamera& m, LensIndex lens, LensAim* out)
            std::isfinite(out->rho) && is_finite(out->m) && is_finite(out->c);
 }
 
+
+// ---- Rounded polygons -------------------------------------------------------------------------
+
 namespace {
 
-AimDisc sensor_disc(const LensAim& a, double d, Vec2 m, double rho)
+// +1 when the corners go counter-clockwise, -1 clockwise, 0 when they enclose no area (fewer than
+// three corners, or all on a line).
+int orientation(const RoundedPolygon& r)
 {
-    // |(Z/d) s - c (1 + Z/d) + m| <= rho + |g| R, divided by Z/d.
+    double area = 0;
+    for (int k = 0; k < r.corners; ++k)
+        area += cross(r.corner[k], r.corner[(k + 1) % r.corners]);
+    return area > 0 ? 1 : (area < 0 ? -1 : 0);
+}
+
+// Distance from p to the segment a-b.
+double segment_distance(Vec2 p, Vec2 a, Vec2 b)
+{
+    const Vec2 e = b - a, q = p - a;
+    const double length2 = dot(e, e);
+    double t = length2 > 0 ? dot(q, e) / length2 : 0;
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    return std::hypot(q.x - t * e.x, q.y - t * e.y);
+}
+
+} // namespace
+
+bool region_holds(const RoundedPolygon& r, Vec2 p)
+{
+    const int turn = orientation(r);
+    if (turn != 0) {
+        bool inside = true;
+        for (int k = 0; k < r.corners && inside; ++k) {
+            const Vec2 a = r.corner[k], b = r.corner[(k + 1) % r.corners];
+            inside = turn * cross(b - a, p - a) >= 0;
+        }
+        if (inside)
+            return true;
+    }
+    for (int k = 0; k < r.corners; ++k)
+        if (segment_distance(p, r.corner[k], r.corner[(k + 1) % r.corners]) <= r.radius)
+            return true;
+    return false;
+}
+
+void region_x_extent(const RoundedPolygon& r, double* x0, double* x1)
+{
+    double lo = r.corner[0].x, hi = r.corner[0].x;
+    for (int k = 1; k < r.corners; ++k) {
+        lo = std::min(lo, r.corner[k].x);
+        hi = std::max(hi, r.corner[k].x);
+    }
+    *x0 = lo - r.radius;
+    *x1 = hi + r.radius;
+}
+
+bool region_chord(const RoundedPolygon& r, double x, double* y0, double* y1)
+{
+    // The boundary of a convex polygon widened by a disc is made of its edges moved out by the
+    // radius along their normals and of arcs about its corners; every point of those pieces (whole
+    // circles about the corners included) lies in the region, so the chord runs from the lowest to
+    // the highest of them at x.
+    const double radius = r.radius;
+    double lo = INFINITY, hi = -INFINITY;
+    for (int k = 0; k < r.corners; ++k) {
+        const Vec2 v = r.corner[k];
+        const double dx = x - v.x;
+        if (std::fabs(dx) <= radius) {
+            const double h = std::sqrt(std::max(0.0, radius * radius - dx * dx));
+            lo = std::min(lo, v.y - h);
+            hi = std::max(hi, v.y + h);
+        }
+    }
+    const int turn = orientation(r);
+    for (int k = 0; k < r.corners; ++k) {
+        const Vec2 a = r.corner[k], b = r.corner[(k + 1) % r.corners];
+        const Vec2 e = b - a;
+        const double length = std::hypot(e.x, e.y);
+        if (!(length > 0))
+            continue;
+        // The outward normal (both sides when the polygon encloses no area).
+        for (int side = -1; side <= 1; side += 2) {
+            if (turn != 0 && side != turn)
+                continue;
+            const Vec2 n{side * e.y / length * radius, -side * e.x / length * radius};
+            const Vec2 p = a + n, q = b + n;
+            if (!(x >= std::min(p.x, q.x) && x <= std::max(p.x, q.x)))
+                continue;
+            if (p.x == q.x) {
+                lo = std::min(lo, std::min(p.y, q.y));
+                hi = std::max(hi, std::max(p.y, q.y));
+                continue;
+            }
+            double t = (x - p.x) / (q.x - p.x);
+            t = t < 0 ? 0 : (t > 1 ? 1 : t);
+            const double y = p.y + t * (q.y - p.y);
+            lo = std::min(lo, y);
+            hi = std::max(hi, y);
+        }
+    }
+    *y0 = lo;
+    *y1 = hi;
+    return hi >= lo;
+}
+
+RoundedPolygon lit_sensor_region(const LensAim& a, double d, int cut)
+{
+    // s lies in the region when the lit cell disc's centre (m - c + (Z/d)(s - c)) / g lies within
+    // rho / |g| of the cell H: s - c - (c - m) d/Z in (d/Z) g (H + disc(rho/|g|)), and H is
+    // symmetric about its centre.
+    const Vec2 m = cut < 0 ? a.m : a.cut_m[cut];
+    const double rho = cut < 0 ? a.rho : a.cut_rho[cut];
     const double g = 1 + a.Z / d - a.Z / a.f;
     const double k = d / a.Z;
     const Vec2 shift{(a.c.x - m.x) * k, (a.c.y - m.y) * k};
-    const double radius = (rho + std::fabs(g) * a.circumradius) * k;
-    const double slack = kRoundingMargin * (std::fabs(shift.x) + std::fabs(shift.y) + radius + std::fabs(a.c.x) +
-                                            std::fabs(a.c.y));
-    return AimDisc{Vec2{a.c.x + shift.x, a.c.y + shift.y}, radius * (1 + kRoundingMargin) + slack};
+    const Vec2 centre{a.c.x + shift.x, a.c.y + shift.y};
+    const double scale = std::fabs(g) * k;
+    RoundedPolygon out;
+    Vec2 cell[6];
+    out.corners = cell_polygon(a.grid, a.pitch, cell);
+    for (int n = 0; n < out.corners; ++n)
+        out.corner[n] = Vec2{centre.x + scale * cell[n].x, centre.y + scale * cell[n].y};
+    const double radius = rho * k;
+    // g's rounding is up to ~1e-16 of (1 + Z/d + Z/|f|), the scale's of that times d/Z.
+    const double slack =
+        kRoundingMargin * (std::fabs(shift.x) + std::fabs(shift.y) + radius + std::fabs(a.c.x) + std::fabs(a.c.y) +
+                           (scale + k + 1 + d / std::fabs(a.f)) * a.circumradius);
+    out.radius = radius * (1 + kRoundingMargin) + slack;
+    return out;
 }
+
+bool own_sensor_cell(const PlenopticCamera& m, LensIndex lens, double sensor_z, RoundedPolygon* out)
+{
+    // own_lens projects the sensor point from the exit pupil's centre e onto the array's plane
+    // (array-local z = 0) and takes the lattice cell there: the cell's points q come from the
+    // sensor points e + (q - e) (e.z - sensor_z) / e.z.
+    if (m.array.errors || !m.lens)
+        return false;
+    const Vec3 e = m.array.to_local(m.lens->exit_pupil_centre());
+    const double scale = (e.z - sensor_z) / e.z;
+    if (!(scale > 0) || !std::isfinite(scale) || !is_finite(e))
+        return false;
+    const Vec2 c = m.array.lattice_centre_local(lens);
+    Vec2 cell[6];
+    out->corners = cell_polygon(m.array.grid, m.array.pitch_mm, cell);
+    for (int n = 0; n < out->corners; ++n)
+        out->corner[n] = Vec2{e.x + scale * (c.x + cell[n].x - e.x), e.y + scale * (c.y + cell[n].y - e.y)};
+    out->radius = kRoundingMargin * (std::fabs(e.x) + std::fabs(e.y) +
+                                     scale * (std::fabs(c.x) + std::fabs(c.y) + std::fabs(e.x) + std::fabs(e.y) +
+                                              m.array.cell_circumradius_mm));
+    return true;
+}
+
+namespace {
 
 AimDisc cell_disc(const LensAim& a, Vec3 s, Vec2 m, double rho)
 {
@@ -103,17 +248,118 @@ AimDisc cell_disc(const LensAim& a, Vec3 s, Vec2 m, double rho)
     return AimDisc{Vec2{x / g, y / g}, rho / std::fabs(g) * (1 + kRoundingMargin) + slack};
 }
 
+// The x range of the convex polygon (n corners, in order) within every disc (finite radii). The
+// extreme points of an intersection of convex sets lie on its pieces' boundaries: a corner, a
+// disc's leftmost or rightmost point, a crossing of an edge and a circle or of two circles; of
+// those lying in every set (to rounding), the smallest and largest x.
+bool polygon_discs_x_range(const Vec2* corner, int n, const AimDisc* discs, int count, double* x0, double* x1)
+{
+    double scale = 0;
+    for (int k = 0; k < n; ++k)
+        scale += std::fabs(corner[k].x) + std::fabs(corner[k].y);
+    for (int k = 0; k < count; ++k)
+        scale += discs[k].radius + std::fabs(discs[k].centre.x) + std::fabs(discs[k].centre.y);
+    const double tolerance = 1e-12 * scale;
+    double turn = 0;
+    for (int k = 0; k < n; ++k)
+        turn += cross(corner[k], corner[(k + 1) % n]);
+    const double sign = turn >= 0 ? 1 : -1;
+    double lo = INFINITY, hi = -INFINITY;
+    auto consider = [&](Vec2 p) {
+        if (!(p.x < lo || p.x > hi))
+            return;
+        for (int k = 0; k < n; ++k) {
+            const Vec2 a = corner[k], b = corner[(k + 1) % n];
+            const Vec2 e = b - a;
+            const double length = std::hypot(e.x, e.y);
+            if (length > 0 && sign * cross(e, p - a) < -tolerance * length)
+                return;
+        }
+        for (int k = 0; k < count; ++k)
+            if (!(std::hypot(p.x - discs[k].centre.x, p.y - discs[k].centre.y) <= discs[k].radius + tolerance))
+                return;
+        lo = std::min(lo, p.x);
+        hi = std::max(hi, p.x);
+    };
+    for (int k = 0; k < n; ++k)
+        consider(corner[k]);
+    for (int k = 0; k < count; ++k) {
+        const AimDisc& d = discs[k];
+        consider(Vec2{d.centre.x - d.radius, d.centre.y});
+        consider(Vec2{d.centre.x + d.radius, d.centre.y});
+        // The circle's crossings with each edge a + t (b - a), 0 <= t <= 1.
+        for (int e = 0; e < n; ++e) {
+            const Vec2 a = corner[e], b = corner[(e + 1) % n];
+            const Vec2 v = b - a, w = a - d.centre;
+            const double A = dot(v, v), B = dot(v, w), C = dot(w, w) - d.radius * d.radius;
+            if (!(A > 0))
+                continue;
+            const double disc = B * B - A * C;
+            if (disc < 0)
+                continue;
+            const double root = std::sqrt(disc);
+            // Without cancellation: q = -(B + sign(B) root), roots q / A and C / q.
+            const double q = -(B + (B < 0 ? -root : root));
+            double ts[2] = {q / A, q != 0 ? C / q : -B / A};
+            for (double t : ts) {
+                if (!(t >= -1e-12 && t <= 1 + 1e-12))
+                    continue;
+                t = t < 0 ? 0 : (t > 1 ? 1 : t);
+                consider(Vec2{a.x + t * v.x, a.y + t * v.y});
+            }
+        }
+        // Its crossings with the other circles.
+        for (int o = k + 1; o < count; ++o) {
+            const AimDisc& f = discs[o];
+            const double dx = f.centre.x - d.centre.x, dy = f.centre.y - d.centre.y;
+            const double between = std::hypot(dx, dy);
+            if (!(between > 0) || between > d.radius + f.radius || between < std::fabs(d.radius - f.radius))
+                continue;
+            const double along = (between * between + d.radius * d.radius - f.radius * f.radius) / (2 * between);
+            const double across = std::sqrt(std::max(0.0, d.radius * d.radius - along * along));
+            const Vec2 u{dx / between, dy / between};
+            const Vec2 base{d.centre.x + along * u.x, d.centre.y + along * u.y};
+            consider(Vec2{base.x - across * u.y, base.y + across * u.x});
+            consider(Vec2{base.x + across * u.y, base.y - across * u.x});
+        }
+    }
+    if (!(hi >= lo))
+        return false;
+    *x0 = lo - tolerance;
+    *x1 = hi + tolerance;
+    return true;
+}
+
+// The lens's finite discs of cell points for sensor point s (the disc and its cuts'); how many.
+int cell_discs(const LensAim& a, Vec3 s, AimDisc discs[3])
+{
+    int count = 0;
+    const AimDisc all[3] = {lit_cell_disc(a, s), a.cuts > 0 ? lit_cell_cut(a, s, 0) : AimDisc{},
+                            a.cuts > 1 ? lit_cell_cut(a, s, 1) : AimDisc{}};
+    for (int k = 0; k < 1 + a.cuts; ++k)
+        if (all[k].radius < std::numeric_limits<double>::infinity())
+            discs[count++] = all[k];
+    return count;
+}
+
+bool cell_x_range(const LensAim& a, const AimDisc* discs, int count, double* x0, double* x1)
+{
+    const double half = 0.5 * a.pitch;
+    if (count == 0) {
+        *x0 = -half;
+        *x1 = half;
+        return true;
+    }
+    Vec2 cell[6];
+    const int n = cell_polygon(a.grid, a.pitch, cell);
+    if (!polygon_discs_x_range(cell, n, discs, count, x0, x1))
+        return false;
+    *x0 = std::max(*x0, -half);
+    *x1 = std::min(*x1, half);
+    return *x1 > *x0;
+}
+
 } // namespace
-
-AimDisc lit_sensor_disc(const LensAim& a, double d)
-{
-    return sensor_disc(a, d, a.m, a.rho);
-}
-
-AimDisc lit_sensor_cut(const LensAim& a, double d, int k)
-{
-    return sensor_disc(a, d, a.cut_m[k], a.cut_rho[k]);
-}
 
 AimDisc lit_cell_disc(const LensAim& a, Vec3 s)
 {
@@ -123,6 +369,13 @@ AimDisc lit_cell_disc(const LensAim& a, Vec3 s)
 AimDisc lit_cell_cut(const LensAim& a, Vec3 s, int k)
 {
     return cell_disc(a, s, a.cut_m[k], a.cut_rho[k]);
+}
+
+bool lit_cell_x_range(const LensAim& a, Vec3 s, double* x0, double* x1)
+{
+    AimDisc discs[3];
+    const int count = cell_discs(a, s, discs);
+    return cell_x_range(a, discs, count, x0, x1);
 }
 
 double cell_half_height(GridType grid, double pitch_mm, double x)
@@ -137,49 +390,6 @@ double cell_half_height(GridType grid, double pitch_mm, double x)
 }
 
 namespace {
-
-// A lens's lit_sensor_disc in pixel coordinates (corner convention: Sensor::point): an axis-aligned
-// ellipse; false when it is not finite.
-struct PixelEllipse {
-    double cu, cv, au, av;
-};
-
-bool pixel_ellipse(const PlenopticCamera& m, const LensAim& a, const Vec3& s, PixelEllipse* e, int cut = -1)
-{
-    const double d = a.z - s.z;
-    if (!(d > 0))
-        return false;
-    const AimDisc disc = cut < 0 ? lit_sensor_disc(a, d) : lit_sensor_cut(a, d, cut);
-    const Vec3 q = m.array.to_optics(Vec3{disc.centre.x, disc.centre.y, s.z});
-    const Sensor& sensor = m.sensor;
-    const double px = sensor.pixel_size_mm[0], py = sensor.pixel_size_mm[1];
-    e->cu = 0.5 * sensor.film.width - (q.x - sensor.offset_mm[0]) / px;
-    e->cv = 0.5 * sensor.film.height + (q.y - sensor.offset_mm[1]) / py;
-    e->au = disc.radius / px;
-    e->av = disc.radius / py;
-    return std::isfinite(e->cu) && std::isfinite(e->cv) && e->au >= 0 && e->av >= 0 && std::isfinite(e->au) &&
-           std::isfinite(e->av);
-}
-
-bool holds_pixel(const PixelEllipse& e, int i, int j)
-{
-    if (!(e.au > 0 && e.av > 0))
-        return false;
-    for (int b = 0; b < 2; ++b)
-        for (int a = 0; a < 2; ++a) {
-            const double du = (i + a - e.cu) / e.au, dv = (j + b - e.cv) / e.av;
-            if (!(du * du + dv * dv <= 1))
-                return false;
-        }
-    return true;
-}
-
-// The ellipse's chord at x (half length; negative when x is outside it).
-double chord(const PixelEllipse& e, double x)
-{
-    const double t = (x - e.cu) / e.au;
-    return t * t <= 1 ? e.av * std::sqrt(1 - t * t) : -1;
-}
 
 // Up to kMaxParts intervals, merged into a union that can be sampled uniformly.
 const int kMaxParts = 9;
@@ -233,10 +443,6 @@ struct Intervals {
     }
 };
 
-} // namespace
-
-namespace {
-
 // What a camera's aim depends on, to tell a cached plan's camera from another (a camera copied or
 // made at the same address differs in one of these when its geometry does).
 struct CameraKey {
@@ -268,29 +474,197 @@ CameraKey key_of(const PlenopticCamera& m)
                       pose.rotation.m[0][1]}};
 }
 
+// Array-local (x, y) in the sensor's plane -> the pixel's own frame: (pixel coordinates - the
+// pixel's corner (i, j)) times the pixel's size, in mm. A rigid map (the array is parallel to the
+// sensor), so regions keep their radii; the pixel is [0, px] x [0, py].
+struct PixelFrame {
+    double o[2];
+    double l[2][2];
+    Vec2 map(Vec2 p) const { return Vec2{o[0] + l[0][0] * p.x + l[0][1] * p.y, o[1] + l[1][0] * p.x + l[1][1] * p.y}; }
+};
+
+PixelFrame pixel_frame(const PlenopticCamera& m, double sensor_z, int i, int j)
+{
+    // Sensor::point: optics x = -(pu - W/2) px + offset, y = (pv - H/2) py + offset; the local
+    // point's optics position is pose.centre + rotation * (x, y, sensor_z).
+    const Sensor& s = m.sensor;
+    const Mat3& r = m.array.pose.rotation;
+    const Vec3& c = m.array.pose.centre_mm;
+    PixelFrame f;
+    f.o[0] = (0.5 * s.film.width - i) * s.pixel_size_mm[0] + s.offset_mm[0] - c.x - r.m[0][2] * sensor_z;
+    f.l[0][0] = -r.m[0][0];
+    f.l[0][1] = -r.m[0][1];
+    f.o[1] = (j - 0.5 * s.film.height) * -s.pixel_size_mm[1] - s.offset_mm[1] + c.y + r.m[1][2] * sensor_z;
+    f.l[1][0] = r.m[1][0];
+    f.l[1][1] = r.m[1][1];
+    return f;
+}
+
+// One lens's part: where its light can land (the intersection of `sets`, in the pixel's frame) and
+// the x range of that part within the pixel.
+const int kMaxSets = 4;
+struct LensPart {
+    int sets;
+    RoundedPolygon set[kMaxSets];
+    double x0, x1;
+};
+
+// The part's chord at x within the pixel's rows [0, py]; its length (negative: none).
+double part_chord(const LensPart& part, double x, double py, double* y0, double* y1)
+{
+    double lo = 0, hi = py;
+    for (int k = 0; k < part.sets; ++k) {
+        double a, b;
+        if (!region_chord(part.set[k], x, &a, &b))
+            return -INFINITY;
+        lo = std::max(lo, a);
+        hi = std::min(hi, b);
+    }
+    *y0 = lo;
+    *y1 = hi;
+    return hi - lo;
+}
+
+// The x range of the part within the pixel [0, px] x [0, py]; false when empty. The chord's length
+// at x is a concave function over the sets' common x range (a minimum of concave upper ends less a
+// maximum of convex lower ones), so the range is where it is >= 0: a point there is found by
+// golden-section search for the maximum, the ends by bisection to 1e-10 of the pixel, each end
+// taken on the outer side.
+bool part_x_range(LensPart* part, double px, double py)
+{
+    double a = 0, b = px;
+    for (int k = 0; k < part->sets; ++k) {
+        const RoundedPolygon& r = part->set[k];
+        double x0, x1;
+        region_x_extent(r, &x0, &x1);
+        a = std::max(a, x0);
+        b = std::min(b, x1);
+        double y0 = r.corner[0].y, y1 = r.corner[0].y;
+        for (int n = 1; n < r.corners; ++n) {
+            y0 = std::min(y0, r.corner[n].y);
+            y1 = std::max(y1, r.corner[n].y);
+        }
+        if (!(y1 + r.radius >= 0 && y0 - r.radius <= py))
+            return false;
+    }
+    if (!(b > a))
+        return false;
+    double y0, y1;
+    const double fa = part_chord(*part, a, py, &y0, &y1), fb = part_chord(*part, b, py, &y0, &y1);
+    double inside = a;
+    if (fa >= 0) {
+        inside = a;
+    } else if (fb >= 0) {
+        inside = b;
+    } else {
+        const double ratio = 0.5 * (std::sqrt(5.0) - 1);
+        double lo = a, hi = b;
+        double x1 = hi - ratio * (hi - lo), x2 = lo + ratio * (hi - lo);
+        double f1 = part_chord(*part, x1, py, &y0, &y1), f2 = part_chord(*part, x2, py, &y0, &y1);
+        bool found = false;
+        for (int n = 0; n < 200; ++n) {
+            if (f1 >= 0 || f2 >= 0) {
+                inside = f1 >= 0 ? x1 : x2;
+                found = true;
+                break;
+            }
+            if (!(hi - lo > 1e-13 * px))
+                break;
+            if (f1 < f2) {
+                lo = x1;
+                x1 = x2;
+                f1 = f2;
+                x2 = lo + ratio * (hi - lo);
+                f2 = part_chord(*part, x2, py, &y0, &y1);
+            } else {
+                hi = x2;
+                x2 = x1;
+                f2 = f1;
+                x1 = hi - ratio * (hi - lo);
+                f1 = part_chord(*part, x1, py, &y0, &y1);
+            }
+        }
+        if (!found)
+            return false;
+    }
+    const double tolerance = 1e-10 * px;
+    part->x0 = a;
+    if (!(fa >= 0)) {
+        double out = a, in = inside;
+        for (int n = 0; n < 200 && in - out > tolerance; ++n) {
+            const double mid = 0.5 * (out + in);
+            if (!(mid > out && mid < in))
+                break;
+            (part_chord(*part, mid, py, &y0, &y1) >= 0 ? in : out) = mid;
+        }
+        part->x0 = out;
+    }
+    part->x1 = b;
+    if (!(fb >= 0)) {
+        double in = inside, out = b;
+        for (int n = 0; n < 200 && out - in > tolerance; ++n) {
+            const double mid = 0.5 * (out + in);
+            if (!(mid > in && mid < out))
+                break;
+            (part_chord(*part, mid, py, &y0, &y1) >= 0 ? in : out) = mid;
+        }
+        part->x1 = out;
+    }
+    return part->x1 > part->x0;
+}
+
 // A pixel's aim, worked out once for all its samples: its points are uniform (the whole pixel may be
-// lit), none (no light reaches it), or drawn from the union of `count` ellipses, whose x ranges
-// within the pixel are `xs` (of total length `width`).
+// lit), none (no light reaches it), or drawn from the union of `count` lenses' parts, whose x ranges
+// within the pixel are `xs` (of total length `width`), in the pixel's frame.
 struct PixelPlan {
     enum Kind { Uniform, Dark, Aimed } kind;
     bool forced;
     LensIndex lens;
     int count;
-    PixelEllipse ellipses[kMaxParts];
-    // Behind a traced lens: lens k's light lands only in ellipses[k] and its cuts[k][0 .. cut_count[k]-1].
-    int cut_count[kMaxParts];
-    PixelEllipse cuts[kMaxParts][2];
+    LensPart parts[kMaxParts];
     Intervals xs;
     double width;
+    double px, py;
 };
 
-// A lens's ellipse and its cuts, for the pixel's plan (false when one is not finite).
-bool lens_ellipses(const PlenopticCamera& m, const LensAim& a, const Vec3& s, PixelPlan* plan, int k)
+// A lens's part for the pixel: its region and its cuts', and when the lens is taken as the sensor
+// points' own lens, its projected cell; false when one is not finite.
+bool lens_part(const PlenopticCamera& m, const LensAim& a, double sensor_z, const PixelFrame& frame, bool own,
+               LensPart* part)
 {
-    plan->cut_count[k] = a.cuts;
-    for (int c = 0; c < a.cuts; ++c)
-        if (!pixel_ellipse(m, a, s, &plan->cuts[k][c], c))
+    const double d = a.z - sensor_z;
+    if (!(d > 0))
+        return false;
+    part->sets = 0;
+    for (int k = -1; k < a.cuts; ++k)
+        part->set[part->sets++] = lit_sensor_region(a, d, k);
+    RoundedPolygon cell;
+    if (own && own_sensor_cell(m, a.lens, sensor_z, &cell))
+        part->set[part->sets++] = cell;
+    // Into the pixel's frame; its rounding is ~1e-16 of the frame's offsets.
+    const double slack = 1e-13 * (std::fabs(frame.o[0]) + std::fabs(frame.o[1]));
+    for (int k = 0; k < part->sets; ++k) {
+        RoundedPolygon& r = part->set[k];
+        for (int n = 0; n < r.corners; ++n) {
+            r.corner[n] = frame.map(r.corner[n]);
+            if (!is_finite(r.corner[n]))
+                return false;
+        }
+        r.radius += slack + 1e-13 * (std::fabs(r.corner[0].x) + std::fabs(r.corner[0].y));
+        if (!(r.radius >= 0 && std::isfinite(r.radius)))
             return false;
+    }
+    part->x0 = part->x1 = 0;
+    return true;
+}
+
+bool holds_pixel(const LensPart& part, double px, double py)
+{
+    for (int k = 0; k < part.sets; ++k)
+        for (int b = 0; b < 2; ++b)
+            for (int a = 0; a < 2; ++a)
+                if (!region_holds(part.set[k], Vec2{a * px, b * py}))
+                    return false;
     return true;
 }
 
@@ -299,8 +673,9 @@ void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced,
     plan->kind = PixelPlan::Uniform;
     plan->forced = forced != nullptr;
     plan->count = 0;
-    for (int k = 0; k < kMaxParts; ++k)
-        plan->cut_count[k] = 0;
+    plan->px = m.sensor.pixel_size_mm[0];
+    plan->py = m.sensor.pixel_size_mm[1];
+    const double px = plan->px, py = plan->py;
     const Vec3 middle = m.sensor.point(i + 0.5, j + 0.5);
     LensIndex lens;
     if (forced) {
@@ -313,24 +688,19 @@ void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced,
     }
     plan->lens = lens;
     LensAim a;
-    PixelEllipse own_ellipse;
     const Vec3 s = m.array.to_local(middle);
-    if (!lens_aim(m, lens, &a) || !pixel_ellipse(m, a, s, &own_ellipse) || !lens_ellipses(m, a, s, plan, 0))
+    const PixelFrame frame = pixel_frame(m, s.z, i, j);
+    LensPart own_part;
+    if (!(px > 0 && py > 0) || !lens_aim(m, lens, &a) || !lens_part(m, a, s.z, frame, !forced, &own_part))
         return;  // the whole pixel may be lit: its own points, as the uniform samples
-    bool held = holds_pixel(own_ellipse, i, j);
-    for (int c = 0; c < plan->cut_count[0]; ++c)
-        held = held && holds_pixel(plan->cuts[0][c], i, j);
-    if (held)
+    if (holds_pixel(own_part, px, py))
         return;
-    const int own_cuts = plan->cut_count[0];
-    const PixelEllipse own_cut[2] = {plan->cuts[0][0], plan->cuts[0][1]};
-    // The ellipses that can light the pixel: the forced lens's; or, for the pixel's own lenses, the
+    // The lenses that can light the pixel: the forced lens; or, for the pixel's own lenses, the
     // lens of its centre and its neighbours (the lattice cells a pixel far smaller than a cell can
     // meet: checked below).
-    PixelEllipse* ellipses = plan->ellipses;
     int count = 0;
     if (forced) {
-        ellipses[count++] = own_ellipse;
+        plan->parts[count++] = own_part;
     } else {
         // Through the exit pupil's centre e the pixel projects onto the array scaled by
         // (array - e) / (sensor - e); a point within delta of the centre's projection belongs to
@@ -339,7 +709,7 @@ void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced,
         // 1.5 times the farthest a lens is displaced from its lattice place (its errors).
         const Vec3 e = m.lens->exit_pupil_centre();
         const double scale = (m.array.pose.centre_mm.z - e.z) / (m.sensor.z_mm - e.z);
-        const double delta = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]) * std::fabs(scale);
+        const double delta = 0.5 * std::hypot(px, py) * std::fabs(scale);
         const double shift = m.array.errors ? m.array.errors->max_shift_mm() : 0;
         if (!(delta + 1.5 * shift < 0.25 * m.array.pitch_mm))
             return;
@@ -350,41 +720,25 @@ void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced,
                 if (grid == GridType::Hexagonal && std::abs(dk + dl) > 1)
                     continue;  // not a neighbour in skew indices
                 const LensIndex other = from_skew(grid, skew + dk, lens.l + dl);
-                PixelEllipse e;
-                if (dk == 0 && dl == 0) {
-                    e = own_ellipse;
-                    plan->cut_count[count] = own_cuts;
-                    plan->cuts[count][0] = own_cut[0];
-                    plan->cuts[count][1] = own_cut[1];
-                } else if (!lens_aim(m, other, &a) || !pixel_ellipse(m, a, s, &e) || !lens_ellipses(m, a, s, plan, count))
+                if (dk == 0 && dl == 0)
+                    plan->parts[count] = own_part;
+                else if (!lens_aim(m, other, &a) || !lens_part(m, a, s.z, frame, true, &plan->parts[count]))
                     return;
-                ellipses[count++] = e;
+                ++count;
             }
     }
-    plan->count = count;
-    // x: the union over the ellipses of the x range of the pixel's part in each (the ellipse's at
-    // the pixel's row nearest its centre).
-    // With cuts, the intersection of the x ranges of the pixel's part in each (which holds the x
-    // range of the pixel's part in their intersection).
+    // x: the union over the parts of their exact x ranges within the pixel.
     plan->xs = Intervals();
+    int kept = 0;
     for (int k = 0; k < count; ++k) {
-        double lo = i, hi = i + 1;
-        bool none = false;
-        for (int c = -1; c < plan->cut_count[k]; ++c) {
-            const PixelEllipse& e = c < 0 ? ellipses[k] : plan->cuts[k][c];
-            const double row = e.cv < j ? j : (e.cv > j + 1 ? j + 1 : e.cv);
-            const double t = (row - e.cv) / e.av;
-            if (!(t * t <= 1)) {
-                none = true;
-                break;
-            }
-            const double reach = e.au * std::sqrt(1 - t * t);
-            lo = std::max<double>(lo, e.cu - reach);
-            hi = std::min<double>(hi, e.cu + reach);
-        }
-        if (!none)
-            plan->xs.add(lo, hi);
+        if (!part_x_range(&plan->parts[k], px, py))
+            continue;
+        if (kept != k)
+            plan->parts[kept] = plan->parts[k];
+        plan->xs.add(plan->parts[kept].x0, plan->parts[kept].x1);
+        ++kept;
     }
+    plan->count = kept;
     plan->width = plan->xs.merge();
     plan->kind = plan->width > 0 ? PixelPlan::Aimed : PixelPlan::Dark;
 }
@@ -429,29 +783,24 @@ PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, doubl
         return out;
     }
     const double x = plan.xs.at(pixel_u, plan.width);
-    // y: the union of the chords at x within the pixel's rows.
+    // y: the union of the parts' chords at x (within the pixel's rows).
     Intervals ys;
     for (int k = 0; k < plan.count; ++k) {
-        const double half = chord(plan.ellipses[k], x);
-        if (!(half >= 0))
-            continue;
-        double lo = std::max<double>(j, plan.ellipses[k].cv - half), hi = std::min<double>(j + 1, plan.ellipses[k].cv + half);
-        for (int c = 0; c < plan.cut_count[k]; ++c) {
-            const PixelEllipse& e = plan.cuts[k][c];
-            const double h = chord(e, x);
-            lo = h >= 0 ? std::max(lo, e.cv - h) : INFINITY;
-            hi = std::min(hi, e.cv + h);
-        }
-        ys.add(lo, hi);
+        const LensPart& part = plan.parts[k];
+        if (!(x >= part.x0 && x <= part.x1))
+            continue;  // the part's chord is empty there
+        double y0, y1;
+        if (part_chord(part, x, plan.py, &y0, &y1) > 0)
+            ys.add(y0, y1);
     }
     const double height = ys.merge();
     if (!(height > 0)) {
         out.passed = false;
         return out;
     }
-    out.pu = x;
-    out.pv = ys.at(pixel_v, height);
-    out.weight = plan.width * height;
+    out.pu = i + x / plan.px;
+    out.pv = j + ys.at(pixel_v, height) / plan.py;
+    out.weight = plan.width * height / (plan.px * plan.py);
     return out;
 }
 
@@ -479,58 +828,36 @@ ArrayRay aimed_cell_ray(const PlenopticCamera& m, const Vec3& p, LensIndex lens,
     const Vec3 s = array.to_local(p);
     if (!(a.z - s.z > 0))
         return array.microlens->sample_ray(array, p, lens, u, v);
-    const AimDisc disc = lit_cell_disc(a, s);
-    const GridType grid = array.grid;
-    const double pitch = array.pitch_mm;
-    const double area = grid == GridType::Hexagonal ? 0.5 * kSqrt3 * pitch * pitch : pitch * pitch;
-    if (a.cuts > 0) {
-        // The cell's part in the disc and both cuts: x uniform over their common x range, y over
-        // the chords' intersection at x.
-        AimDisc discs[3] = {disc, lit_cell_cut(a, s, 0), lit_cell_cut(a, s, 1)};
-        bool whole = true;
-        double lo = -0.5 * pitch, hi = 0.5 * pitch;
-        for (const AimDisc& d : discs) {
-            if (!(d.radius < std::numeric_limits<double>::infinity()))
-                continue;
-            whole = whole && std::sqrt(d.centre.x * d.centre.x + d.centre.y * d.centre.y) + a.circumradius <= d.radius;
-            lo = std::max(lo, d.centre.x - d.radius);
-            hi = std::min(hi, d.centre.x + d.radius);
-        }
-        if (whole)
-            return array.microlens->sample_ray(array, p, lens, u, v);  // the whole cell may pass
-        if (!(hi > lo))
-            return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false, Vec3{0, 0, 0}};
-        const double x = lo + u * (hi - lo);
-        const double half = cell_half_height(grid, pitch, x);
-        double y0 = -half, y1 = half;
-        for (const AimDisc& d : discs) {
-            if (!(d.radius < std::numeric_limits<double>::infinity()))
-                continue;
-            const double t = (x - d.centre.x) / d.radius;
-            const double c = d.radius * std::sqrt(t < 1 ? 1 - t * t : 0);
-            y0 = std::max(y0, d.centre.y - c);
-            y1 = std::min(y1, d.centre.y + c);
-        }
-        if (!(y1 > y0))
-            return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false, Vec3{0, 0, 0}};
-        *weight = (hi - lo) * (y1 - y0) / area;
-        return array.microlens->cell_ray(array, p, lens, Vec2{x, y0 + v * (y1 - y0)});
-    }
-    if (!(disc.radius < std::numeric_limits<double>::infinity()) ||
-        std::sqrt(disc.centre.x * disc.centre.x + disc.centre.y * disc.centre.y) + a.circumradius <= disc.radius)
+    AimDisc discs[3];
+    const int count = cell_discs(a, s, discs);
+    bool whole = true;
+    for (int k = 0; k < count && whole; ++k)
+        whole = std::sqrt(discs[k].centre.x * discs[k].centre.x + discs[k].centre.y * discs[k].centre.y) +
+                    a.circumradius <=
+                discs[k].radius;
+    if (whole)
         return array.microlens->sample_ray(array, p, lens, u, v);  // the whole cell may pass
-    const ChordSample sample = sample_chords(
-        -0.5 * pitch, 0.5 * pitch, disc.centre.x - disc.radius, disc.centre.x + disc.radius,
-        [grid, pitch](double x, double* y0, double* y1) {
-            const double half = cell_half_height(grid, pitch, x);
-            *y0 = -half;
-            *y1 = half;
-        },
-        disc.centre, disc.radius, disc.radius, area, u, v);
-    if (!sample.passed)
-        return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false, Vec3{0, 0, 0}};
-    *weight = sample.weight;
-    return array.microlens->cell_ray(array, p, lens, sample.point);
+    // The cell's part in the discs: x uniform over its exact x range, y over the cell's height and
+    // the discs' chords at x.
+    const ArrayRay none{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false, Vec3{0, 0, 0}};
+    double lo, hi;
+    if (!cell_x_range(a, discs, count, &lo, &hi))
+        return none;
+    const double x = lo + u * (hi - lo);
+    const double half = cell_half_height(a.grid, a.pitch, x);
+    double y0 = -half, y1 = half;
+    for (int k = 0; k < count; ++k) {
+        const AimDisc& d = discs[k];
+        const double t = (x - d.centre.x) / d.radius;
+        const double c = d.radius * std::sqrt(t * t < 1 ? 1 - t * t : 0);
+        y0 = std::max(y0, d.centre.y - c);
+        y1 = std::min(y1, d.centre.y + c);
+    }
+    if (!(y1 > y0))
+        return none;
+    const double area = a.grid == GridType::Hexagonal ? 0.5 * kSqrt3 * a.pitch * a.pitch : a.pitch * a.pitch;
+    *weight = (hi - lo) * (y1 - y0) / area;
+    return array.microlens->cell_ray(array, p, lens, Vec2{x, y0 + v * (y1 - y0)});
 }
 
 } // namespace plenoptic

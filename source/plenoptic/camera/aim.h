@@ -12,14 +12,20 @@
 //     x(h, s) = g h - (Z / d) s + (Z / f) c,   g = 1 + Z / d - Z / f,
 // affine in h and in s. Light passes the main lens only where x lies in a disc (centre m, radius
 // rho) of that plane: the thin lens's aperture, the thick lens's exit pupil (both exact), a traced
-// lens's pupil bounds (PupilBounds::disc_holding over the cell: conservative). So
+// lens's pupil bounds (PupilBounds::discs_holding over the cell, a disc and up to two cutting discs:
+// conservative). So
 //  - for a sensor point, the cell points whose rays can pass lie in the disc of centre
-//    (m + (Z / d) s - (Z / f) c) / g and radius rho / |g| (lit_cell_disc);
-//  - the sensor points that light through the lens can reach at all lie in the disc of centre
-//    (c (1 + Z / d) - m) d / Z and radius (rho + |g| R) d / Z, R the cell's circumradius
-//    (lit_sensor_disc: the microimage, conservatively).
-// Each region is sampled by its chords (sample_chords): x uniform over the region's x range, then y
-// uniform over the chord at x; the weight is the x range times the chord over the whole's area.
+//    (m + (Z / d) s - (Z / f) c) / g and radius rho / |g| (lit_cell_disc), intersected with the
+//    cell (lit_cell_x_range: the exact x range of that part);
+//  - some cell point's ray from s can pass exactly when that disc meets the cell H (a polygon about
+//    c), i.e. when s lies in c + (c - m) d / Z + (|g| d / Z) H widened by rho d / Z
+//    (lit_sensor_region: the microimage, exactly for one disc; behind a traced lens the
+//    intersection of the regions of its discs, which holds the exact one);
+//  - the renderer takes a sensor point's light through its own lens (own_lens: the lens whose cell
+//    holds the point's projection from the exit pupil's centre), so through that lens only from the
+//    cell's projection onto the sensor (own_sensor_cell, for an array without errors).
+// Each region is sampled by its chords: x uniform over the region's exact x range, then y uniform
+// over the chord at x; the weight is the x range times the chord over the whole's area.
 
 #ifndef PLENOPTIC_AIM_H
 #define PLENOPTIC_AIM_H
@@ -47,6 +53,8 @@ struct LensAim {
     Vec2 c;
     double z;
     double f;
+    GridType grid;
+    double pitch;
     double circumradius;
     double Z;
     Vec2 m;
@@ -67,11 +75,30 @@ bool camera_can_aim(const PlenopticCamera& model);
 // lens without pupil bounds, a lens off the bounds' plane, a limiting plane not in front of it.
 bool lens_aim(const PlenopticCamera& model, LensIndex lens, LensAim* out);
 
-// The disc of sensor points (array-local x, y; the sensor d behind the lens plane, d > 0) holding
-// every sensor point from which a ray through the lens's cell can pass the main lens.
-AimDisc lit_sensor_disc(const LensAim& aim, double d);
-// The same for cutting disc k (0 or 1) of the lens's plane instead of its disc.
-AimDisc lit_sensor_cut(const LensAim& aim, double d, int k);
+// A convex region of a plane: the points within `radius` of a convex polygon (`corners` corners in
+// order, either way round; one corner: a disc).
+struct RoundedPolygon {
+    int corners;
+    Vec2 corner[6];
+    double radius;
+};
+// Whether p lies in the region.
+bool region_holds(const RoundedPolygon& r, Vec2 p);
+// The region's x range.
+void region_x_extent(const RoundedPolygon& r, double* x0, double* x1);
+// The region's chord at x, [*y0, *y1]; false when x lies outside its x range.
+bool region_chord(const RoundedPolygon& r, double x, double* y0, double* y1);
+
+// The region of sensor points (array-local x, y; the sensor d behind the lens plane, d > 0) from
+// which a ray through the lens's cell can pass the main lens's disc (k = -1) or cutting disc k (0
+// or 1): the cell polygon scaled by |g| d / Z about c + (c - m) d / Z, widened by rho d / Z.
+RoundedPolygon lit_sensor_region(const LensAim& aim, double d, int k = -1);
+
+// The sensor points (array-local x, y, in the sensor's plane at array-local z sensor_z) whose own
+// lens (rays.h: own_lens) is `lens`: its cell projected from the exit pupil's centre. False when
+// the array has errors (displaced lenses' cells are not the lattice's) or the projection is not
+// defined; then any point may be.
+bool own_sensor_cell(const PlenopticCamera& model, LensIndex lens, double sensor_z, RoundedPolygon* out);
 
 // The disc of cell points (array-local, from the lens's centre) holding every point through which
 // the ray from sensor point s (array-local, behind the lens) can pass the main lens; infinite
@@ -80,46 +107,22 @@ AimDisc lit_cell_disc(const LensAim& aim, Vec3 s);
 // The same for cutting disc k (0 or 1) of the lens's plane instead of its disc.
 AimDisc lit_cell_cut(const LensAim& aim, Vec3 s, int k);
 
+// The x range (from the lens's centre) of the cell's part where light from sensor point s can pass
+// (the cell ∩ lit_cell_disc ∩ the cuts' discs), exactly up to rounding (widened by it); false when
+// that part is empty.
+bool lit_cell_x_range(const LensAim& aim, Vec3 s, double* x0, double* x1);
+
 // Half the height of a lens's cell (core/lattice.h: cell_polygon, centred on the lens) at x from its
 // centre; negative outside the cell's x range.
 double cell_half_height(GridType grid, double pitch_mm, double x);
 
-// A point of a region sampled by its chords, and its weight (the sampled measure over the whole
-// region's); passed false when the chord at that x is empty (the sample carries no light).
-struct ChordSample {
-    Vec2 point;
-    double weight;
-    bool passed;
-};
-
-// The region {x0 <= x <= x1, |y - yc(x)| <= half(x)} intersected with the ellipse of centre e and
-// semi-axes (ax, ay), for sample (u, v): x uniform over [max(x0, xa), min(x1, xb)] (xa, xb: the
-// caller's x range of the intersection, or of the ellipse), y uniform over the chord at x. Weight:
-// the x range times the chord, over `area`.
-template <class HalfHeight>
-ChordSample sample_chords(double x0, double x1, double xa, double xb, HalfHeight half_height, Vec2 e, double ax,
-                          double ay, double area, double u, double v)
-{
-    const double lo = x0 > xa ? x0 : xa, hi = x1 < xb ? x1 : xb;
-    if (!(hi > lo))
-        return ChordSample{Vec2{0, 0}, 0, false};
-    const double x = lo + u * (hi - lo);
-    const double t = (x - e.x) / ax;
-    const double chord = ay * std::sqrt(t < 1 ? 1 - t * t : 0);
-    double y0, y1;
-    half_height(x, &y0, &y1);
-    const double a = y0 > e.y - chord ? y0 : e.y - chord, b = y1 < e.y + chord ? y1 : e.y + chord;
-    if (!(b > a))
-        return ChordSample{Vec2{x, e.y}, 0, false};
-    return ChordSample{Vec2{x, a + v * (b - a)}, (hi - lo) * (b - a) / area, true};
-}
-
 // Where a sample of pixel (i, j) looks (the pixel point (pu, pv) in pixel coordinates, corner
 // convention) and through which lens, with the weight of that choice. When the pixel lies partly
-// outside the lit_sensor_disc of its centre's lens, the point is drawn from the pixel's part in the
-// union of the discs of that lens and its neighbours (the lenses whose own regions the pixel can
-// meet; with a forced lens, overlap modelling, that lens's disc alone, and then lens_forced); a pixel
-// that no light reaches gets no point (passed false). Otherwise the sample's own point, weight 1.
+// outside the region where light through its centre's lens lands (lit_sensor_region and the cuts',
+// within own_sensor_cell), the point is drawn from the pixel's part in the union of the regions of
+// that lens and its neighbours (the lenses whose own regions the pixel can meet; with a forced lens,
+// overlap modelling, that lens's region alone, and then lens_forced); a pixel that no light reaches
+// gets no point (passed false). Otherwise the sample's own point, weight 1.
 struct PixelAim {
     double pu, pv;
     double weight;
@@ -130,7 +133,7 @@ struct PixelAim {
 PixelAim aim_pixel(const PlenopticCamera& model, int i, int j, double pixel_u, double pixel_v, const LensIndex* forced);
 
 // The ray from sensor point p through `lens` for aperture sample (u, v), drawn from the part of
-// the cell where light from p can pass (lit_cell_disc), with *weight that part's sampled measure
+// the cell where light from p can pass (lit_cell_disc and the cuts', over lit_cell_x_range), with *weight that part's sampled measure
 // over the cell's area; the uniform sample_ray (weight 1) when that part holds the whole cell or
 // the lens cannot be aimed at. Not passed when no point of the cell can pass.
 ArrayRay aimed_cell_ray(const PlenopticCamera& model, const Vec3& p, LensIndex lens, double u, double v, double* weight);
