@@ -210,26 +210,37 @@ RoundedPolygon lit_sensor_region(const LensAim& a, double d, int cut)
     return out;
 }
 
-bool own_sensor_cell(const PlenopticCamera& m, LensIndex lens, double sensor_z, RoundedPolygon* out)
+int own_sensor_cell(const PlenopticCamera& m, LensIndex lens, double sensor_z, HalfPlane out[8])
 {
-    // own_lens projects the sensor point from the exit pupil's centre e onto the array's plane
-    // (array-local z = 0) and takes the lattice cell there: the cell's points q come from the
-    // sensor points e + (q - e) (e.z - sensor_z) / e.z.
-    if (m.array.errors || !m.lens)
-        return false;
+    // own_lens projects the sensor point s from the exit pupil's centre e onto the array's plane
+    // (array-local z = 0), q = e + (s - e) / K with K = (e.z - sensor_z) / e.z, and takes the lens
+    // whose centre is nearest q (MicrolensArray::nearest). q is nearer centre a than centre b when
+    // (b - a) . q <= (b - a) . (a + b) / 2, i.e. (b - a) . s <= (b - a) . (e + K ((a + b) / 2 - e)).
+    if (!m.lens)
+        return 0;
     const Vec3 e = m.array.to_local(m.lens->exit_pupil_centre());
-    const double scale = (e.z - sensor_z) / e.z;
-    if (!(scale > 0) || !std::isfinite(scale) || !is_finite(e))
-        return false;
-    const Vec2 c = m.array.lattice_centre_local(lens);
-    Vec2 cell[6];
-    out->corners = cell_polygon(m.array.grid, m.array.pitch_mm, cell);
-    for (int n = 0; n < out->corners; ++n)
-        out->corner[n] = Vec2{e.x + scale * (c.x + cell[n].x - e.x), e.y + scale * (c.y + cell[n].y - e.y)};
-    out->radius = kRoundingMargin * (std::fabs(e.x) + std::fabs(e.y) +
-                                     scale * (std::fabs(c.x) + std::fabs(c.y) + std::fabs(e.x) + std::fabs(e.y) +
-                                              m.array.cell_circumradius_mm));
-    return true;
+    const double K = (e.z - sensor_z) / e.z;
+    if (!(K > 0) || !std::isfinite(K) || !is_finite(e))
+        return 0;
+    const GridType grid = m.array.grid;
+    const Vec2 a = m.array.centre_local(lens);
+    const std::int64_t skew = skew_k(grid, lens);
+    int count = 0;
+    for (int dl = -1; dl <= 1; ++dl)
+        for (int dk = -1; dk <= 1; ++dk) {
+            if ((dk == 0 && dl == 0) || (grid == GridType::Hexagonal && std::abs(dk + dl) > 1))
+                continue;
+            const Vec2 b = m.array.centre_local(from_skew(grid, skew + dk, lens.l + dl));
+            const Vec2 n{b.x - a.x, b.y - a.y};
+            const Vec2 mid{e.x + K * (0.5 * (a.x + b.x) - e.x), e.y + K * (0.5 * (a.y + b.y) - e.y)};
+            const double scale = std::fabs(n.x) + std::fabs(n.y);
+            const double slack = kRoundingMargin * scale *
+                                 (std::fabs(e.x) + std::fabs(e.y) +
+                                  K * (std::fabs(a.x) + std::fabs(a.y) + std::fabs(b.x) + std::fabs(b.y) + std::fabs(e.x) +
+                                       std::fabs(e.y)));
+            out[count++] = HalfPlane{n, dot(n, mid) + slack};
+        }
+    return count;
 }
 
 namespace {
@@ -502,10 +513,12 @@ PixelFrame pixel_frame(const PlenopticCamera& m, double sensor_z, int i, int j)
 
 // One lens's part: where its light can land (the intersection of `sets`, in the pixel's frame) and
 // the x range of that part within the pixel.
-const int kMaxSets = 4;
+const int kMaxSets = 3;
 struct LensPart {
     int sets;
     RoundedPolygon set[kMaxSets];
+    int planes;
+    HalfPlane plane[8];
     double x0, x1;
 };
 
@@ -519,6 +532,17 @@ double part_chord(const LensPart& part, double x, double py, double* y0, double*
             return -INFINITY;
         lo = std::max(lo, a);
         hi = std::min(hi, b);
+    }
+    for (int k = 0; k < part.planes; ++k) {
+        // n.x x + n.y y <= offset
+        const HalfPlane& h = part.plane[k];
+        const double rest = h.offset - h.normal.x * x;
+        if (h.normal.y > 0)
+            hi = std::min(hi, rest / h.normal.y);
+        else if (h.normal.y < 0)
+            lo = std::max(lo, rest / h.normal.y);
+        else if (!(rest >= 0))
+            return -INFINITY;
     }
     *y0 = lo;
     *y1 = hi;
@@ -638,11 +662,19 @@ bool lens_part(const PlenopticCamera& m, const LensAim& a, double sensor_z, cons
     part->sets = 0;
     for (int k = -1; k < a.cuts; ++k)
         part->set[part->sets++] = lit_sensor_region(a, d, k);
-    RoundedPolygon cell;
-    if (own && own_sensor_cell(m, a.lens, sensor_z, &cell))
-        part->set[part->sets++] = cell;
+    part->planes = own ? own_sensor_cell(m, a.lens, sensor_z, part->plane) : 0;
     // Into the pixel's frame; its rounding is ~1e-16 of the frame's offsets.
     const double slack = 1e-13 * (std::fabs(frame.o[0]) + std::fabs(frame.o[1]));
+    for (int k = 0; k < part->planes; ++k) {
+        // n . s <= b with s = L^T (p - o) (L is a rotation, or one with a reflection): (L n) . p <= b + (L n) . o.
+        HalfPlane& h = part->plane[k];
+        const Vec2 n{frame.l[0][0] * h.normal.x + frame.l[0][1] * h.normal.y,
+                     frame.l[1][0] * h.normal.x + frame.l[1][1] * h.normal.y};
+        h = HalfPlane{n, h.offset + n.x * frame.o[0] + n.y * frame.o[1] +
+                             slack * (std::fabs(n.x) + std::fabs(n.y))};
+        if (!(is_finite(h.normal) && std::isfinite(h.offset)))
+            return false;
+    }
     for (int k = 0; k < part->sets; ++k) {
         RoundedPolygon& r = part->set[k];
         for (int n = 0; n < r.corners; ++n) {
@@ -660,11 +692,16 @@ bool lens_part(const PlenopticCamera& m, const LensAim& a, double sensor_z, cons
 
 bool holds_pixel(const LensPart& part, double px, double py)
 {
-    for (int k = 0; k < part.sets; ++k)
-        for (int b = 0; b < 2; ++b)
-            for (int a = 0; a < 2; ++a)
-                if (!region_holds(part.set[k], Vec2{a * px, b * py}))
+    for (int b = 0; b < 2; ++b)
+        for (int a = 0; a < 2; ++a) {
+            const Vec2 p{a * px, b * py};
+            for (int k = 0; k < part.sets; ++k)
+                if (!region_holds(part.set[k], p))
                     return false;
+            for (int k = 0; k < part.planes; ++k)
+                if (!(dot(part.plane[k].normal, p) <= part.plane[k].offset))
+                    return false;
+        }
     return true;
 }
 

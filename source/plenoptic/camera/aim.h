@@ -94,11 +94,19 @@ bool region_chord(const RoundedPolygon& r, double x, double* y0, double* y1);
 // or 1): the cell polygon scaled by |g| d / Z about c + (c - m) d / Z, widened by rho d / Z.
 RoundedPolygon lit_sensor_region(const LensAim& aim, double d, int k = -1);
 
+// A half-plane {p : dot(normal, p) <= offset}.
+struct HalfPlane {
+    Vec2 normal;
+    double offset;
+};
+
 // The sensor points (array-local x, y, in the sensor's plane at array-local z sensor_z) whose own
-// lens (rays.h: own_lens) is `lens`: its cell projected from the exit pupil's centre. False when
-// the array has errors (displaced lenses' cells are not the lattice's) or the projection is not
-// defined; then any point may be.
-bool own_sensor_cell(const PlenopticCamera& model, LensIndex lens, double sensor_z, RoundedPolygon* out);
+// lens (rays.h: own_lens) can be `lens`: its cell projected from the exit pupil's centre onto the
+// sensor, as the half-planes (up to 8) of the points nearer its centre than each neighbour's (the
+// lattice's, or the displaced centres of an array with errors: nearest_displaced finds the nearest
+// displaced centre, whose cell its neighbours' bisectors bound); how many. 0 when the projection
+// is not defined (then any point may be).
+int own_sensor_cell(const PlenopticCamera& model, LensIndex lens, double sensor_z, HalfPlane out[8]);
 
 // The disc of cell points (array-local, from the lens's centre) holding every point through which
 // the ray from sensor point s (array-local, behind the lens) can pass the main lens; infinite
