@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "plenoptic/array/microlens_array.h"
 #include "plenoptic/camera/rays.h"
@@ -94,14 +96,97 @@ int orientation(const RoundedPolygon& r)
     return area > 0 ? 1 : (area < 0 ? -1 : 0);
 }
 
-// Distance from p to the segment a-b.
-double segment_distance(Vec2 p, Vec2 a, Vec2 b)
+// Squared distance from p to the segment a-b.
+double segment_distance2(Vec2 p, Vec2 a, Vec2 b)
 {
     const Vec2 e = b - a, q = p - a;
     const double length2 = dot(e, e);
     double t = length2 > 0 ? dot(q, e) / length2 : 0;
     t = t < 0 ? 0 : (t > 1 ? 1 : t);
-    return std::hypot(q.x - t * e.x, q.y - t * e.y);
+    const double dx = q.x - t * e.x, dy = q.y - t * e.y;
+    return dx * dx + dy * dy;
+}
+
+// A rounded polygon's boundary pieces for its chords: the circles about its corners and its edges
+// moved out by the radius (both ways when the polygon encloses no area).
+struct Outline {
+    int corners;
+    Vec2 corner[6];
+    double radius, radius2;
+    int edges;
+    Vec2 p[12], q[12];
+    int side[12];  // +1: on the upper boundary (outward normal up), -1: the lower, 0: vertical
+};
+
+void make_outline(const RoundedPolygon& r, Outline* o)
+{
+    o->corners = r.corners;
+    for (int k = 0; k < r.corners; ++k)
+        o->corner[k] = r.corner[k];
+    o->radius = r.radius;
+    o->radius2 = r.radius * r.radius;
+    o->edges = 0;
+    const int turn = orientation(r);
+    for (int k = 0; k < r.corners; ++k) {
+        const Vec2 a = r.corner[k], b = r.corner[(k + 1) % r.corners];
+        const Vec2 e = b - a;
+        const double length = std::sqrt(dot(e, e));
+        if (!(length > 0))
+            continue;
+        for (int side = -1; side <= 1; side += 2) {
+            if (turn != 0 && side != turn)
+                continue;
+            const Vec2 n{side * e.y / length * r.radius, -side * e.x / length * r.radius};
+            o->p[o->edges] = a + n;
+            o->q[o->edges] = b + n;
+            const double up = -side * e.x;  // the outward normal's y, times the length
+            o->side[o->edges] = up > 0 ? 1 : (up < 0 ? -1 : 0);
+            ++o->edges;
+        }
+    }
+}
+
+// The chord's ends at x: the lower one when `lower`, the upper one when `upper` (else -inf, +inf);
+// false when x lies outside the region's x range.
+bool outline_chord(const Outline& o, double x, bool lower, bool upper, double* y0, double* y1)
+{
+    // The boundary of a convex polygon widened by a disc is made of its edges moved out by the
+    // radius along their normals and of arcs about its corners; every point of those pieces (whole
+    // circles about the corners included) lies in the region, so the chord runs from the lowest to
+    // the highest of them at x (the highest on an arc or an edge facing up or sideways).
+    double lo = INFINITY, hi = -INFINITY;
+    bool any = false;
+    for (int k = 0; k < o.corners; ++k) {
+        const Vec2 v = o.corner[k];
+        const double dx = x - v.x;
+        if (std::fabs(dx) <= o.radius) {
+            any = true;
+            const double h = std::sqrt(std::max(0.0, o.radius2 - dx * dx));
+            lo = std::min(lo, v.y - h);
+            hi = std::max(hi, v.y + h);
+        }
+    }
+    for (int k = 0; k < o.edges; ++k) {
+        if (!(o.side[k] > 0 ? upper : (o.side[k] < 0 ? lower : true)))
+            continue;
+        const Vec2 p = o.p[k], q = o.q[k];
+        if (!(x >= std::min(p.x, q.x) && x <= std::max(p.x, q.x)))
+            continue;
+        any = true;
+        if (p.x == q.x) {
+            lo = std::min(lo, std::min(p.y, q.y));
+            hi = std::max(hi, std::max(p.y, q.y));
+            continue;
+        }
+        double t = (x - p.x) / (q.x - p.x);
+        t = t < 0 ? 0 : (t > 1 ? 1 : t);
+        const double y = p.y + t * (q.y - p.y);
+        lo = std::min(lo, y);
+        hi = std::max(hi, y);
+    }
+    *y0 = lower ? lo : -INFINITY;
+    *y1 = upper ? hi : INFINITY;
+    return any;
 }
 
 } // namespace
@@ -119,7 +204,7 @@ bool region_holds(const RoundedPolygon& r, Vec2 p)
             return true;
     }
     for (int k = 0; k < r.corners; ++k)
-        if (segment_distance(p, r.corner[k], r.corner[(k + 1) % r.corners]) <= r.radius)
+        if (segment_distance2(p, r.corner[k], r.corner[(k + 1) % r.corners]) <= r.radius * r.radius)
             return true;
     return false;
 }
@@ -137,51 +222,9 @@ void region_x_extent(const RoundedPolygon& r, double* x0, double* x1)
 
 bool region_chord(const RoundedPolygon& r, double x, double* y0, double* y1)
 {
-    // The boundary of a convex polygon widened by a disc is made of its edges moved out by the
-    // radius along their normals and of arcs about its corners; every point of those pieces (whole
-    // circles about the corners included) lies in the region, so the chord runs from the lowest to
-    // the highest of them at x.
-    const double radius = r.radius;
-    double lo = INFINITY, hi = -INFINITY;
-    for (int k = 0; k < r.corners; ++k) {
-        const Vec2 v = r.corner[k];
-        const double dx = x - v.x;
-        if (std::fabs(dx) <= radius) {
-            const double h = std::sqrt(std::max(0.0, radius * radius - dx * dx));
-            lo = std::min(lo, v.y - h);
-            hi = std::max(hi, v.y + h);
-        }
-    }
-    const int turn = orientation(r);
-    for (int k = 0; k < r.corners; ++k) {
-        const Vec2 a = r.corner[k], b = r.corner[(k + 1) % r.corners];
-        const Vec2 e = b - a;
-        const double length = std::hypot(e.x, e.y);
-        if (!(length > 0))
-            continue;
-        // The outward normal (both sides when the polygon encloses no area).
-        for (int side = -1; side <= 1; side += 2) {
-            if (turn != 0 && side != turn)
-                continue;
-            const Vec2 n{side * e.y / length * radius, -side * e.x / length * radius};
-            const Vec2 p = a + n, q = b + n;
-            if (!(x >= std::min(p.x, q.x) && x <= std::max(p.x, q.x)))
-                continue;
-            if (p.x == q.x) {
-                lo = std::min(lo, std::min(p.y, q.y));
-                hi = std::max(hi, std::max(p.y, q.y));
-                continue;
-            }
-            double t = (x - p.x) / (q.x - p.x);
-            t = t < 0 ? 0 : (t > 1 ? 1 : t);
-            const double y = p.y + t * (q.y - p.y);
-            lo = std::min(lo, y);
-            hi = std::max(hi, y);
-        }
-    }
-    *y0 = lo;
-    *y1 = hi;
-    return hi >= lo;
+    Outline o;
+    make_outline(r, &o);
+    return outline_chord(o, x, true, true, y0, y1) && *y1 >= *y0;
 }
 
 RoundedPolygon lit_sensor_region(const LensAim& a, double d, int cut)
@@ -260,9 +303,12 @@ AimDisc cell_disc(const LensAim& a, Vec3 s, Vec2 m, double rho)
 }
 
 // The x range of the convex polygon (n corners, in order) within every disc (finite radii). The
-// extreme points of an intersection of convex sets lie on its pieces' boundaries: a corner, a
-// disc's leftmost or rightmost point, a crossing of an edge and a circle or of two circles; of
-// those lying in every set (to rounding), the smallest and largest x.
+// extreme points of an intersection of convex sets lie on its boundary, made of the parts of the
+// polygon's edges within every disc and of the parts of the circles within the polygon and the
+// other discs; x is extreme on an edge's part at its ends, on a circle's part at the circle's
+// leftmost or rightmost point or at the part's ends (on an edge, counted there, or on another
+// circle). So: each edge clipped by every disc, and the circles' extreme points and crossings that
+// lie in the polygon and the other discs (to rounding).
 bool polygon_discs_x_range(const Vec2* corner, int n, const AimDisc* discs, int count, double* x0, double* x1)
 {
     double scale = 0;
@@ -271,67 +317,99 @@ bool polygon_discs_x_range(const Vec2* corner, int n, const AimDisc* discs, int 
     for (int k = 0; k < count; ++k)
         scale += discs[k].radius + std::fabs(discs[k].centre.x) + std::fabs(discs[k].centre.y);
     const double tolerance = 1e-12 * scale;
+    double lo = INFINITY, hi = -INFINITY;
+    // The corners within every disc; an edge between two of them lies within them all.
+    bool inside[6];
+    for (int e = 0; e < n; ++e) {
+        inside[e] = true;
+        for (int k = 0; k < count && inside[e]; ++k) {
+            const double dx = corner[e].x - discs[k].centre.x, dy = corner[e].y - discs[k].centre.y;
+            inside[e] = dx * dx + dy * dy <= discs[k].radius * discs[k].radius;
+        }
+        if (inside[e]) {
+            lo = std::min(lo, corner[e].x);
+            hi = std::max(hi, corner[e].x);
+        }
+    }
+    // The other edges a + t (b - a), 0 <= t <= 1, within every disc: |a + t v - c|^2 <= r^2 (those
+    // whose x span lies within the range so far cannot widen it).
+    for (int e = 0; e < n; ++e) {
+        const int f = (e + 1) % n;
+        if (inside[e] && inside[f])
+            continue;
+        const Vec2 a = corner[e], b = corner[f];
+        if (std::min(a.x, b.x) >= lo && std::max(a.x, b.x) <= hi)
+            continue;
+        const Vec2 v = b - a;
+        const double A = dot(v, v);
+        if (!(A > 0))
+            continue;
+        double t0 = 0, t1 = 1;
+        for (int k = 0; k < count && t0 <= t1; ++k) {
+            const Vec2 w = a - discs[k].centre;
+            const double B = dot(v, w), C = dot(w, w) - discs[k].radius * discs[k].radius;
+            const double disc = B * B - A * C;
+            if (!(disc >= 0)) {
+                t1 = -1;
+                break;
+            }
+            // Without cancellation: q = -(B + sign(B) root), roots q / A and C / q.
+            const double root = std::sqrt(disc);
+            const double q = -(B + (B < 0 ? -root : root));
+            double r0 = q / A, r1 = q != 0 ? C / q : r0;
+            if (r0 > r1)
+                std::swap(r0, r1);
+            t0 = std::max(t0, r0);
+            t1 = std::min(t1, r1);
+        }
+        if (!(t0 <= t1))
+            continue;
+        const double xa = a.x + t0 * v.x, xb = a.x + t1 * v.x;
+        lo = std::min(lo, std::min(xa, xb));
+        hi = std::max(hi, std::max(xa, xb));
+    }
     double turn = 0;
     for (int k = 0; k < n; ++k)
         turn += cross(corner[k], corner[(k + 1) % n]);
     const double sign = turn >= 0 ? 1 : -1;
-    double lo = INFINITY, hi = -INFINITY;
-    auto consider = [&](Vec2 p) {
+    // A point of circle `skip` (and `skip2`): kept if in the polygon and the other discs.
+    auto consider = [&](Vec2 p, int skip, int skip2) {
         if (!(p.x < lo || p.x > hi))
             return;
         for (int k = 0; k < n; ++k) {
             const Vec2 a = corner[k], b = corner[(k + 1) % n];
             const Vec2 e = b - a;
-            const double length = std::hypot(e.x, e.y);
-            if (length > 0 && sign * cross(e, p - a) < -tolerance * length)
+            const double c = sign * cross(e, p - a);
+            if (c < 0 && c * c > tolerance * tolerance * dot(e, e))
                 return;
         }
-        for (int k = 0; k < count; ++k)
-            if (!(std::hypot(p.x - discs[k].centre.x, p.y - discs[k].centre.y) <= discs[k].radius + tolerance))
+        for (int k = 0; k < count; ++k) {
+            if (k == skip || k == skip2)
+                continue;
+            const double dx = p.x - discs[k].centre.x, dy = p.y - discs[k].centre.y;
+            const double r = discs[k].radius + tolerance;
+            if (!(dx * dx + dy * dy <= r * r))
                 return;
+        }
         lo = std::min(lo, p.x);
         hi = std::max(hi, p.x);
     };
-    for (int k = 0; k < n; ++k)
-        consider(corner[k]);
     for (int k = 0; k < count; ++k) {
         const AimDisc& d = discs[k];
-        consider(Vec2{d.centre.x - d.radius, d.centre.y});
-        consider(Vec2{d.centre.x + d.radius, d.centre.y});
-        // The circle's crossings with each edge a + t (b - a), 0 <= t <= 1.
-        for (int e = 0; e < n; ++e) {
-            const Vec2 a = corner[e], b = corner[(e + 1) % n];
-            const Vec2 v = b - a, w = a - d.centre;
-            const double A = dot(v, v), B = dot(v, w), C = dot(w, w) - d.radius * d.radius;
-            if (!(A > 0))
-                continue;
-            const double disc = B * B - A * C;
-            if (disc < 0)
-                continue;
-            const double root = std::sqrt(disc);
-            // Without cancellation: q = -(B + sign(B) root), roots q / A and C / q.
-            const double q = -(B + (B < 0 ? -root : root));
-            double ts[2] = {q / A, q != 0 ? C / q : -B / A};
-            for (double t : ts) {
-                if (!(t >= -1e-12 && t <= 1 + 1e-12))
-                    continue;
-                t = t < 0 ? 0 : (t > 1 ? 1 : t);
-                consider(Vec2{a.x + t * v.x, a.y + t * v.y});
-            }
-        }
-        // Its crossings with the other circles.
+        consider(Vec2{d.centre.x - d.radius, d.centre.y}, k, k);
+        consider(Vec2{d.centre.x + d.radius, d.centre.y}, k, k);
         for (int o = k + 1; o < count; ++o) {
             const AimDisc& f = discs[o];
             const double dx = f.centre.x - d.centre.x, dy = f.centre.y - d.centre.y;
-            const double between = std::hypot(dx, dy);
+            const double between = std::sqrt(dx * dx + dy * dy);
             if (!(between > 0) || between > d.radius + f.radius || between < std::fabs(d.radius - f.radius))
                 continue;
             const double along = (between * between + d.radius * d.radius - f.radius * f.radius) / (2 * between);
             const double across = std::sqrt(std::max(0.0, d.radius * d.radius - along * along));
             const Vec2 u{dx / between, dy / between};
             const Vec2 base{d.centre.x + along * u.x, d.centre.y + along * u.y};
-            consider(Vec2{base.x - across * u.y, base.y + across * u.x});
-            consider(Vec2{base.x + across * u.y, base.y - across * u.x});
+            consider(Vec2{base.x - across * u.y, base.y + across * u.x}, k, o);
+            consider(Vec2{base.x + across * u.y, base.y - across * u.x}, k, o);
         }
     }
     if (!(hi >= lo))
@@ -517,23 +595,32 @@ const int kMaxSets = 3;
 struct LensPart {
     int sets;
     RoundedPolygon set[kMaxSets];
+    Outline outline[kMaxSets];
     int planes;
     HalfPlane plane[8];
     double x0, x1;
+    // Which ends of each set's chord can fall within the pixel's rows over [x0, x1] (the others
+    // are beyond them there; sampling asks only for these).
+    bool lower[kMaxSets], upper[kMaxSets], plane_needed[8];
 };
 
 // The part's chord at x within the pixel's rows [0, py]; its length (negative: none).
-double part_chord(const LensPart& part, double x, double py, double* y0, double* y1)
+double part_chord(const LensPart& part, double x, double py, double* y0, double* y1, bool all = true)
 {
     double lo = 0, hi = py;
     for (int k = 0; k < part.sets; ++k) {
+        const bool lower = all || part.lower[k], upper = all || part.upper[k];
+        if (!(lower || upper))
+            continue;
         double a, b;
-        if (!region_chord(part.set[k], x, &a, &b))
+        if (!outline_chord(part.outline[k], x, lower, upper, &a, &b))
             return -INFINITY;
         lo = std::max(lo, a);
         hi = std::min(hi, b);
     }
     for (int k = 0; k < part.planes; ++k) {
+        if (!(all || part.plane_needed[k]))
+            continue;
         // n.x x + n.y y <= offset
         const HalfPlane& h = part.plane[k];
         const double rest = h.offset - h.normal.x * x;
@@ -634,7 +721,31 @@ bool part_x_range(LensPart* part, double px, double py)
         }
         part->x1 = out;
     }
-    return part->x1 > part->x0;
+    if (!(part->x1 > part->x0))
+        return false;
+    // A chord's upper end is concave in x, its lower end convex, a half-plane's bound linear: each
+    // is beyond the pixel's rows over [x0, x1] when it is at both ends.
+    for (int k = 0; k < part->sets; ++k) {
+        double a0, b0, a1, b1;
+        const bool both = outline_chord(part->outline[k], part->x0, true, true, &a0, &b0) &&
+                          outline_chord(part->outline[k], part->x1, true, true, &a1, &b1);
+        part->lower[k] = !(both && a0 <= 0 && a1 <= 0);
+        part->upper[k] = !(both && b0 >= py && b1 >= py);
+    }
+    for (int k = 0; k < part->planes; ++k) {
+        const HalfPlane& h = part->plane[k];
+        bool beyond = false;
+        if (h.normal.y > 0)
+            beyond = (h.offset - h.normal.x * part->x0) / h.normal.y >= py &&
+                     (h.offset - h.normal.x * part->x1) / h.normal.y >= py;
+        else if (h.normal.y < 0)
+            beyond = (h.offset - h.normal.x * part->x0) / h.normal.y <= 0 &&
+                     (h.offset - h.normal.x * part->x1) / h.normal.y <= 0;
+        else
+            beyond = h.offset - h.normal.x * part->x0 >= 0 && h.offset - h.normal.x * part->x1 >= 0;
+        part->plane_needed[k] = !beyond;
+    }
+    return true;
 }
 
 // A pixel's aim, worked out once for all its samples: its points are uniform (the whole pixel may be
@@ -685,6 +796,7 @@ bool lens_part(const PlenopticCamera& m, const LensAim& a, double sensor_z, cons
         r.radius += slack + 1e-13 * (std::fabs(r.corner[0].x) + std::fabs(r.corner[0].y));
         if (!(r.radius >= 0 && std::isfinite(r.radius)))
             return false;
+        make_outline(r, &part->outline[k]);
     }
     part->x0 = part->x1 = 0;
     return true;
@@ -781,13 +893,21 @@ void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced,
 }
 
 // The plan of the pixel last asked for on this thread (samples come pixel by pixel).
-struct CachedPlan {
+// Per thread, the plans of the pixel last asked for: one per lens its samples were forced through
+// (overlap modelling interleaves a pixel's lenses sample by sample), or the one unforced; up to
+// kCachedPlans, then the oldest is made again.
+const int kCachedPlans = 16;
+struct CachedPlans {
     bool valid = false;
     CameraKey key;
     int i = 0, j = 0;
-    bool forced = false;
-    LensIndex forced_lens{0, 0};
-    PixelPlan plan;
+    int count = 0, next = 0;
+    struct Entry {
+        bool forced;
+        LensIndex lens;
+        PixelPlan plan;
+    };
+    std::vector<Entry> entries = std::vector<Entry>(kCachedPlans);
 };
 
 } // namespace
@@ -795,20 +915,31 @@ struct CachedPlan {
 PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, double pixel_v, const LensIndex* forced)
 {
     PixelAim out{i + pixel_u, j + pixel_v, 1, false, LensIndex{0, 0}, true};
-    static thread_local CachedPlan cache;
+    static thread_local CachedPlans cache;
     const CameraKey key = key_of(m);
-    if (!(cache.valid && cache.i == i && cache.j == j && cache.forced == (forced != nullptr) &&
-          (!forced || cache.forced_lens == *forced) && cache.key == key)) {
-        plan_pixel(m, i, j, forced, &cache.plan);
+    if (!(cache.valid && cache.i == i && cache.j == j && cache.key == key)) {
         cache.valid = true;
         cache.key = key;
         cache.i = i;
         cache.j = j;
-        cache.forced = forced != nullptr;
-        if (forced)
-            cache.forced_lens = *forced;
+        cache.count = cache.next = 0;
     }
-    const PixelPlan& plan = cache.plan;
+    int found = -1;
+    for (int k = 0; k < cache.count && found < 0; ++k) {
+        const CachedPlans::Entry& e = cache.entries[size_t(k)];
+        if (e.forced == (forced != nullptr) && (!forced || e.lens == *forced))
+            found = k;
+    }
+    if (found < 0) {
+        found = cache.next;
+        cache.next = (cache.next + 1) % kCachedPlans;
+        cache.count = std::max(cache.count, found + 1);
+        CachedPlans::Entry& e = cache.entries[size_t(found)];
+        e.forced = forced != nullptr;
+        e.lens = forced ? *forced : LensIndex{0, 0};
+        plan_pixel(m, i, j, forced, &e.plan);
+    }
+    const PixelPlan& plan = cache.entries[size_t(found)].plan;
     if (plan.kind == PixelPlan::Uniform)
         return out;
     if (plan.forced) {
@@ -827,7 +958,7 @@ PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, doubl
         if (!(x >= part.x0 && x <= part.x1))
             continue;  // the part's chord is empty there
         double y0, y1;
-        if (part_chord(part, x, plan.py, &y0, &y1) > 0)
+        if (part_chord(part, x, plan.py, &y0, &y1, false) > 0)
             ys.add(y0, y1);
     }
     const double height = ys.merge();
@@ -845,23 +976,34 @@ ArrayRay aimed_cell_ray(const PlenopticCamera& m, const Vec3& p, LensIndex lens,
 {
     *weight = 1;
     const MicrolensArray& array = m.array;
-    // The lens last aimed at on this thread (a pixel's samples mostly go through one lens).
-    struct CachedLens {
-        bool valid = false, aimed = false;
+    // The lenses last aimed at on this thread (a pixel's samples go through one lens, or with
+    // overlap modelling through a few in turn).
+    struct CachedLenses {
         CameraKey key;
-        LensAim aim;
+        int count = 0, next = 0;
+        bool aimed[8];
+        LensAim aim[8];
     };
-    static thread_local CachedLens cache;
+    static thread_local CachedLenses cache;
     const CameraKey key = key_of(m);
-    if (!(cache.valid && cache.aim.lens == lens && cache.key == key)) {
-        cache.aimed = lens_aim(m, lens, &cache.aim);
-        cache.aim.lens = lens;
+    if (!(cache.count > 0 && cache.key == key)) {
         cache.key = key;
-        cache.valid = true;
+        cache.count = cache.next = 0;
     }
-    if (!cache.aimed)
+    int found = -1;
+    for (int k = 0; k < cache.count && found < 0; ++k)
+        if (cache.aim[k].lens == lens)
+            found = k;
+    if (found < 0) {
+        found = cache.next;
+        cache.next = (cache.next + 1) % 8;
+        cache.count = std::max(cache.count, found + 1);
+        cache.aimed[found] = lens_aim(m, lens, &cache.aim[found]);
+        cache.aim[found].lens = lens;
+    }
+    if (!cache.aimed[found])
         return array.microlens->sample_ray(array, p, lens, u, v);
-    const LensAim& a = cache.aim;
+    const LensAim& a = cache.aim[found];
     const Vec3 s = array.to_local(p);
     if (!(a.z - s.z > 0))
         return array.microlens->sample_ray(array, p, lens, u, v);
