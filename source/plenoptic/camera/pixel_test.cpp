@@ -102,32 +102,44 @@ TEST(Pixel, AdaptiveSamplingStopsEarlyOnFlatScenesAndGoesOnOnNoisyOnes)
 TEST(Pixel, AdaptiveSamplingDoesNotTakeAnUnluckyBlockedStartForADarkPixel)
 {
     // Plenoptic 1.0 with f-number-matched microlenses: pixels at a microimage's rim are partly
-    // lit, and for some of them every one of the first samples is blocked.
+    // lit, and with uniform samples, for some of them every one of the first samples is blocked.
+    // Aimed samples (camera/aim.h) behind this thin main lens are aimed exactly: none of a lit
+    // pixel's samples is blocked, so no start is unlucky.
     const int W = 160, H = 120, minimum = 16, maximum = 256;
-    CameraParams fixed = matched_plenoptic1();
-    CameraParams adaptive = fixed;
-    fixed.sampling.samples = maximum;
-    adaptive.sampling.adaptive = true;
-    adaptive.sampling.samples_min = minimum;
-    adaptive.sampling.samples_max = maximum;
-    const PlenopticCamera m_fixed = with_film(make_camera(fixed), W, H), m_adaptive = with_film(make_camera(adaptive), W, H);
-    auto white = [](const OpticsRay&) { return Rgbt{1, 1, 1, 0}; };
-    int unlucky = 0;
-    for (int j = 0; j < H; ++j)
-        for (int i = 0; i < W; ++i) {
-            bool first_lit = false;
-            for (int n = 0; n < minimum && !first_lit; ++n) {
-                OpticsRay ray;
-                first_lit = (ray = m_adaptive.generate_ray(i, j, make_sample(i, j, n, maximum))).passed;
+    for (const bool aim : {false, true}) {
+        CameraParams fixed = matched_plenoptic1();
+        CameraParams adaptive = fixed;
+        fixed.sampling.samples = maximum;
+        adaptive.sampling.adaptive = true;
+        adaptive.sampling.samples_min = minimum;
+        adaptive.sampling.samples_max = maximum;
+        PlenopticCamera m_fixed = with_film(make_camera(fixed), W, H), m_adaptive = with_film(make_camera(adaptive), W, H);
+        ASSERT_TRUE(m_fixed.sampling.aim && m_adaptive.sampling.aim);
+        m_fixed.sampling.aim = m_adaptive.sampling.aim = aim;
+        auto white = [](const OpticsRay&) { return Rgbt{1, 1, 1, 0}; };
+        int unlucky = 0, lit_pixels = 0;
+        for (int j = 0; j < H; ++j)
+            for (int i = 0; i < W; ++i) {
+                bool first_lit = false;
+                for (int n = 0; n < minimum && !first_lit; ++n) {
+                    OpticsRay ray;
+                    first_lit = (ray = m_adaptive.generate_ray(i, j, make_sample(i, j, n, maximum))).passed;
+                }
+                const bool lit = shade_pixel(m_fixed, i, j, white).r > 0;
+                const Rgbt value = shade_pixel(m_adaptive, i, j, white);
+                EXPECT_EQ(value.r > 0, lit) << "pixel " << i << "," << j << ": dark exactly when no sample passes";
+                EXPECT_EQ(m_adaptive.receives_light(i, j), lit) << "pixel " << i << "," << j;
+                lit_pixels += lit;
+                if (lit && !first_lit)
+                    ++unlucky;
             }
-            const bool lit = shade_pixel(m_fixed, i, j, white).r > 0;
-            const Rgbt value = shade_pixel(m_adaptive, i, j, white);
-            EXPECT_EQ(value.r > 0, lit) << "pixel " << i << "," << j << ": dark exactly when no sample passes";
-            EXPECT_EQ(m_adaptive.receives_light(i, j), lit) << "pixel " << i << "," << j;
-            if (lit && !first_lit)
-                ++unlucky;
+        EXPECT_GT(lit_pixels, W * H / 2);
+        if (aim) {
+            EXPECT_EQ(unlucky, 0) << "aimed exactly, a lit pixel's first samples pass";
+        } else {
+            EXPECT_GT(unlucky, 0) << "the set-up should have rim pixels whose first samples are all blocked";
         }
-    EXPECT_GT(unlucky, 0) << "the set-up should have rim pixels whose first samples are all blocked";
+    }
 }
 
 TEST(Pixel, VignettingProbesBringRimPixelsCloserToTheirTrueLitFraction)
