@@ -643,6 +643,27 @@ double part_chord(const LensPart& part, double x, double py, double* y0, double*
 // taken on the outer side.
 bool part_x_range(LensPart* part, double px, double py)
 {
+    // A set farther from the pixel's centre than its radius and half the pixel's diagonal, or a
+    // half-plane that leaves out all four corners, leaves out the whole pixel.
+    const Vec2 middle{0.5 * px, 0.5 * py};
+    const double reach = 0.5 * std::sqrt(px * px + py * py);
+    for (int k = 0; k < part->sets; ++k) {
+        const RoundedPolygon& r = part->set[k];
+        const double far = r.radius + reach;
+        if (!region_holds(RoundedPolygon{r.corners, {r.corner[0], r.corner[1], r.corner[2], r.corner[3], r.corner[4],
+                                                     r.corner[5]},
+                                         far},
+                          middle))
+            return false;
+    }
+    for (int k = 0; k < part->planes; ++k) {
+        const HalfPlane& h = part->plane[k];
+        bool out = true;
+        for (int c = 0; c < 4 && out; ++c)
+            out = dot(h.normal, Vec2{(c & 1) * px, (c >> 1) * py}) > h.offset;
+        if (out)
+            return false;
+    }
     double a = 0, b = px;
     for (int k = 0; k < part->sets; ++k) {
         const RoundedPolygon& r = part->set[k];
