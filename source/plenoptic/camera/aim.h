@@ -23,7 +23,7 @@
 //    intersection of the regions of its discs, which holds the exact one);
 //  - the renderer takes a sensor point's light through its own lens (own_lens: the lens whose cell
 //    holds the point's projection from the exit pupil's centre), so through that lens only from the
-//    cell's projection onto the sensor (own_sensor_cell, for an array without errors).
+//    cell's projection onto the sensor (own_sensor_cell; with errors, the displaced centres' cell).
 // Each region is sampled by its chords: x uniform over the region's exact x range, then y uniform
 // over the chord at x; the weight is the x range times the chord over the whole's area.
 
@@ -45,8 +45,8 @@ struct AimDisc {
     double radius;
 };
 
-// What aiming needs of one lens (array-local, mm): its centre and plane, focal length, the cell's
-// circumradius, and the disc of the plane Z in front of it (Z > 0) where light can pass the main
+// What aiming needs of one lens (array-local, mm): its centre and plane, focal length, the cell
+// (grid, pitch, circumradius), and the disc of the plane Z in front of it (Z > 0) where light can pass the main
 // lens (radius 0: none passes through this lens).
 struct LensAim {
     LensIndex lens;
@@ -116,7 +116,7 @@ AimDisc lit_cell_disc(const LensAim& aim, Vec3 s);
 AimDisc lit_cell_cut(const LensAim& aim, Vec3 s, int k);
 
 // The x range (from the lens's centre) of the cell's part where light from sensor point s can pass
-// (the cell ∩ lit_cell_disc ∩ the cuts' discs), exactly up to rounding (widened by it); false when
+// (the cell within lit_cell_disc and the cuts' discs), exactly up to rounding (widened by it); false when
 // that part is empty.
 bool lit_cell_x_range(const LensAim& aim, Vec3 s, double* x0, double* x1);
 
@@ -141,8 +141,8 @@ struct PixelAim {
 PixelAim aim_pixel(const PlenopticCamera& model, int i, int j, double pixel_u, double pixel_v, const LensIndex* forced);
 
 // The ray from sensor point p through `lens` for aperture sample (u, v), drawn from the part of
-// the cell where light from p can pass (lit_cell_disc and the cuts', over lit_cell_x_range), with *weight that part's sampled measure
-// over the cell's area; the uniform sample_ray (weight 1) when that part holds the whole cell or
+// the cell where light from p can pass (lit_cell_disc and the cuts', over lit_cell_x_range), with
+// *weight that part's sampled measure over the cell's area; the uniform sample_ray (weight 1) when that part holds the whole cell or
 // the lens cannot be aimed at. Not passed when no point of the cell can pass.
 ArrayRay aimed_cell_ray(const PlenopticCamera& model, const Vec3& p, LensIndex lens, double u, double v, double* weight);
 
