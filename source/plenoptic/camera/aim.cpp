@@ -12,6 +12,7 @@
 
 #include "plenoptic/array/microlens_array.h"
 #include "plenoptic/camera/rays.h"
+#include "plenoptic/camera/rays_internal.h"
 #include "plenoptic/lens/main_lens.h"
 #include "plenoptic/lens/pupil_bounds.h"
 
@@ -422,6 +423,10 @@ bool polygon_discs_x_range(const Vec2* corner, int n, const AimDisc* discs, int 
 // The lens's finite discs of cell points for sensor point s (the disc and its cuts'); how many.
 int cell_discs(const LensAim& a, Vec3 s, AimDisc discs[3])
 {
+    if (a.cuts == 0) {
+        discs[0] = lit_cell_disc(a, s);
+        return discs[0].radius < std::numeric_limits<double>::infinity() ? 1 : 0;
+    }
     int count = 0;
     const AimDisc all[3] = {lit_cell_disc(a, s), a.cuts > 0 ? lit_cell_cut(a, s, 0) : AimDisc{},
                             a.cuts > 1 ? lit_cell_cut(a, s, 1) : AimDisc{}};
@@ -431,6 +436,64 @@ int cell_discs(const LensAim& a, Vec3 s, AimDisc discs[3])
     return count;
 }
 
+// The x range of the cell (centred on 0) within one disc, exactly up to rounding (widened by it,
+// as polygon_discs_x_range): the x where the disc's chord meets the cell's column [-h(x), h(x)],
+// i.e. where the distance from (x, |y_d|) to that column, max(0, |y_d| - h(x)), is at most the
+// disc's reach sqrt(r^2 - (x - x_d)^2). A rectangle's h is constant; a hexagon's
+// h = (p - |x|) / sqrt 3 is linear on each half, so there the condition is |x - x_d| <= r where
+// h(x) >= |y_d| and a quadratic in |x| where h(x) < |y_d|.
+bool cell_disc_x_range(GridType grid, double pitch, const AimDisc& d, double* x0, double* x1)
+{
+    const double half = 0.5 * pitch;
+    const double a = std::fabs(d.centre.y), cx = d.centre.x, r = d.radius;
+    double lo = INFINITY, hi = -INFINITY;
+    double scale;
+    if (grid != GridType::Hexagonal) {
+        scale = 4 * pitch;  // the corners' |x| + |y|, as polygon_discs_x_range
+        const double beyond = a - half;
+        const double w2 = r * r - (beyond > 0 ? beyond * beyond : 0);
+        if (w2 >= 0) {
+            const double w = std::sqrt(w2);
+            lo = std::max(-half, cx - w);
+            hi = std::min(half, cx + w);
+        }
+    } else {
+        const double R = pitch / kSqrt3;
+        scale = 2 * pitch + 4 * R;
+        // h(|x|) >= a for |x| <= p - sqrt(3) a.
+        const double within = std::min(half, pitch - kSqrt3 * a);
+        if (within >= 0 && std::max(-within, cx - r) <= std::min(within, cx + r)) {
+            lo = std::max(-within, cx - r);
+            hi = std::min(within, cx + r);
+        }
+        const double from = std::max(0.0, pitch - kSqrt3 * a);
+        if (from <= half) {
+            // t = |x| on the side x = side t: (side t - x_d)^2 + (a - R + t / sqrt 3)^2 <= r^2,
+            // (4/3) t^2 + 2 B t + C <= 0.
+            const double A = 4.0 / 3.0;
+            const double C = cx * cx + (a - R) * (a - R) - r * r;
+            for (int side = -1; side <= 1; side += 2) {
+                const double B = -side * cx + (a - R) / kSqrt3;
+                const double disc = B * B - A * C;
+                if (!(disc >= 0))
+                    continue;
+                const double root = std::sqrt(disc);
+                const double t0 = std::max(from, (-B - root) / A), t1 = std::min(half, (-B + root) / A);
+                if (!(t0 <= t1))
+                    continue;
+                lo = std::min(lo, side > 0 ? t0 : -t1);
+                hi = std::max(hi, side > 0 ? t1 : -t0);
+            }
+        }
+    }
+    if (!(hi >= lo))
+        return false;
+    const double tolerance = 1e-12 * (scale + r + std::fabs(cx) + std::fabs(d.centre.y));
+    *x0 = lo - tolerance;
+    *x1 = hi + tolerance;
+    return true;
+}
+
 bool cell_x_range(const LensAim& a, const AimDisc* discs, int count, double* x0, double* x1)
 {
     const double half = 0.5 * a.pitch;
@@ -438,6 +501,13 @@ bool cell_x_range(const LensAim& a, const AimDisc* discs, int count, double* x0,
         *x0 = -half;
         *x1 = half;
         return true;
+    }
+    if (count == 1) {
+        if (!cell_disc_x_range(a.grid, a.pitch, discs[0], x0, x1))
+            return false;
+        *x0 = std::max(*x0, -half);
+        *x1 = std::min(*x1, half);
+        return *x1 > *x0;
     }
     Vec2 cell[6];
     const int n = cell_polygon(a.grid, a.pitch, cell);
@@ -552,6 +622,21 @@ struct CameraKey {
     }
 };
 
+// Whether k is m's key (key_of(m) == k), without making the key (asked once or twice a sample).
+bool key_is(const CameraKey& k, const PlenopticCamera& m)
+{
+    const Sensor& s = m.sensor;
+    const ArrayPose& pose = m.array.pose;
+    return k.camera == &m && k.parts[0] == m.lens.get() && k.parts[1] == m.array.microlens.get() &&
+           k.parts[2] == m.pupil_bounds.get() && k.parts[3] == m.array.errors.get() && k.geometry[0] == s.z_mm &&
+           k.geometry[1] == s.pixel_size_mm[0] && k.geometry[2] == s.pixel_size_mm[1] &&
+           k.geometry[3] == s.offset_mm[0] && k.geometry[4] == s.offset_mm[1] &&
+           k.geometry[5] == double(s.film.width) && k.geometry[6] == double(s.film.height) &&
+           k.geometry[7] == pose.centre_mm.x && k.geometry[8] == pose.centre_mm.y &&
+           k.geometry[9] == pose.centre_mm.z && k.geometry[10] == pose.rotation.m[0][0] &&
+           k.geometry[11] == pose.rotation.m[0][1];
+}
+
 CameraKey key_of(const PlenopticCamera& m)
 {
     const Sensor& s = m.sensor;
@@ -634,6 +719,35 @@ double part_chord(const LensPart& part, double x, double py, double* y0, double*
     *y0 = lo;
     *y1 = hi;
     return hi - lo;
+}
+
+// Leaves out of an outline the pieces that are nowhere within [x0, x1] (a circle is there where
+// |x - corner.x| <= radius, which rounding keeps monotone on each side of the corner; an edge
+// between its ends' x) and the edges of the sides not asked for: the chords at x in [x0, x1] stay
+// the same, bit for bit, and cost less to sample.
+void prune_outline(Outline* o, double x0, double x1, bool lower, bool upper)
+{
+    int corners = 0;
+    for (int k = 0; k < o->corners; ++k) {
+        const Vec2 v = o->corner[k];
+        if (x0 - v.x > o->radius || v.x - x1 > o->radius)
+            continue;
+        o->corner[corners++] = v;
+    }
+    o->corners = corners;
+    int edges = 0;
+    for (int k = 0; k < o->edges; ++k) {
+        const Vec2 p = o->p[k], q = o->q[k];
+        if (std::max(p.x, q.x) < x0 || std::min(p.x, q.x) > x1)
+            continue;
+        if (!(o->side[k] > 0 ? upper : (o->side[k] < 0 ? lower : true)))
+            continue;
+        o->p[edges] = p;
+        o->q[edges] = q;
+        o->side[edges] = o->side[k];
+        ++edges;
+    }
+    o->edges = edges;
 }
 
 // The x range of the part within the pixel [0, px] x [0, py]; false when empty. The chord's length
@@ -752,6 +866,7 @@ bool part_x_range(LensPart* part, double px, double py)
                           outline_chord(part->outline[k], part->x1, true, true, &a1, &b1);
         part->lower[k] = !(both && a0 <= 0 && a1 <= 0);
         part->upper[k] = !(both && b0 >= py && b1 >= py);
+        prune_outline(&part->outline[k], part->x0, part->x1, part->lower[k], part->upper[k]);
     }
     for (int k = 0; k < part->planes; ++k) {
         const HalfPlane& h = part->plane[k];
@@ -838,6 +953,65 @@ bool holds_pixel(const LensPart& part, double px, double py)
     return true;
 }
 
+// Whether the lens's region (lit_sensor_region, within the circle about its centre of radius the
+// cell's circumradius scaled by |g| d/Z plus rho d/Z) lies, with a margin, farther than `reach`
+// from the pixel's centre s (array-local): then part_x_range would drop the lens's part (its
+// region widened by reach leaves out the centre), so the part need not be made. False when unsure.
+bool region_far(const LensAim& a, Vec3 s, double reach)
+{
+    const double d = a.z - s.z;
+    if (!(d > 0))
+        return false;
+    const double k = d / a.Z;
+    const double g = 1 + a.Z / d - a.Z / a.f;
+    // The margin far exceeds the regions' widening for rounding (1e-12 of their terms).
+    const double margin = 1e-9 * (std::fabs(a.c.x) + std::fabs(a.c.y) + std::fabs(a.m.x) + std::fabs(a.m.y) +
+                                  std::fabs(s.x) + std::fabs(s.y) + d + (k + 1 + d / std::fabs(a.f)) * a.circumradius);
+    const double outer = (a.circumradius * std::fabs(g) * k + a.rho * k) * (1 + 1e-9) + reach + margin;
+    const double dx = s.x - (a.c.x + (a.c.x - a.m.x) * k), dy = s.y - (a.c.y + (a.c.y - a.m.y) * k);
+    return dx * dx + dy * dy > outer * outer && std::isfinite(outer);
+}
+
+// A cheap test that the lens's part holds the whole pixel (centre s, array-local), conservative:
+// the pixel lies within the inscribed disc of each region (about its centre c + (c - m) d/Z, of
+// radius the cell's inradius p/2 scaled by |g| d/Z, plus rho d/Z), and, when q (the centre's
+// projection onto the array from the exit pupil's centre) is given, the pixel's projection lies
+// within the inscribed disc of the lens's own cell (about its displaced centre, radius p/2 less the
+// largest displacement: the neighbours' centres are at least p less twice that away). Shrunk by
+// 1e-9, far beyond the rounding; when it fails, lens_part and holds_pixel decide.
+bool inner_holds_pixel(const PlenopticCamera& m, const LensAim& a, Vec3 s, const Vec2* q, double px, double py)
+{
+    const double d = a.z - s.z;
+    if (!(d > 0))
+        return false;
+    const double reach = 0.5 * std::sqrt(px * px + py * py);
+    const double k = d / a.Z;
+    const double g = 1 + a.Z / d - a.Z / a.f;
+    const double inradius = 0.5 * a.pitch * std::fabs(g) * k;
+    for (int cut = -1; cut < a.cuts; ++cut) {
+        const Vec2 mm = cut < 0 ? a.m : a.cut_m[cut];
+        const double rho = cut < 0 ? a.rho : a.cut_rho[cut];
+        const double room = (inradius + rho * k) * (1 - 1e-9) - reach;
+        if (!(room > 0))
+            return false;
+        const double dx = s.x - (a.c.x + (a.c.x - mm.x) * k), dy = s.y - (a.c.y + (a.c.y - mm.y) * k);
+        if (!(dx * dx + dy * dy <= room * room))
+            return false;
+    }
+    if (q) {
+        const Vec3 e = m.lens->exit_pupil_centre();
+        const double scale = (m.array.pose.centre_mm.z - e.z) / (m.sensor.z_mm - e.z);
+        const double shift = m.array.errors ? m.array.errors->max_shift_mm() : 0;
+        const double room = (0.5 * a.pitch - shift) * (1 - 1e-9) - reach * std::fabs(scale);
+        if (!(room > 0) || !std::isfinite(scale))
+            return false;
+        const double dx = q->x - a.c.x, dy = q->y - a.c.y;
+        if (!(dx * dx + dy * dy <= room * room))
+            return false;
+    }
+    return true;
+}
+
 void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced, PixelPlan* plan)
 {
     plan->kind = PixelPlan::Uniform;
@@ -848,21 +1022,25 @@ void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced,
     const double px = plan->px, py = plan->py;
     const Vec3 middle = m.sensor.point(i + 0.5, j + 0.5);
     LensIndex lens;
+    Vec2 q;  // the centre's projection onto the array (own_lens)
     if (forced) {
         lens = *forced;
     } else {
-        const OwnLens own = own_lens(m, middle);
-        if (!own.found)
+        if (!detail::project_to_array(m, middle, &q))
             return;
-        lens = own.lens;
+        lens = m.array.nearest(q.x, q.y);
     }
     plan->lens = lens;
     LensAim a;
     const Vec3 s = m.array.to_local(middle);
+    if (!(px > 0 && py > 0) || !lens_aim(m, lens, &a))
+        return;  // the whole pixel may be lit: its own points, as the uniform samples
+    if (inner_holds_pixel(m, a, s, forced ? nullptr : &q, px, py))
+        return;  // most pixels: no part to make
     const PixelFrame frame = pixel_frame(m, s.z, i, j);
     LensPart own_part;
-    if (!(px > 0 && py > 0) || !lens_aim(m, lens, &a) || !lens_part(m, a, s.z, frame, !forced, &own_part))
-        return;  // the whole pixel may be lit: its own points, as the uniform samples
+    if (!lens_part(m, a, s.z, frame, !forced, &own_part))
+        return;
     if (holds_pixel(own_part, px, py))
         return;
     // The lenses that can light the pixel: the forced lens; or, for the pixel's own lenses, the
@@ -883,6 +1061,7 @@ void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced,
         const double shift = m.array.errors ? m.array.errors->max_shift_mm() : 0;
         if (!(delta + 1.5 * shift < 0.25 * m.array.pitch_mm))
             return;
+        const double reach = 0.5 * std::sqrt(px * px + py * py);
         const GridType grid = m.array.grid;
         const std::int64_t skew = skew_k(grid, lens);
         for (int dl = -1; dl <= 1; ++dl)
@@ -890,10 +1069,16 @@ void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced,
                 if (grid == GridType::Hexagonal && std::abs(dk + dl) > 1)
                     continue;  // not a neighbour in skew indices
                 const LensIndex other = from_skew(grid, skew + dk, lens.l + dl);
-                if (dk == 0 && dl == 0)
+                if (dk == 0 && dl == 0) {
                     plan->parts[count] = own_part;
-                else if (!lens_aim(m, other, &a) || !lens_part(m, a, s.z, frame, true, &plan->parts[count]))
-                    return;
+                } else {
+                    if (!lens_aim(m, other, &a))
+                        return;
+                    if (region_far(a, s, reach))
+                        continue;  // part_x_range would drop it
+                    if (!lens_part(m, a, s.z, frame, true, &plan->parts[count]))
+                        return;
+                }
                 ++count;
             }
     }
@@ -937,10 +1122,9 @@ PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, doubl
 {
     PixelAim out{i + pixel_u, j + pixel_v, 1, false, LensIndex{0, 0}, true};
     static thread_local CachedPlans cache;
-    const CameraKey key = key_of(m);
-    if (!(cache.valid && cache.i == i && cache.j == j && cache.key == key)) {
+    if (!(cache.valid && cache.i == i && cache.j == j && key_is(cache.key, m))) {
         cache.valid = true;
-        cache.key = key;
+        cache.key = key_of(m);
         cache.i = i;
         cache.j = j;
         cache.count = cache.next = 0;
@@ -1001,17 +1185,17 @@ ArrayRay aimed_cell_ray(const PlenopticCamera& m, const Vec3& p, LensIndex lens,
     // overlap modelling through a few in turn).
     struct CachedLenses {
         CameraKey key;
-        int count = 0, next = 0;
+        int count = 0, next = 0, last = 0;
         bool aimed[8];
         LensAim aim[8];
     };
     static thread_local CachedLenses cache;
-    const CameraKey key = key_of(m);
-    if (!(cache.count > 0 && cache.key == key)) {
-        cache.key = key;
+    if (!(cache.count > 0 && key_is(cache.key, m))) {
+        cache.key = key_of(m);
         cache.count = cache.next = 0;
     }
-    int found = -1;
+    // The lens last asked for first (a pixel's samples mostly go through one lens).
+    int found = cache.count > 0 && cache.aim[cache.last].lens == lens ? cache.last : -1;
     for (int k = 0; k < cache.count && found < 0; ++k)
         if (cache.aim[k].lens == lens)
             found = k;
@@ -1022,6 +1206,7 @@ ArrayRay aimed_cell_ray(const PlenopticCamera& m, const Vec3& p, LensIndex lens,
         cache.aimed[found] = lens_aim(m, lens, &cache.aim[found]);
         cache.aim[found].lens = lens;
     }
+    cache.last = found;
     if (!cache.aimed[found])
         return array.microlens->sample_ray(array, p, lens, u, v);
     const LensAim& a = cache.aim[found];
