@@ -289,7 +289,7 @@ int own_sensor_cell(const PlenopticCamera& m, LensIndex lens, double sensor_z, H
 
 namespace {
 
-AimDisc cell_disc(const LensAim& a, Vec3 s, Vec2 m, double rho)
+inline AimDisc cell_disc(const LensAim& a, Vec3 s, Vec2 m, double rho)
 {
     // g h - (Z/d) s + (Z/f) c within rho of m; from the lens's centre: h - c within rho / |g| of
     // (m - c + (Z/d) (s - c)) / g.
@@ -424,7 +424,7 @@ bool polygon_discs_x_range(const Vec2* corner, int n, const AimDisc* discs, int 
 int cell_discs(const LensAim& a, Vec3 s, AimDisc discs[3])
 {
     if (a.cuts == 0) {
-        discs[0] = lit_cell_disc(a, s);
+        discs[0] = cell_disc(a, s, a.m, a.rho);
         return discs[0].radius < std::numeric_limits<double>::infinity() ? 1 : 0;
     }
     int count = 0;
@@ -750,6 +750,35 @@ void prune_outline(Outline* o, double x0, double x1, bool lower, bool upper)
     o->edges = edges;
 }
 
+// Which ends of the part's chords can fall within the pixel's rows [0, py] over [x0, x1] (each
+// set present at both ends): part_chord(..., all = false) skips the others, with the same result
+// there, bit for bit.
+void mark_needed(LensPart* part, double x0, double x1, double py)
+{
+    // A chord's upper end is concave in x, its lower end convex, a half-plane's bound linear: each
+    // is beyond the pixel's rows over [x0, x1] when it is at both ends.
+    for (int k = 0; k < part->sets; ++k) {
+        double a0, b0, a1, b1;
+        const bool both = outline_chord(part->outline[k], x0, true, true, &a0, &b0) &&
+                          outline_chord(part->outline[k], x1, true, true, &a1, &b1);
+        part->lower[k] = !(both && a0 <= 0 && a1 <= 0);
+        part->upper[k] = !(both && b0 >= py && b1 >= py);
+    }
+    for (int k = 0; k < part->planes; ++k) {
+        const HalfPlane& h = part->plane[k];
+        bool beyond = false;
+        if (h.normal.y > 0)
+            beyond = (h.offset - h.normal.x * x0) / h.normal.y >= py &&
+                     (h.offset - h.normal.x * x1) / h.normal.y >= py;
+        else if (h.normal.y < 0)
+            beyond = (h.offset - h.normal.x * x0) / h.normal.y <= 0 &&
+                     (h.offset - h.normal.x * x1) / h.normal.y <= 0;
+        else
+            beyond = h.offset - h.normal.x * x0 >= 0 && h.offset - h.normal.x * x1 >= 0;
+        part->plane_needed[k] = !beyond;
+    }
+}
+
 // The x range of the part within the pixel [0, px] x [0, py]; false when empty. The chord's length
 // at x is a concave function over the sets' common x range (a minimum of concave upper ends less a
 // maximum of convex lower ones), so the range is where it is >= 0: a point there is found by
@@ -795,8 +824,13 @@ bool part_x_range(LensPart* part, double px, double py)
     }
     if (!(b > a))
         return false;
+    // The search asks for chords within [a, b] only, and for their ends that can fall within the
+    // pixel's rows there.
+    for (int k = 0; k < part->sets; ++k)
+        prune_outline(&part->outline[k], a, b, true, true);
+    mark_needed(part, a, b, py);
     double y0, y1;
-    const double fa = part_chord(*part, a, py, &y0, &y1), fb = part_chord(*part, b, py, &y0, &y1);
+    const double fa = part_chord(*part, a, py, &y0, &y1, false), fb = part_chord(*part, b, py, &y0, &y1, false);
     double inside = a;
     if (fa >= 0) {
         inside = a;
@@ -806,7 +840,7 @@ bool part_x_range(LensPart* part, double px, double py)
         const double ratio = 0.5 * (std::sqrt(5.0) - 1);
         double lo = a, hi = b;
         double x1 = hi - ratio * (hi - lo), x2 = lo + ratio * (hi - lo);
-        double f1 = part_chord(*part, x1, py, &y0, &y1), f2 = part_chord(*part, x2, py, &y0, &y1);
+        double f1 = part_chord(*part, x1, py, &y0, &y1, false), f2 = part_chord(*part, x2, py, &y0, &y1, false);
         bool found = false;
         for (int n = 0; n < 200; ++n) {
             if (f1 >= 0 || f2 >= 0) {
@@ -821,13 +855,13 @@ bool part_x_range(LensPart* part, double px, double py)
                 x1 = x2;
                 f1 = f2;
                 x2 = lo + ratio * (hi - lo);
-                f2 = part_chord(*part, x2, py, &y0, &y1);
+                f2 = part_chord(*part, x2, py, &y0, &y1, false);
             } else {
                 hi = x2;
                 x2 = x1;
                 f2 = f1;
                 x1 = hi - ratio * (hi - lo);
-                f1 = part_chord(*part, x1, py, &y0, &y1);
+                f1 = part_chord(*part, x1, py, &y0, &y1, false);
             }
         }
         if (!found)
@@ -841,7 +875,7 @@ bool part_x_range(LensPart* part, double px, double py)
             const double mid = 0.5 * (out + in);
             if (!(mid > out && mid < in))
                 break;
-            (part_chord(*part, mid, py, &y0, &y1) >= 0 ? in : out) = mid;
+            (part_chord(*part, mid, py, &y0, &y1, false) >= 0 ? in : out) = mid;
         }
         part->x0 = out;
     }
@@ -852,35 +886,15 @@ bool part_x_range(LensPart* part, double px, double py)
             const double mid = 0.5 * (out + in);
             if (!(mid > in && mid < out))
                 break;
-            (part_chord(*part, mid, py, &y0, &y1) >= 0 ? in : out) = mid;
+            (part_chord(*part, mid, py, &y0, &y1, false) >= 0 ? in : out) = mid;
         }
         part->x1 = out;
     }
     if (!(part->x1 > part->x0))
         return false;
-    // A chord's upper end is concave in x, its lower end convex, a half-plane's bound linear: each
-    // is beyond the pixel's rows over [x0, x1] when it is at both ends.
-    for (int k = 0; k < part->sets; ++k) {
-        double a0, b0, a1, b1;
-        const bool both = outline_chord(part->outline[k], part->x0, true, true, &a0, &b0) &&
-                          outline_chord(part->outline[k], part->x1, true, true, &a1, &b1);
-        part->lower[k] = !(both && a0 <= 0 && a1 <= 0);
-        part->upper[k] = !(both && b0 >= py && b1 >= py);
+    mark_needed(part, part->x0, part->x1, py);
+    for (int k = 0; k < part->sets; ++k)
         prune_outline(&part->outline[k], part->x0, part->x1, part->lower[k], part->upper[k]);
-    }
-    for (int k = 0; k < part->planes; ++k) {
-        const HalfPlane& h = part->plane[k];
-        bool beyond = false;
-        if (h.normal.y > 0)
-            beyond = (h.offset - h.normal.x * part->x0) / h.normal.y >= py &&
-                     (h.offset - h.normal.x * part->x1) / h.normal.y >= py;
-        else if (h.normal.y < 0)
-            beyond = (h.offset - h.normal.x * part->x0) / h.normal.y <= 0 &&
-                     (h.offset - h.normal.x * part->x1) / h.normal.y <= 0;
-        else
-            beyond = h.offset - h.normal.x * part->x0 >= 0 && h.offset - h.normal.x * part->x1 >= 0;
-        part->plane_needed[k] = !beyond;
-    }
     return true;
 }
 
