@@ -868,28 +868,19 @@ bool part_x_range(LensPart* part, double px, double py)
             return false;
     }
     const double tolerance = 1e-10 * px;
-    part->x0 = a;
-    if (!(fa >= 0)) {
-        double out = a, in = inside;
-        for (int n = 0; n < 200 && in - out > tolerance; ++n) {
-            const double mid = 0.5 * (out + in);
-            if (!(mid > out && mid < in))
+    // An end of the range that is dark: the boundary between it and the lit point `inside`,
+    // bisected to the tolerance; its dark end, so that the range holds every lit x.
+    const auto dark_end = [&](double dark, double lit) {
+        for (int n = 0; n < 200 && std::fabs(lit - dark) > tolerance; ++n) {
+            const double mid = 0.5 * (dark + lit);
+            if (!(mid > std::min(dark, lit) && mid < std::max(dark, lit)))
                 break;
-            (part_chord(*part, mid, py, &y0, &y1, false) >= 0 ? in : out) = mid;
+            (part_chord(*part, mid, py, &y0, &y1, false) >= 0 ? lit : dark) = mid;
         }
-        part->x0 = out;
-    }
-    part->x1 = b;
-    if (!(fb >= 0)) {
-        double in = inside, out = b;
-        for (int n = 0; n < 200 && out - in > tolerance; ++n) {
-            const double mid = 0.5 * (out + in);
-            if (!(mid > in && mid < out))
-                break;
-            (part_chord(*part, mid, py, &y0, &y1, false) >= 0 ? in : out) = mid;
-        }
-        part->x1 = out;
-    }
+        return dark;
+    };
+    part->x0 = fa >= 0 ? a : dark_end(a, inside);
+    part->x1 = fb >= 0 ? b : dark_end(b, inside);
     if (!(part->x1 > part->x0))
         return false;
     mark_needed(part, part->x0, part->x1, py);
