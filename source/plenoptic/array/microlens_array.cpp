@@ -95,27 +95,23 @@ LensIndex MicrolensArray::nearest_displaced(LensIndex lattice, double x, double 
     // whose actual centre is nearest is the lattice cell's or one of its neighbours'. A neighbour
     // whose lattice point is farther than the best distance so far plus the largest shift cannot
     // be nearer: its error is not looked up (most points are well inside their cells).
-    const std::int64_t skew = skew_k(grid, lattice);
-    const bool hexagonal = grid == GridType::Hexagonal;
     const double shift = errors->max_shift_mm();
     LensIndex best = lattice;
     const Vec2 c0 = centre_local(lattice);
     double best_sq = (x - c0.x) * (x - c0.x) + (y - c0.y) * (y - c0.y);
-    for (int dl = -1; dl <= 1; ++dl) {
-        for (int dk = -1; dk <= 1; ++dk) {
-            if ((dk == 0 && dl == 0) || (hexagonal && std::abs(dk + dl) > 1))
-                continue;
-            const LensIndex lens = from_skew(grid, skew + dk, lattice.l + dl);
-            const Vec2 n = lattice_centre_local(lens);
-            const double reach = std::sqrt(best_sq) + shift;
-            if ((x - n.x) * (x - n.x) + (y - n.y) * (y - n.y) > reach * reach)
-                continue;
-            const Vec2 c = centre_local(lens);
-            const double sq = (x - c.x) * (x - c.x) + (y - c.y) * (y - c.y);
-            if (sq < best_sq) {
-                best_sq = sq;
-                best = lens;
-            }
+    LensIndex adjacent[8];
+    const int n_adjacent = adjacent_lenses(grid, lattice, adjacent);
+    for (int q = 0; q < n_adjacent; ++q) {
+        const LensIndex lens = adjacent[q];
+        const Vec2 n = lattice_centre_local(lens);
+        const double reach = std::sqrt(best_sq) + shift;
+        if ((x - n.x) * (x - n.x) + (y - n.y) * (y - n.y) > reach * reach)
+            continue;
+        const Vec2 c = centre_local(lens);
+        const double sq = (x - c.x) * (x - c.x) + (y - c.y) * (y - c.y);
+        if (sq < best_sq) {
+            best_sq = sq;
+            best = lens;
         }
     }
     return best;

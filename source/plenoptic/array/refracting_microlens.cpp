@@ -300,24 +300,20 @@ double surface_ahead(const RefractingShape& s, Medium medium, Vec3 P, Vec3 D, bo
 double cell_exit(const MicrolensArray& array, LensIndex lens, Vec3 X, Vec3 V, LensIndex* next)
 {
     const Vec2 c = array.centre_local(lens);
-    const std::int64_t skew = skew_k(array.grid, lens);
-    const bool hexagonal = array.grid == GridType::Hexagonal;
     double best = std::numeric_limits<double>::infinity();
-    for (int dl = -1; dl <= 1; ++dl) {
-        for (int dk = -1; dk <= 1; ++dk) {
-            if ((dk == 0 && dl == 0) || (hexagonal && std::abs(dk + dl) > 1))
-                continue;
-            const LensIndex n = from_skew(array.grid, skew + dk, lens.l + dl);
-            const Vec2 cn = array.centre_local(n);
-            const double ex = cn.x - c.x, ey = cn.y - c.y;
-            const double along = V.x * ex + V.y * ey;
-            if (!(along > 0))
-                continue;
-            const double t = ((0.5 * (c.x + cn.x) - X.x) * ex + (0.5 * (c.y + cn.y) - X.y) * ey) / along;
-            if (t < best) {
-                best = t;
-                *next = n;
-            }
+    LensIndex adjacent[8];
+    const int n_adjacent = adjacent_lenses(array.grid, lens, adjacent);
+    for (int q = 0; q < n_adjacent; ++q) {
+        const LensIndex n = adjacent[q];
+        const Vec2 cn = array.centre_local(n);
+        const double ex = cn.x - c.x, ey = cn.y - c.y;
+        const double along = V.x * ex + V.y * ey;
+        if (!(along > 0))
+            continue;
+        const double t = ((0.5 * (c.x + cn.x) - X.x) * ex + (0.5 * (c.y + cn.y) - X.y) * ey) / along;
+        if (t < best) {
+            best = t;
+            *next = n;
         }
     }
     return std::max(best, 0.0);

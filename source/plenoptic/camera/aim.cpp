@@ -266,24 +266,21 @@ int own_sensor_cell(const PlenopticCamera& m, LensIndex lens, double sensor_z, H
     const double K = (e.z - sensor_z) / e.z;
     if (!(K > 0) || !std::isfinite(K) || !is_finite(e))
         return 0;
-    const GridType grid = m.array.grid;
     const Vec2 a = m.array.centre_local(lens);
-    const std::int64_t skew = skew_k(grid, lens);
+    LensIndex adjacent[8];
+    const int n_adjacent = adjacent_lenses(m.array.grid, lens, adjacent);
     int count = 0;
-    for (int dl = -1; dl <= 1; ++dl)
-        for (int dk = -1; dk <= 1; ++dk) {
-            if ((dk == 0 && dl == 0) || (grid == GridType::Hexagonal && std::abs(dk + dl) > 1))
-                continue;
-            const Vec2 b = m.array.centre_local(from_skew(grid, skew + dk, lens.l + dl));
-            const Vec2 n{b.x - a.x, b.y - a.y};
-            const Vec2 mid{e.x + K * (0.5 * (a.x + b.x) - e.x), e.y + K * (0.5 * (a.y + b.y) - e.y)};
-            const double scale = std::fabs(n.x) + std::fabs(n.y);
-            const double slack = kRoundingMargin * scale *
-                                 (std::fabs(e.x) + std::fabs(e.y) +
-                                  K * (std::fabs(a.x) + std::fabs(a.y) + std::fabs(b.x) + std::fabs(b.y) + std::fabs(e.x) +
-                                       std::fabs(e.y)));
-            out[count++] = HalfPlane{n, dot(n, mid) + slack};
-        }
+    for (int q = 0; q < n_adjacent; ++q) {
+        const Vec2 b = m.array.centre_local(adjacent[q]);
+        const Vec2 n{b.x - a.x, b.y - a.y};
+        const Vec2 mid{e.x + K * (0.5 * (a.x + b.x) - e.x), e.y + K * (0.5 * (a.y + b.y) - e.y)};
+        const double scale = std::fabs(n.x) + std::fabs(n.y);
+        const double slack = kRoundingMargin * scale *
+                             (std::fabs(e.x) + std::fabs(e.y) +
+                              K * (std::fabs(a.x) + std::fabs(a.y) + std::fabs(b.x) + std::fabs(b.y) + std::fabs(e.x) +
+                                   std::fabs(e.y)));
+        out[count++] = HalfPlane{n, dot(n, mid) + slack};
+    }
     return count;
 }
 

@@ -40,6 +40,19 @@ LensIndex from_skew(GridType grid, std::int64_t k_skew, std::int64_t l)
     return grid == GridType::Hexagonal ? LensIndex{k_skew + floor_div(l, 2), l} : LensIndex{k_skew, l};
 }
 
+int adjacent_lenses(GridType grid, LensIndex lens, LensIndex out[8])
+{
+    const std::int64_t skew = skew_k(grid, lens);
+    int count = 0;
+    for (int dl = -1; dl <= 1; ++dl)
+        for (int dk = -1; dk <= 1; ++dk) {
+            if ((dk == 0 && dl == 0) || (grid == GridType::Hexagonal && (dk + dl > 1 || dk + dl < -1)))
+                continue;  // the lens itself, or not adjacent in skew indices
+            out[count++] = from_skew(grid, skew + dk, lens.l + dl);
+        }
+    return count;
+}
+
 double row_spacing(GridType grid, double pitch)
 {
     return grid == GridType::Hexagonal ? pitch * (kSqrt3 / 2) : pitch;

@@ -41,6 +41,11 @@ inline std::int64_t floor_mod(std::int64_t a, std::int64_t m) { return a - floor
 std::int64_t skew_k(GridType grid, LensIndex lens);
 LensIndex from_skew(GridType grid, std::int64_t k_skew, std::int64_t l);
 
+// The lenses whose cells share an edge (or, rectangular, a corner) with the lens's cell: 6 for
+// hexagonal grids, 8 for rectangular ones, in the order of (dl, dk) = (-1, -1), (-1, 0), ...,
+// (1, 1) in skew indices (the lens itself left out). Returns how many.
+int adjacent_lenses(GridType grid, LensIndex lens, LensIndex out[8]);
+
 double row_spacing(GridType grid, double pitch);      // p, or p sqrt(3)/2
 double cell_inradius(GridType grid, double pitch);    // p/2 for both grids
 double cell_circumradius(GridType grid, double pitch);// p/sqrt(2), or p/sqrt(3)
