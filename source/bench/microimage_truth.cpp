@@ -9,7 +9,7 @@
 //   plenoptic_microimage_truth --lens-file FILE --f-number N --focus-distance Z
 //       --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--thick] [--offset X_MM Y_MM] [--threads T]
 //       [--errors S F R SEED] [--refracting R CAP SUBSTRATE IOR] [--caps-to-sensor] [--reference]
-//       [--every-lens] [--check N] [--csv OUT]
+//       [--every-lens] [--no-symmetry] [--check N] [--csv OUT]
 //
 // --offset shifts the sensor (sensor { offset }): a crop of a larger raw away from its centre,
 // e.g. its corner. --errors gives the array manufacturing errors (errors { position S focal_length F
@@ -19,6 +19,8 @@
 // SUBSTRATE }, the curved side towards the scene, or towards the sensor with --caps-to-sensor; F_MM of
 // --array is then unused). Refracting lenses on an array without errors are interpolated between
 // anchors (MicroimageOptions::anchor_step); --every-lens measures every lens instead (anchor_step 0).
+// Refracting lenses on an array centred on the axis are measured in the symmetry's wedge only
+// (MicroimageOptions::symmetry); --no-symmetry measures each lens where it is.
 // --check N measures N lenses of the picture each (never interpolated: measured_microimages), drawn
 // at random from a fixed seed, and the picture's four corner lenses, and adds to the JSON the largest
 // differences of the run's answer from theirs (check_du_px, check_dv_px, check_fraction) and the
@@ -55,6 +57,7 @@ struct Options {
     bool errors = false;
     bool reference = false;
     bool every_lens = false;
+    bool no_symmetry = false;
     bool caps_to_sensor = false;
     int check = 0;
     int anchor_step = -1, refracting_points = 0, check_points = 0;
@@ -94,6 +97,8 @@ bool parse(int argc, char** argv, Options* o)
             o->reference = true;
         else if (arg == "--every-lens")
             o->every_lens = true;
+        else if (arg == "--no-symmetry")
+            o->no_symmetry = true;
         else if (arg == "--caps-to-sensor")
             o->caps_to_sensor = true;
         else if (arg == "--check-points" && left >= 1)
@@ -129,7 +134,7 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "usage: plenoptic_microimage_truth --lens-file FILE --f-number N --focus-distance Z\n"
                              "         --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--thick] [--offset X_MM Y_MM]\n"
                              "         [--threads T] [--errors S F R SEED] [--refracting R CAP SUBSTRATE IOR]\n"
-                             "         [--caps-to-sensor] [--reference] [--every-lens] [--check N] [--csv OUT]\n");
+                             "         [--caps-to-sensor] [--reference] [--every-lens] [--no-symmetry] [--check N] [--csv OUT]\n");
         return 2;
     }
     Prescription lens;
@@ -172,6 +177,8 @@ int main(int argc, char** argv)
         options.anchor_step = o.anchor_step;
     if (o.refracting_points > 0)
         options.refracting_points = o.refracting_points;
+    if (o.no_symmetry)
+        options.symmetry = false;
     if (o.every_lens)
         options.anchor_step = 0;
 
@@ -252,8 +259,8 @@ int main(int argc, char** argv)
                     checked, check_du, check_dv, check_fraction, check_cpu, (long long)worst.k, (long long)worst.l);
     std::printf("{\"size\": [%d, %d], \"offset_mm\": [%.9g, %.9g], \"lenses\": %zu, \"lit_lenses\": %zu, "
                 "\"threads\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"peak_rss_mib\": %.1f, \"anchors\": %zu, "
-                "\"interpolated\": %zu, \"measured\": %zu}\n",
+                "\"interpolated\": %zu, \"measured\": %zu, \"wedge_lenses\": %zu}\n",
                 o.camera.width, o.camera.height, o.offset_mm[0], o.offset_mm[1], truth.size(), lit, o.threads, wall, cpu,
-                usage.ru_maxrss / 1024.0, work.anchors, work.interpolated, work.measured);
+                usage.ru_maxrss / 1024.0, work.anchors, work.interpolated, work.measured, work.wedge_lenses);
     return 0;
 }

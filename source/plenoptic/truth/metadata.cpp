@@ -190,6 +190,8 @@ Json microimages_json(const MicroimageSummary* summary)
         integration["anchors"] = summary->work.anchors;
         integration["interpolated_lenses"] = summary->work.interpolated;
     }
+    if (summary->work.wedge_lenses > 0)
+        integration["wedge_lenses"] = summary->work.wedge_lenses;  // measured, the others their images
     json["integration"] = integration;
     const LatticeFit& fit = summary->fit;
     if (fit.valid) {
