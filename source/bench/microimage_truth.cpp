@@ -19,8 +19,8 @@
 // SUBSTRATE }, the curved side towards the scene, or towards the sensor with --caps-to-sensor; F_MM of
 // --array is then unused). Refracting lenses on an array without errors are interpolated between
 // anchors (MicroimageOptions::anchor_step); --every-lens measures every lens instead (anchor_step 0).
-// Refracting lenses on an array centred on the axis are measured in the symmetry's wedge only
-// (MicroimageOptions::symmetry); --no-symmetry measures each lens where it is.
+// Refracting lenses on an array centred on the axis are measured in one quarter of it only, the
+// others mirrored (MicroimageOptions::symmetry); --no-symmetry measures each lens where it is.
 // --check N measures N lenses of the picture each (never interpolated: measured_microimages), drawn
 // at random from a fixed seed, and the picture's four corner lenses, and adds to the JSON the largest
 // differences of the run's answer from theirs (check_du_px, check_dv_px, check_fraction) and the
@@ -259,8 +259,8 @@ int main(int argc, char** argv)
                     checked, check_du, check_dv, check_fraction, check_cpu, (long long)worst.k, (long long)worst.l);
     std::printf("{\"size\": [%d, %d], \"offset_mm\": [%.9g, %.9g], \"lenses\": %zu, \"lit_lenses\": %zu, "
                 "\"threads\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"peak_rss_mib\": %.1f, \"anchors\": %zu, "
-                "\"interpolated\": %zu, \"measured\": %zu, \"wedge_lenses\": %zu}\n",
+                "\"interpolated\": %zu, \"measured\": %zu, \"quarter_lenses\": %zu}\n",
                 o.camera.width, o.camera.height, o.offset_mm[0], o.offset_mm[1], truth.size(), lit, o.threads, wall, cpu,
-                usage.ru_maxrss / 1024.0, work.anchors, work.interpolated, work.measured, work.wedge_lenses);
+                usage.ru_maxrss / 1024.0, work.anchors, work.interpolated, work.measured, work.quarter_lenses);
     return 0;
 }

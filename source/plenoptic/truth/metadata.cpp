@@ -190,8 +190,8 @@ Json microimages_json(const MicroimageSummary* summary)
         integration["anchors"] = summary->work.anchors;
         integration["interpolated_lenses"] = summary->work.interpolated;
     }
-    if (summary->work.wedge_lenses > 0)
-        integration["wedge_lenses"] = summary->work.wedge_lenses;  // measured, the others their images
+    if (summary->work.quarter_lenses > 0)
+        integration["quarter_lenses"] = summary->work.quarter_lenses;  // measured; the others mirror them
     json["integration"] = integration;
     const LatticeFit& fit = summary->fit;
     if (fit.valid) {

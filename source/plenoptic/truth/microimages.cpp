@@ -678,93 +678,72 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
 // The camera's symmetry about its optical axis, where the truth uses it: refracting microlenses (the
 // costly ones, measured at refracting_points^2 cell points) on an ideal array (no manufacturing
 // errors, not tilted, one kind of lens) whose lens (0, 0) sits on the axis, on a hexagonal or square
-// lattice. The main lens is symmetric about its axis (every model is), and so are the sensor's
-// plane, the array's plane and the lattice with its cells about lens (0, 0): each turn of the
-// lattice about that lens by a multiple of 60 degrees (square: 90) and each mirror in a line through
-// it along a row or between rows maps the camera onto itself, lens onto lens, and the light through
-// a lens onto the light through the lens it maps to. So a lens's microimage is the image of that of
-// its lens in the wedge between the array's +x direction and 30 degrees (square: 45) from it, and
-// only the lenses of that wedge are measured; the others take their wedge lens's microimage, turned
-// and mirrored (centroid; the lit fraction as it is). That makes the measured truth exactly
-// symmetric, which the 24 x 24 cell rule is not on its own (a lens measured where it is and the
-// same lens turned by 60 degrees differ by some 1e-3 px and 1.5e-4 of lit fraction, the rule's
-// own error); it is as accurate, about 12 (square: 8) times cheaper on a whole sensor.
+// lattice, its rows along the sensor's x or y axis. The main lens is symmetric about its axis (every
+// model is), and so are the sensor's and the array's planes; the lattice with its cells is symmetric
+// under the mirrors in the array's x and y axes through lens (0, 0). Each mirror maps the camera onto itself, lens onto lens, and the
+// light through a lens onto the light through its image; and the truth's own rule is symmetric
+// under the same mirrors (its cell points, the renderer's map of the cell, and its directions from
+// the start point, 0 and 90 degrees among them; its start point is the mirrored guess, or the
+// centroid of a coarse grid centred on it). So a lens's microimage is its mirror image's, mirrored:
+// only the lenses of the quarter x >= 0, y >= 0 of the array's frame are measured, and every other
+// lens takes the microimage of its image there, mirrored (centroid; the lit fraction as it is). The
+// lattice's turns by 60 degrees and its mirrors in lines between the axes are symmetries of the
+// camera too, but not of the rule (a lens and its image under them, each measured, differ by the
+// rule's own error, some 1e-3 px): used, they would put steps of that size into the truth where a
+// lens and its neighbour would take their microimages from lenses measured apart.
 class Symmetry {
 public:
     Symmetry(const PlenopticCamera& m, const PlenopticCamera& light, const MicroimageOptions& options)
     {
         const MicrolensArray& a = m.array;
-        const bool hexagonal = a.grid == GridType::Hexagonal;
-        valid_ = options.symmetry && a.microlens && a.microlens->forms_image() && !a.microlens->first_order_exact() && !a.errors &&
-                 !light.array.errors && (hexagonal || a.grid == GridType::Rectangular) && !a.pose.tilted &&
+        valid_ = options.symmetry && a.microlens && a.microlens->forms_image() && !a.microlens->first_order_exact() &&
+                 !a.errors && !light.array.errors &&
+                 (a.grid == GridType::Hexagonal || a.grid == GridType::Rectangular) && !a.pose.tilted &&
                  !light.array.pose.tilted && a.lens_type_count == 1 && a.pose.centre_mm.x == 0 &&
                  a.pose.centre_mm.y == 0 && light.array.pose.centre_mm.x == 0 && light.array.pose.centre_mm.y == 0;
-        sector_ = hexagonal ? kPi / 3 : kPi / 2;
-        // The array's turn about the axis (its rows' direction in the optics frame).
+        // The array's turn about the axis (its rows' direction in the optics frame): a multiple of 90
+        // degrees (exact: array/microlens_array.h), so that its mirrors are the sensor's, under which
+        // the rule's coarse grids and directions, laid out in pixels, are symmetric too.
         const Vec3 x = mul(a.pose.rotation, Vec3{1, 0, 0});
         frame_[0] = x.x;
         frame_[1] = x.y;
+        valid_ = valid_ && (frame_[0] == 0 || frame_[1] == 0);
     }
     bool valid() const { return valid_; }
 
-    // The lens of the wedge whose microimage `lens`'s is the image of, and that map: `turns` times
-    // the sector, after a mirror in the wedge's far side when `mirrored`.
-    LensIndex wedge_lens(const MicrolensArray& a, LensIndex lens, int* turns, bool* mirrored) const
+    // The lens of the quarter x >= 0, y >= 0 whose mirror image `lens` is, and the mirrors that map
+    // it there (x -> -x, y -> -y).
+    static LensIndex quarter_lens(const MicrolensArray& a, LensIndex lens, bool* mirror_x, bool* mirror_y)
     {
         const Vec2 c = a.lattice_centre_local(lens);
-        double angle = std::atan2(c.y, c.x);
-        if (angle < 0)
-            angle += 2 * kPi;
-        *turns = c.x == 0 && c.y == 0 ? 0 : int(std::floor(angle / sector_));
-        if (*turns < 0 || *turns >= int(std::lround(2 * kPi / sector_)))
-            *turns = 0;
-        Vec2 q = turn(c, -*turns * sector_);
-        *mirrored = std::atan2(q.y, q.x) > 0.5 * sector_;
-        if (*mirrored)
-            q = mirror(q);
-        const LensIndex found = a.nearest(q.x, q.y);
-        const Vec2 back = a.lattice_centre_local(found);
-        if (!(std::hypot(back.x - q.x, back.y - q.y) <= 1e-9 * a.pitch_mm)) {
-            *turns = 0;  // (not reached on these lattices: the map takes lattice points to lattice points)
-            *mirrored = false;
+        *mirror_x = c.x < 0;
+        *mirror_y = c.y < 0;
+        if (!*mirror_x && !*mirror_y)
             return lens;
-        }
-        return found;
+        return a.nearest(std::fabs(c.x), std::fabs(c.y));  // a lattice point: the lattice is symmetric
     }
 
-    // A sensor point (centre-convention pixels) of the wedge lens's microimage, mapped.
-    Vec2 map_px(const Sensor& sensor, int turns, bool mirrored, Vec2 px) const
+    // A sensor point (centre-convention pixels) of the quarter lens's microimage, mirrored.
+    Vec2 map_px(const Sensor& sensor, bool mirror_x, bool mirror_y, Vec2 px) const
     {
         const Vec3 p = sensor.point(px.x + 0.5, px.y + 0.5);
-        // Into the array's frame (a turn about the axis), the map, and back.
+        // Into the array's frame (a turn about the axis), mirrored, and back.
         Vec2 q{frame_[0] * p.x + frame_[1] * p.y, -frame_[1] * p.x + frame_[0] * p.y};
-        if (mirrored)
-            q = mirror(q);
-        q = turn(q, turns * sector_);
+        if (mirror_x)
+            q.x = -q.x;
+        if (mirror_y)
+            q.y = -q.y;
         const PixelPoint out = sensor.to_pixel(frame_[0] * q.x - frame_[1] * q.y, frame_[1] * q.x + frame_[0] * q.y);
         return Vec2{out.u, out.v};
     }
 
 private:
-    static Vec2 turn(Vec2 v, double angle)
-    {
-        const double c = std::cos(angle), s = std::sin(angle);
-        return Vec2{c * v.x - s * v.y, s * v.x + c * v.y};
-    }
-    // The mirror in the line at half the sector from +x (through a corner of the hexagonal cell).
-    Vec2 mirror(Vec2 v) const
-    {
-        const double c = std::cos(sector_), s = std::sin(sector_);
-        return Vec2{c * v.x + s * v.y, s * v.x - c * v.y};
-    }
-
     bool valid_ = false;
-    double sector_ = 0;
     double frame_[2] = {1, 0};  // cos, sin of the array's turn
 };
 
 // measure_lenses, with the camera's symmetry where it holds: each lens of `out` takes the microimage
-// of its wedge lens, those measured once each (and kept in `cache`, by lens, for later calls).
+// of its quarter lens, those measured once each (and kept in `cache`, by lens, for later calls).
 bool measure_symmetric(const PlenopticCamera& m, const PlenopticCamera& light, const MicroimageOptions& options,
                        std::vector<MicroimageTruth>& out, std::int64_t step, const MicroimageProgress& progress,
                        const MicroimageCancel& cancelled, std::vector<char>* lobes,
@@ -777,9 +756,8 @@ bool measure_symmetric(const PlenopticCamera& m, const PlenopticCamera& light, c
     std::unordered_map<std::uint64_t, std::pair<MicroimageTruth, char>> local;
     std::unordered_map<std::uint64_t, std::pair<MicroimageTruth, char>>& known = cache ? *cache : local;
     struct Map {
-        LensIndex wedge;
-        int turns;
-        bool mirrored;
+        LensIndex quarter;
+        bool mirror_x, mirror_y;
     };
     std::vector<Map> maps(out.size());
     std::vector<MicroimageTruth> wanted;
@@ -787,11 +765,11 @@ bool measure_symmetric(const PlenopticCamera& m, const PlenopticCamera& light, c
         std::unordered_map<std::uint64_t, char> seen;
         for (std::size_t i = 0; i < out.size(); ++i) {
             Map& map = maps[i];
-            map.wedge = symmetry.wedge_lens(m.array, out[i].lens, &map.turns, &map.mirrored);
-            const std::uint64_t k = key(map.wedge);
+            map.quarter = Symmetry::quarter_lens(m.array, out[i].lens, &map.mirror_x, &map.mirror_y);
+            const std::uint64_t k = key(map.quarter);
             if (known.count(k) == 0 && seen.emplace(k, 1).second) {
                 MicroimageTruth t = MicroimageTruth();
-                t.lens = map.wedge;
+                t.lens = map.quarter;
                 wanted.push_back(t);
             }
         }
@@ -800,7 +778,7 @@ bool measure_symmetric(const PlenopticCamera& m, const PlenopticCamera& light, c
         return p.lens.l != q.lens.l ? p.lens.l < q.lens.l : p.lens.k < q.lens.k;
     });
     std::vector<char> wanted_lobes;
-    // (The wedge lenses of lenses `step` apart along rows are `step` apart too: anchors of one level.)
+    // (The quarter lenses of lenses `step` apart along rows are `step` apart too: anchors of a level.)
     if (!measure_lenses(m, light, options, wanted, step, progress, cancelled, &wanted_lobes))
         return false;
     for (std::size_t i = 0; i < wanted.size(); ++i)
@@ -808,12 +786,13 @@ bool measure_symmetric(const PlenopticCamera& m, const PlenopticCamera& light, c
     if (lobes)
         lobes->assign(out.size(), 0);
     for (std::size_t i = 0; i < out.size(); ++i) {
-        const std::pair<MicroimageTruth, char>& found = known.at(key(maps[i].wedge));
+        const std::pair<MicroimageTruth, char>& found = known.at(key(maps[i].quarter));
         const LensIndex lens = out[i].lens;
         out[i] = found.first;
         out[i].lens = lens;
         if (out[i].lit) {
-            const Vec2 c = symmetry.map_px(m.sensor, maps[i].turns, maps[i].mirrored, Vec2{found.first.u_px, found.first.v_px});
+            const Vec2 c = symmetry.map_px(m.sensor, maps[i].mirror_x, maps[i].mirror_y,
+                                           Vec2{found.first.u_px, found.first.v_px});
             out[i].u_px = c.x;
             out[i].v_px = c.y;
         }
@@ -828,13 +807,12 @@ bool measure_symmetric(const PlenopticCamera& m, const PlenopticCamera& light, c
 // lit fraction are smooth functions of where the lens is. Those lenses are measured exactly at
 // anchors, every anchor_step-th lens of every anchor_step-th row, and interpolated between them
 // (a cubic in each direction, on the 4 x 4 anchors nearest the lens), wherever the anchors say the
-// cubic holds; the other lenses are measured. A lens's place among the anchors: its skew indices
-// (X, Y) = (k_s, l), so that the anchors, the lenses whose X and Y are multiples of the step, form a
-// lattice of the same shape as the array's (symmetric about lens (0, 0) as the array is: Symmetry),
-// and the cubics run along the lattice's two directions.
-double anchor_x(GridType grid, LensIndex lens)
+// cubic holds; the other lenses are measured. A lens's position in lattice units: X = k (+ 1/2 on
+// the odd rows of a hexagonal array), Y = l. (The anchors' grid is symmetric under the mirrors of
+// Symmetry: an anchor's quarter lens is an anchor.)
+double lattice_x(GridType grid, LensIndex lens)
 {
-    return double(skew_k(grid, lens));
+    return double(lens.k) + (grid == GridType::Hexagonal && floor_mod(lens.l, 2) == 1 ? 0.5 : 0.0);
 }
 
 // The cubic through four anchors at 0, 1, 2, 3, at t: its weights.
@@ -887,7 +865,7 @@ struct Anchors {
     // The first anchor (i0, j0) of the lens's 4 x 4, and where the lens lies in anchor units.
     void stencil(GridType grid, LensIndex lens, std::int64_t* i0, std::int64_t* j0, double* x, double* y) const
     {
-        *x = anchor_x(grid, lens) / double(step);
+        *x = lattice_x(grid, lens) / double(step);
         *y = double(lens.l) / double(step);
         *i0 = std::max(k0, std::min(k1 - 3, std::int64_t(std::floor(*x)) - 1));
         *j0 = std::max(l0, std::min(l1 - 3, std::int64_t(std::floor(*y)) - 1));
@@ -901,7 +879,7 @@ struct Anchors {
                 if ((j >= j0 && j <= j0 + 3) || (i >= i0 && i <= i0 + 3))
                     f(i, j);
     }
-    LensIndex lens(GridType grid, std::int64_t K, std::int64_t L) const { return from_skew(grid, K * step, L * step); }
+    LensIndex lens(std::int64_t K, std::int64_t L) const { return LensIndex{K * step, L * step}; }
 };
 
 // The lens's microimage from the anchors, or false where the anchors do not vouch for the cubic (a
@@ -922,7 +900,7 @@ bool interpolate(const Anchors& a, GridType grid, MicroimageTruth* truth, Vec2 l
     bool dark = false;
     bool lobe = false;
     a.each(i0, j0, [&](std::int64_t i, std::int64_t j) {
-        const auto found = a.values->find(anchor_key(a.lens(grid, i, j)));
+        const auto found = a.values->find(anchor_key(a.lens(i, j)));
         if (found == a.values->end() || !found->second.lit) {
             dark = true;
         } else {
@@ -1036,14 +1014,14 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
             out.reserve(count);
     }
 
-    // Lenses measured so far (as the wedge lenses of the camera's symmetry).
+    // Lenses measured so far (as the quarter lenses of the camera's symmetry).
     std::unordered_map<std::uint64_t, std::pair<MicroimageTruth, char>> known;
     const Symmetry symmetry(m, light, options);
     if (!interpolates(m, light, options) || out.empty()) {
         counts.measured = out.size();
         if (!measure_symmetric(m, light, options, out, 1, progress, cancelled, nullptr, &known))
             out.clear();
-        counts.wedge_lenses = symmetry.valid() ? known.size() : 0;
+        counts.quarter_lenses = symmetry.valid() ? known.size() : 0;
         return out;
     }
     // Levels of anchors: anchor_step, then half of it, ... down to 4 lenses apart. At each level the
@@ -1053,8 +1031,8 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     // The lenses left at the end are measured. Every decision depends on the lenses alone.
     double x_lo = INFINITY, x_hi = -INFINITY;
     for (const MicroimageTruth& t : out) {
-        x_lo = std::min(x_lo, anchor_x(m.array.grid, t.lens));
-        x_hi = std::max(x_hi, anchor_x(m.array.grid, t.lens));
+        x_lo = std::min(x_lo, lattice_x(m.array.grid, t.lens));
+        x_hi = std::max(x_hi, lattice_x(m.array.grid, t.lens));
     }
     const std::int64_t l_lo = out.front().lens.l, l_hi = out.back().lens.l;
     const std::size_t total = out.size();
@@ -1092,7 +1070,7 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
                 double x, y;
                 anchors.stencil(m.array.grid, out[index].lens, &i0, &j0, &x, &y);
                 anchors.each(i0, j0, [&](std::int64_t i, std::int64_t j) {
-                    const LensIndex lens = anchors.lens(m.array.grid, i, j);
+                    const LensIndex lens = anchors.lens(i, j);
                     const std::uint64_t key = anchor_key(lens);
                     if (values.count(key) == 0 && seen.emplace(key, 1).second) {
                         MicroimageTruth truth = MicroimageTruth();
@@ -1103,15 +1081,14 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
             }
         }
         // Anchors that cost more than measuring the lenses they serve: measure those lenses. (What
-        // a set of lenses costs: the lenses to measure for it, the wedge lenses with the symmetry.)
+        // a set of lenses costs: the lenses to measure for it, the quarter lenses with the symmetry.)
         auto cost = [&](std::size_t count, const std::function<LensIndex(std::size_t)>& lens_at) {
             if (!symmetry.valid())
                 return count;
             std::unordered_map<std::uint64_t, char> seen;
             for (std::size_t i = 0; i < count; ++i) {
-                int turns;
-                bool mirrored;
-                const std::uint64_t key = anchor_key(symmetry.wedge_lens(m.array, lens_at(i), &turns, &mirrored));
+                bool mirror_x, mirror_y;
+                const std::uint64_t key = anchor_key(Symmetry::quarter_lens(m.array, lens_at(i), &mirror_x, &mirror_y));
                 if (known.count(key) == 0)
                     seen.emplace(key, 1);
             }
@@ -1157,7 +1134,7 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         // No level paid: every lens measured.
         if (!measure_symmetric(m, light, options, out, 1, progress, cancelled, nullptr, &known))
             out.clear();
-        counts.wedge_lenses = symmetry.valid() ? known.size() : 0;
+        counts.quarter_lenses = symmetry.valid() ? known.size() : 0;
         return out;
     }
     std::vector<MicroimageTruth> measured(pending.size(), MicroimageTruth());
@@ -1169,7 +1146,7 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     }
     for (std::size_t i = 0; i < pending.size(); ++i)
         out[pending[i]] = measured[i];
-    counts.wedge_lenses = symmetry.valid() ? known.size() : 0;
+    counts.quarter_lenses = symmetry.valid() ? known.size() : 0;
     return out;
 }
 

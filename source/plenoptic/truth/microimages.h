@@ -63,11 +63,11 @@ struct MicroimageOptions {
     // Refracting microlenses: cell points a side (at least aperture_points).
     int refracting_points = 24;
     // Refracting microlenses on an ideal array whose lens (0, 0) sits on the optical axis (hexagonal
-    // or square lattice, not tilted, no manufacturing errors): measure only the lenses of the
-    // wedge between the array's +x direction and 30 degrees (square: 45) from it, and give every
-    // other lens the microimage of the wedge lens it is the image of under the turns and mirrors
-    // that map the camera onto itself (turned and mirrored likewise). false: each lens measured
-    // where it is.
+    // or square lattice, its rows along the sensor's x or y axis, not tilted, no manufacturing
+    // errors): measure only the lenses of the quarter x >= 0, y >= 0 of the array's frame, and give
+    // every other lens the microimage of its mirror image there, mirrored (the camera and the cell
+    // rule are symmetric under those mirrors, so this is what measuring the lens gives, to
+    // rounding). false: each lens measured where it is.
     bool symmetry = true;
 };
 
@@ -96,9 +96,9 @@ struct MicroimageWork {
     std::size_t anchors = 0;       // lenses measured as anchors (0: no interpolation)
     std::size_t interpolated = 0;  // lenses of the picture interpolated between anchors
     std::size_t measured = 0;      // lenses of the picture measured each
-    // With MicroimageOptions::symmetry in use: the lenses actually measured (wedge lenses, for the
+    // With MicroimageOptions::symmetry in use: the lenses actually measured (quarter lenses, for the
     // anchors and the lenses measured each); 0 otherwise.
-    std::size_t wedge_lenses = 0;
+    std::size_t quarter_lenses = 0;
 };
 std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& model, const MicroimageOptions& options,
                                               const MicroimageProgress& progress = MicroimageProgress(),

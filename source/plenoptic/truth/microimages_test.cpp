@@ -489,18 +489,19 @@ TEST(MicroimageTruth, RefractingLensesBetweenAnchorsAgreeWithMeasuringThem)
     }
 }
 
-// Refracting microlenses on an array whose lens (0, 0) sits on the axis: the camera maps onto itself
-// under the lattice's turns by 60 degrees about that lens and its mirrors, so the truth measures the
-// lenses of one wedge and gives every other lens the image of its wedge lens's microimage
-// (MicroimageOptions::symmetry). One orbit of twelve lenses, found here from the lattice's own
-// geometry (lens centres turned and mirrored), behind the vignetting triplet where it cuts the
-// microimages: (1) the truth's twelve microimages are the images of one another, to rounding (which
-// map takes which lens); (2) each lens measured where it is (symmetry off) agrees with that within
-// the 24 x 24 cell rule's own error, and at 48 x 48 cell points two lenses of the orbit measured
-// where they are are each other's images within 0.001 px: the symmetry is the camera's;
-// (3) the same with the array turned about the axis (its rows, and so its mirrors, turned);
-// (4) an array moved off the axis is measured lens by lens (the option changes nothing).
-TEST(MicroimageTruth, RefractingMicroimagesAreImagesOfTheirWedgeLenses)
+// Refracting microlenses on an array whose lens (0, 0) sits on the axis: the camera, and the truth's
+// own rule, map onto themselves under the mirrors in the array's x and y axes, so the truth measures
+// the lenses of the quarter x >= 0, y >= 0 and gives each other lens its image's microimage,
+// mirrored (MicroimageOptions::symmetry). Four lenses that are each other's mirror images, found
+// here from the lattice's geometry, behind the vignetting triplet where it cuts the microimages:
+// (1) their microimages as the truth gives them are each other's mirror images, to rounding;
+// (2) each lens measured where it is (symmetry off) gives the same microimage within 1e-6 px and
+// 1e-9 of lit fraction (the rule is symmetric too), where a lens's offset from its lattice centre,
+// which a wrong mirror would turn, is some 0.4 px; (3) the same with the array turned about the
+// axis by 90 degrees (its mirrors the sensor's y and x); (4) an array moved off the axis, or turned
+// by 10 degrees (whose mirrors are not the rule's: it lays its grids and directions out in pixels),
+// is measured lens by lens (the option changes nothing).
+TEST(MicroimageTruth, RefractingMicroimagesAreMirrorImagesOfTheirQuarterLenses)
 {
     const Prescription lens = vignetting_triplet();
     const ImageDistance focus = paraxial_image_distance(lens, 3000);
@@ -520,39 +521,35 @@ TEST(MicroimageTruth, RefractingMicroimagesAreImagesOfTheirWedgeLenses)
     params.array.refracting.substrate_mm = 0.05;
     params.array.distance_mm = 0.85 - 0.08 / 1.5;
     params.array.baffles = true;
-    const double turn_deg[2] = {0, 10};
+    const double turn_deg[2] = {0, 90};
     for (double turned : turn_deg) {
         CameraParams p = params;
         p.array.rotate_deg[2] = turned;
         const PlenopticCamera camera = with_film(make_camera(p), 40, 40);
         const GridType grid = GridType::Hexagonal;
         const double pitch = 0.25, psi = turned * kPi / 180;
-        // A lens 12 degrees from the rows, 9.7 mm from the axis, and its orbit: mirrored in the rows
-        // (y -> -y) or not, then turned by t 60 degrees, in the array's own frame.
-        const LensIndex seed{38, 10};
+        // A lens on an odd row (its mirror in x is not its own column), 9.6 mm from the axis, and its
+        // mirror images in the array's own frame.
+        const LensIndex seed{37, 11};
         const Vec2 c = lens_centre(grid, pitch, seed);
-        std::vector<LensIndex> orbit;
-        std::vector<std::pair<int, bool>> maps;
-        for (int mirrored = 0; mirrored < 2; ++mirrored)
-            for (int t = 0; t < 6; ++t) {
-                const double a = t * kPi / 3, y = mirrored ? -c.y : c.y;
-                const Vec2 q{std::cos(a) * c.x - std::sin(a) * y, std::sin(a) * c.x + std::cos(a) * y};
-                const LensIndex l = nearest_lens(grid, pitch, q.x, q.y);
-                const Vec2 back = lens_centre(grid, pitch, l);
-                ASSERT_NEAR(back.x, q.x, 1e-9);
-                ASSERT_NEAR(back.y, q.y, 1e-9);
-                orbit.push_back(l);
-                maps.push_back(std::make_pair(t, mirrored != 0));
-            }
+        std::vector<LensIndex> images;
+        const double signs[4][2] = {{1, 1}, {-1, 1}, {1, -1}, {-1, -1}};
+        for (const auto& sign : signs) {
+            const LensIndex l = nearest_lens(grid, pitch, sign[0] * c.x, sign[1] * c.y);
+            const Vec2 back = lens_centre(grid, pitch, l);
+            ASSERT_NEAR(back.x, sign[0] * c.x, 1e-12);
+            ASSERT_NEAR(back.y, sign[1] * c.y, 1e-12);
+            images.push_back(l);
+        }
         MicroimageOptions symmetric = default_microimage_options();
         symmetric.threads = 2;
         MicroimageOptions each = symmetric;
         each.symmetry = false;
-        const std::vector<MicroimageTruth> a = measured_microimages(camera, orbit, symmetric);
-        const std::vector<MicroimageTruth> b = measured_microimages(camera, orbit, each);
-        ASSERT_EQ(a.size(), orbit.size());
-        ASSERT_EQ(b.size(), orbit.size());
-        // The seed's microimage centroid in the array's frame (optics frame turned back by psi).
+        const std::vector<MicroimageTruth> a = measured_microimages(camera, images, symmetric);
+        const std::vector<MicroimageTruth> b = measured_microimages(camera, images, each);
+        ASSERT_EQ(a.size(), images.size());
+        ASSERT_EQ(b.size(), images.size());
+        // A centroid in the array's frame (the optics frame turned back by psi).
         auto local = [&](const MicroimageTruth& t) {
             const Vec3 q = camera.sensor.point(t.u_px + 0.5, t.v_px + 0.5);
             return Vec2{std::cos(psi) * q.x + std::sin(psi) * q.y, -std::sin(psi) * q.x + std::cos(psi) * q.y};
@@ -560,58 +557,42 @@ TEST(MicroimageTruth, RefractingMicroimagesAreImagesOfTheirWedgeLenses)
         ASSERT_TRUE(a[0].lit);
         const Vec2 s0 = local(a[0]);
         double worst_map = 0, worst_each = 0, worst_fraction = 0, spread = 0;
-        for (std::size_t i = 0; i < orbit.size(); ++i) {
+        for (std::size_t i = 0; i < images.size(); ++i) {
             ASSERT_TRUE(a[i].lit && b[i].lit) << i;
-            const double ang = maps[i].first * kPi / 3, y = maps[i].second ? -s0.y : s0.y;
-            const Vec2 expected{std::cos(ang) * s0.x - std::sin(ang) * y, std::sin(ang) * s0.x + std::cos(ang) * y};
             const Vec2 got = local(a[i]);
-            worst_map = std::max(worst_map, std::hypot(got.x - expected.x, got.y - expected.y) / 0.025);
-            EXPECT_NEAR(a[i].lit_fraction, a[0].lit_fraction, 1e-12) << i;
+            worst_map = std::max(worst_map, std::hypot(got.x - signs[i][0] * s0.x, got.y - signs[i][1] * s0.y) / 0.025);
+            EXPECT_EQ(a[i].lit_fraction, a[0].lit_fraction) << i;
             worst_each = std::max(worst_each, std::max(std::fabs(a[i].u_px - b[i].u_px), std::fabs(a[i].v_px - b[i].v_px)));
             worst_fraction = std::max(worst_fraction, std::fabs(a[i].lit_fraction - b[i].lit_fraction));
-            // How far the lens's microimage lies from its lattice centre: what a wrong map would move.
-            const MicroimageCentre centre = microimage_centre_px(camera, orbit[i]);
+            // How far the microimage lies from the lens's lattice centre: what a wrong mirror would move.
+            const MicroimageCentre centre = microimage_centre_px(camera, images[i]);
             spread = std::max(spread, std::hypot(a[i].u_px - centre.u, a[i].v_px - centre.v));
         }
-        EXPECT_LT(worst_map, 1e-6) << turned;
-        // (Measured: the 24 x 24 rule's own error in this set-up; a lens measured where it is and as
-        // its wedge lens's image differ by it, far less than the offsets a wrong map would move.)
-        EXPECT_LT(worst_each, 5e-3) << turned;
-        EXPECT_LT(worst_fraction, 1e-3) << turned;
-        EXPECT_GT(spread, 20 * worst_each) << turned;
-        // Finer, two lenses measured where they are: each other's images.
-        MicroimageOptions fine = each;
-        fine.refracting_points = 48;
-        const std::vector<LensIndex> two = {orbit[0], orbit[7]};  // the seed; mirrored and turned by 60 degrees
-        const std::vector<MicroimageTruth> f = measured_microimages(camera, two, fine);
-        ASSERT_EQ(f.size(), 2u);
-        const Vec2 f0 = local(f[0]), f1 = local(f[1]);
-        const double ang = kPi / 3;
-        const Vec2 expected{std::cos(ang) * f0.x + std::sin(ang) * f0.y, std::sin(ang) * f0.x - std::cos(ang) * f0.y};
-        const double fine_apart = std::hypot(f1.x - expected.x, f1.y - expected.y) / 0.025;
-        const Vec2 c0 = local(b[0]), c7 = local(b[7]);
-        const Vec2 coarse_expected{std::cos(ang) * c0.x + std::sin(ang) * c0.y, std::sin(ang) * c0.x - std::cos(ang) * c0.y};
-        const double coarse_apart = std::hypot(c7.x - coarse_expected.x, c7.y - coarse_expected.y) / 0.025;
-        EXPECT_LT(fine_apart, 1e-3) << turned;
-        std::printf("array turned %g deg: orbit of 12 lenses, map %.2g px; measured where they are: within %.2g px and "
-                    "%.2g of lit fraction (offsets up to %.3g px); a mirrored pair %.2g px apart at 24 x 24, %.2g px "
-                    "at 48 x 48\n",
-                    turned, worst_map, worst_each, worst_fraction, spread, coarse_apart, fine_apart);
+        EXPECT_LT(worst_map, 1e-9) << turned;
+        EXPECT_LT(worst_each, 1e-6) << turned;
+        EXPECT_LT(worst_fraction, 1e-9) << turned;
+        EXPECT_GT(spread, 0.1) << turned;
+        std::printf("array turned %g deg: 4 mirror images, mirrored to %.2g px; measured where they are: within %.2g px "
+                    "and %.2g of lit fraction (offsets from the lattice up to %.3g px)\n",
+                    turned, worst_map, worst_each, worst_fraction, spread);
     }
-    // Off the axis: no symmetry to use.
-    CameraParams moved = params;
+    // Off the axis, or turned by 10 degrees: no symmetry used.
+    CameraParams moved = params, turned = params;
     moved.array.translate_mm[0] = 0.08;
-    const PlenopticCamera camera = with_film(make_camera(moved), 40, 40);
-    MicroimageOptions with = default_microimage_options(), without = with;
-    without.symmetry = false;
-    const std::vector<LensIndex> lenses = {LensIndex{38, 10}, LensIndex{-38, -10}, LensIndex{10, 38}};
-    const std::vector<MicroimageTruth> x = measured_microimages(camera, lenses, with);
-    const std::vector<MicroimageTruth> y = measured_microimages(camera, lenses, without);
-    ASSERT_EQ(x.size(), y.size());
-    for (std::size_t i = 0; i < x.size(); ++i) {
-        EXPECT_EQ(x[i].u_px, y[i].u_px);
-        EXPECT_EQ(x[i].v_px, y[i].v_px);
-        EXPECT_EQ(x[i].lit_fraction, y[i].lit_fraction);
+    turned.array.rotate_deg[2] = 10;
+    for (const CameraParams& p : {moved, turned}) {
+        const PlenopticCamera camera = with_film(make_camera(p), 40, 40);
+        MicroimageOptions with = default_microimage_options(), without = with;
+        without.symmetry = false;
+        const std::vector<LensIndex> lenses = {LensIndex{37, 11}, LensIndex{-38, 11}, LensIndex{37, -11}};
+        const std::vector<MicroimageTruth> x = measured_microimages(camera, lenses, with);
+        const std::vector<MicroimageTruth> y = measured_microimages(camera, lenses, without);
+        ASSERT_EQ(x.size(), y.size());
+        for (std::size_t i = 0; i < x.size(); ++i) {
+            EXPECT_EQ(x[i].u_px, y[i].u_px);
+            EXPECT_EQ(x[i].v_px, y[i].v_px);
+            EXPECT_EQ(x[i].lit_fraction, y[i].lit_fraction);
+        }
     }
 }
 
