@@ -742,6 +742,12 @@ private:
     double frame_[2] = {1, 0};  // cos, sin of the array's turn
 };
 
+// A lens as a key of the maps of measured lenses.
+std::uint64_t anchor_key(LensIndex lens)
+{
+    return (std::uint64_t(lens.k) << 32) ^ (std::uint64_t(lens.l) & 0xffffffffull);
+}
+
 // measure_lenses, with the camera's symmetry where it holds: each lens of `out` takes the microimage
 // of its quarter lens, those measured once each (and kept in `cache`, by lens, for later calls).
 bool measure_symmetric(const PlenopticCamera& m, const PlenopticCamera& light, const MicroimageOptions& options,
@@ -752,7 +758,6 @@ bool measure_symmetric(const PlenopticCamera& m, const PlenopticCamera& light, c
     const Symmetry symmetry(m, light, options);
     if (!symmetry.valid())
         return measure_lenses(m, light, options, out, step, progress, cancelled, lobes);
-    auto key = [](LensIndex lens) { return (std::uint64_t(lens.k) << 32) ^ (std::uint64_t(lens.l) & 0xffffffffull); };
     std::unordered_map<std::uint64_t, std::pair<MicroimageTruth, char>> local;
     std::unordered_map<std::uint64_t, std::pair<MicroimageTruth, char>>& known = cache ? *cache : local;
     struct Map {
@@ -766,7 +771,7 @@ bool measure_symmetric(const PlenopticCamera& m, const PlenopticCamera& light, c
         for (std::size_t i = 0; i < out.size(); ++i) {
             Map& map = maps[i];
             map.quarter = Symmetry::quarter_lens(m.array, out[i].lens, &map.mirror_x, &map.mirror_y);
-            const std::uint64_t k = key(map.quarter);
+            const std::uint64_t k = anchor_key(map.quarter);
             if (known.count(k) == 0 && seen.emplace(k, 1).second) {
                 MicroimageTruth t = MicroimageTruth();
                 t.lens = map.quarter;
@@ -782,11 +787,11 @@ bool measure_symmetric(const PlenopticCamera& m, const PlenopticCamera& light, c
     if (!measure_lenses(m, light, options, wanted, step, progress, cancelled, &wanted_lobes))
         return false;
     for (std::size_t i = 0; i < wanted.size(); ++i)
-        known[key(wanted[i].lens)] = std::make_pair(wanted[i], wanted_lobes[i]);
+        known[anchor_key(wanted[i].lens)] = std::make_pair(wanted[i], wanted_lobes[i]);
     if (lobes)
         lobes->assign(out.size(), 0);
     for (std::size_t i = 0; i < out.size(); ++i) {
-        const std::pair<MicroimageTruth, char>& found = known.at(key(maps[i].quarter));
+        const std::pair<MicroimageTruth, char>& found = known.at(anchor_key(maps[i].quarter));
         const LensIndex lens = out[i].lens;
         out[i] = found.first;
         out[i].lens = lens;
@@ -850,11 +855,6 @@ struct AnchorValue {
     // (region_moments).
     bool lobe;
 };
-
-std::uint64_t anchor_key(LensIndex lens)
-{
-    return (std::uint64_t(lens.k) << 32) ^ (std::uint64_t(lens.l) & 0xffffffffull);
-}
 
 // The anchors of one level: lenses (K step, L step), K = k0 .. k1, L = l0 .. l1, those measured
 // in `values`.

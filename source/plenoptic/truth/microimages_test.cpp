@@ -346,6 +346,32 @@ TEST(MicroimageTruth, ReusingNeighboursAgreesFromScratchForRefractingAndTiltedLe
     }
 }
 
+// Refracting microlenses behind the vignetting triplet focused at 3000 mm: hexagonal, pitch 0.25 mm,
+// pixels of 0.025 mm, caps of R = 0.425 mm (n 1.5, 0.03 mm on 0.05 mm of substrate, the curved side
+// to the scene) whose paraxial focal length, 0.85 mm, is the array's f; the sensor at their back
+// focal distance, f - L / n from the flat back (curved side to the sensor: f from the caps' vertex
+// plane, whose principal plane is that vertex).
+CameraParams refracting_behind_triplet()
+{
+    const Prescription lens = vignetting_triplet();
+    const ImageDistance focus = paraxial_image_distance(lens, 3000);
+    CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.25, 0.85, 0.85, 50, 4, focus.mm);
+    params.main.type = MainLensType::Prescription;
+    params.main.has_focal_length = false;
+    params.main.has_f_number = false;
+    params.main.has_prescription = true;
+    params.main.prescription = lens;
+    params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.025;
+    params.array.lens = MicrolensType::Refracting;
+    params.array.focal_length_count = 0;
+    params.array.refracting.radius_mm = 0.425;
+    params.array.refracting.ior = 1.5;
+    params.array.refracting.cap_mm = 0.03;
+    params.array.refracting.substrate_mm = 0.05;
+    params.array.distance_mm = 0.85 - 0.08 / 1.5;
+    return params;
+}
+
 // Refracting microlenses on an array without errors: the lenses between anchors (every fourth lens
 // of every fourth row here) are interpolated. Every lens checked must agree with measuring it
 // (measured_microimages, what anchor_step 0 gives) within 0.001 px and 1e-4 of lit fraction, with
@@ -354,32 +380,14 @@ TEST(MicroimageTruth, ReusingNeighboursAgreesFromScratchForRefractingAndTiltedLe
 // same bits as anchor_step 0.
 TEST(MicroimageTruth, RefractingLensesBetweenAnchorsAgreeWithMeasuringThem)
 {
-    const Prescription lens = vignetting_triplet();
-    const ImageDistance focus = paraxial_image_distance(lens, 3000);
-    ASSERT_TRUE(focus.real);
+    ASSERT_TRUE(paraxial_image_distance(vignetting_triplet(), 3000).real);
     // Lenses a quarter of the other tests' (pitch 0.25 mm, 10 pixels of 0.025 mm), so that anchors
     // four lenses apart are 1 mm apart in the triplet's field, as sixteen Lytro-class lenses are a
     // thirtieth of that camera's field; the picture (240 x 208 pixels, 6 x 5.2 mm) lies towards
     // the corner of the field, where the triplet vignettes.
-    CameraParams scene_side = plenoptic_camera(GridType::Hexagonal, 0.25, 0.85, 0.85, 50, 4, focus.mm);
-    scene_side.main.type = MainLensType::Prescription;
-    scene_side.main.has_focal_length = false;
-    scene_side.main.has_f_number = false;
-    scene_side.main.has_prescription = true;
-    scene_side.main.prescription = lens;
-    scene_side.sensor.pixel_size_mm[0] = scene_side.sensor.pixel_size_mm[1] = 0.025;
+    CameraParams scene_side = refracting_behind_triplet();
     scene_side.sensor.offset_mm[0] = 9;
     scene_side.sensor.offset_mm[1] = 7;
-    // Caps of the same paraxial focal length (R = f (n - 1)); the sensor at their back focal
-    // distance: f - L / n from the flat back (curved side to the scene), f from the caps' vertex
-    // plane (curved side to the sensor, whose principal plane is that vertex).
-    scene_side.array.lens = MicrolensType::Refracting;
-    scene_side.array.focal_length_count = 0;
-    scene_side.array.refracting.radius_mm = 0.425;
-    scene_side.array.refracting.ior = 1.5;
-    scene_side.array.refracting.cap_mm = 0.03;
-    scene_side.array.refracting.substrate_mm = 0.05;
-    scene_side.array.distance_mm = 0.85 - 0.08 / 1.5;
     // Without baffles light that leaves a cell in the glass goes on in the neighbour's; with caps
     // towards the scene thin lobes of it, apart from the lens's own light, are counted at the cell
     // points near the cell's edge whose own light is gone, and the lenses whose anchors count any
@@ -503,23 +511,8 @@ TEST(MicroimageTruth, RefractingLensesBetweenAnchorsAgreeWithMeasuringThem)
 // is measured lens by lens (the option changes nothing).
 TEST(MicroimageTruth, RefractingMicroimagesAreMirrorImagesOfTheirQuarterLenses)
 {
-    const Prescription lens = vignetting_triplet();
-    const ImageDistance focus = paraxial_image_distance(lens, 3000);
-    ASSERT_TRUE(focus.real);
-    CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.25, 0.85, 0.85, 50, 4, focus.mm);
-    params.main.type = MainLensType::Prescription;
-    params.main.has_focal_length = false;
-    params.main.has_f_number = false;
-    params.main.has_prescription = true;
-    params.main.prescription = lens;
-    params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.025;
-    params.array.lens = MicrolensType::Refracting;
-    params.array.focal_length_count = 0;
-    params.array.refracting.radius_mm = 0.425;
-    params.array.refracting.ior = 1.5;
-    params.array.refracting.cap_mm = 0.03;
-    params.array.refracting.substrate_mm = 0.05;
-    params.array.distance_mm = 0.85 - 0.08 / 1.5;
+    ASSERT_TRUE(paraxial_image_distance(vignetting_triplet(), 3000).real);
+    CameraParams params = refracting_behind_triplet();
     params.array.baffles = true;
     const double turn_deg[2] = {0, 90};
     for (double turned : turn_deg) {
