@@ -439,11 +439,7 @@ TEST(Optics, OverlapPruningNeverDropsALensThatDeliversLight)
     // Behind a traced lens (pupil bounds decide), lenses displaced along the normal and tilted.
     const Prescription triplet = test::vignetting_triplet();
     CameraParams real = plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 4, paraxial_image_distance(triplet, 3000).mm);
-    real.main.type = MainLensType::Prescription;
-    real.main.has_focal_length = false;
-    real.main.has_f_number = false;
-    real.main.has_prescription = true;
-    real.main.prescription = triplet;
+    test::use_prescription(&real, triplet);
     real.array.has_errors = true;
     real.array.errors.position_sd_mm = 0.004;
     real.array.errors.position_sd_z_mm = 0.005;
@@ -456,12 +452,7 @@ TEST(Optics, OverlapPruningNeverDropsALensThatDeliversLight)
     // pruning keeps is not asserted (with tilted lenses it keeps all of them).
     for (bool scene_side : {true, false}) {
         CameraParams refracting = plenoptic_camera(GridType::Hexagonal, 0.1, 0.16, 0.2, 50, 2.5, 50);
-        refracting.array.lens = MicrolensType::Refracting;
-        refracting.array.focal_length_count = 0;
-        refracting.array.refracting.radius_mm = 0.08;
-        refracting.array.refracting.ior = 1.5;
-        refracting.array.refracting.cap_mm = 0.025;
-        refracting.array.refracting.substrate_mm = 0.2;
+        test::use_refracting_caps(&refracting, 0.08, 1.5, 0.025, 0.2);
         refracting.array.refracting.curved_towards_scene = scene_side;
         const std::string name = std::string("refracting caps towards the ") + (scene_side ? "scene" : "sensor");
         check_overlap_pruning(name.c_str(), refracting, 1.01);

@@ -88,6 +88,28 @@ inline CameraParams plenoptic_camera(GridType grid, double pitch_mm, double micr
     return p;
 }
 
+// The main lens made a traced prescription (in place of plenoptic_camera's thin lens).
+inline void use_prescription(CameraParams* p, const Prescription& lens)
+{
+    p->main.type = MainLensType::Prescription;
+    p->main.has_focal_length = false;
+    p->main.has_f_number = false;
+    p->main.has_prescription = true;
+    p->main.prescription = lens;
+}
+
+// Refracting microlenses in place of the array's thin ones: plano-convex caps of radius R and index n,
+// cap_mm tall on substrate_mm of glass (the curved side to the scene unless the caller turns it).
+inline void use_refracting_caps(CameraParams* p, double radius_mm, double ior, double cap_mm, double substrate_mm)
+{
+    p->array.lens = MicrolensType::Refracting;
+    p->array.focal_length_count = 0;
+    p->array.refracting.radius_mm = radius_mm;
+    p->array.refracting.ior = ior;
+    p->array.refracting.cap_mm = cap_mm;
+    p->array.refracting.substrate_mm = substrate_mm;
+}
+
 inline void set_pose(CameraParams* p, double rx, double ry, double rz, double tx, double ty, double tz)
 {
     p->array.rotate_deg[0] = rx;

@@ -151,11 +151,7 @@ TEST(TracedProjection, AWeakSingletImagesWhereTheThinLensDoes)
     const double front_h = L - p.front_principal_z, rear_h = L - p.rear_principal_z;
     const double D = 2100;  // behind the rear vertex (the stop)
     CameraParams real = plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 2000, 100, D);
-    real.main.type = MainLensType::Prescription;
-    real.main.has_focal_length = false;
-    real.main.has_f_number = false;
-    real.main.has_prescription = true;
-    real.main.prescription = lens;
+    test::use_prescription(&real, lens);
     CameraParams thin = plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, p.efl_mm, p.efl_mm / p.exit_pupil_mm, D + rear_h);
     for (CameraParams* c : {&real, &thin}) {
         c->sensor.pixel_size_mm[0] = c->sensor.pixel_size_mm[1] = 0.01;

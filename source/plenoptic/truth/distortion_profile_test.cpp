@@ -128,11 +128,7 @@ TEST(DistortionProfile, ChannelsOfADispersingSingletFollowTheParaxialChiefRayAtT
     Prescription lens = singlet_with_stop(20);
     lens.surfaces[1].glass.abbe = 20;
     CameraParams p = thin_lens_camera(50, 4, 0);
-    p.main.type = MainLensType::Prescription;
-    p.main.has_focal_length = false;
-    p.main.has_f_number = false;
-    p.main.has_prescription = true;
-    p.main.prescription = lens;
+    test::use_prescription(&p, lens);
     p.main.distance_mm = paraxial_image_distance(lens, 2000).mm;
     p.sensor.pixel_size_mm[0] = p.sensor.pixel_size_mm[1] = 0.02;
     const PlenopticCamera d_line = with_film(make_camera(p), 1500, 1000);

@@ -90,11 +90,7 @@ CameraParams triplet_pinholes_camera()
     const Prescription lens = vignetting_triplet();
     CameraParams params = plenoptic_camera(GridType::Rectangular, 2.5, 0, 8.5, 50, 4,
                                            paraxial_image_distance(lens, 3000).mm);
-    params.main.type = MainLensType::Prescription;
-    params.main.has_focal_length = false;
-    params.main.has_f_number = false;
-    params.main.has_prescription = true;
-    params.main.prescription = lens;
+    test::use_prescription(&params, lens);
     params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.5;
     return params;
 }
@@ -161,11 +157,7 @@ TEST(MicroimageTruth, ThinMicrolensesConvergeInApertureAndThreadsDoNotMatter)
     const ImageDistance focus = paraxial_image_distance(lens, 3000);
     ASSERT_TRUE(focus.real);
     CameraParams params = plenoptic_camera(GridType::Hexagonal, 2.5, 8.5, 8.5, 50, 4, focus.mm);
-    params.main.type = MainLensType::Prescription;
-    params.main.has_focal_length = false;
-    params.main.has_f_number = false;
-    params.main.has_prescription = true;
-    params.main.prescription = lens;
+    test::use_prescription(&params, lens);
     params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.5;
     const PlenopticCamera m = make_camera(params);
     const int W = 120, H = 120;
@@ -204,11 +196,7 @@ TEST(MicroimageTruth, ReusingNeighboursAgreesWithEveryLensFromScratch)
     const ImageDistance focus = paraxial_image_distance(lens, 3000);
     ASSERT_TRUE(focus.real);
     CameraParams thin = plenoptic_camera(GridType::Hexagonal, 1.0, 3.4, 3.4, 50, 4, focus.mm);
-    thin.main.type = MainLensType::Prescription;
-    thin.main.has_focal_length = false;
-    thin.main.has_f_number = false;
-    thin.main.has_prescription = true;
-    thin.main.prescription = lens;
+    test::use_prescription(&thin, lens);
     thin.sensor.pixel_size_mm[0] = thin.sensor.pixel_size_mm[1] = 0.1;
     CameraParams ideal = plenoptic_camera(GridType::Rectangular, 0.2, 0.8, 0.8, 50, 8, 52);
     ideal.sensor.pixel_size_mm[0] = ideal.sensor.pixel_size_mm[1] = 0.01;
@@ -274,11 +262,7 @@ TEST(MicroimageTruth, ReusingNeighboursAgreesFromScratchForRefractingAndTiltedLe
     const ImageDistance focus = paraxial_image_distance(lens, 3000);
     ASSERT_TRUE(focus.real);
     CameraParams thin = plenoptic_camera(GridType::Hexagonal, 1.0, 3.4, 3.4, 50, 4, focus.mm);
-    thin.main.type = MainLensType::Prescription;
-    thin.main.has_focal_length = false;
-    thin.main.has_f_number = false;
-    thin.main.has_prescription = true;
-    thin.main.prescription = lens;
+    test::use_prescription(&thin, lens);
     thin.sensor.pixel_size_mm[0] = thin.sensor.pixel_size_mm[1] = 0.1;
     CameraParams tilted = thin;
     tilted.array.has_errors = true;
@@ -290,12 +274,7 @@ TEST(MicroimageTruth, ReusingNeighboursAgreesFromScratchForRefractingAndTiltedLe
     // Plano-convex caps of the same paraxial focal length (R = f (n - 1)), the curved side towards
     // the scene, the sensor at their back focal distance f - L / n from the flat face.
     CameraParams refracting = thin;
-    refracting.array.lens = MicrolensType::Refracting;
-    refracting.array.focal_length_count = 0;
-    refracting.array.refracting.radius_mm = 1.7;
-    refracting.array.refracting.ior = 1.5;
-    refracting.array.refracting.cap_mm = 0.12;
-    refracting.array.refracting.substrate_mm = 0.2;
+    test::use_refracting_caps(&refracting, 1.7, 1.5, 0.12, 0.2);
     refracting.array.distance_mm = 3.4 - 0.32 / 1.5;
     CameraParams refracting_errors = refracting;
     refracting_errors.array.has_errors = true;
@@ -356,18 +335,9 @@ CameraParams refracting_behind_triplet()
     const Prescription lens = vignetting_triplet();
     const ImageDistance focus = paraxial_image_distance(lens, 3000);
     CameraParams params = plenoptic_camera(GridType::Hexagonal, 0.25, 0.85, 0.85, 50, 4, focus.mm);
-    params.main.type = MainLensType::Prescription;
-    params.main.has_focal_length = false;
-    params.main.has_f_number = false;
-    params.main.has_prescription = true;
-    params.main.prescription = lens;
+    test::use_prescription(&params, lens);
     params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.025;
-    params.array.lens = MicrolensType::Refracting;
-    params.array.focal_length_count = 0;
-    params.array.refracting.radius_mm = 0.425;
-    params.array.refracting.ior = 1.5;
-    params.array.refracting.cap_mm = 0.03;
-    params.array.refracting.substrate_mm = 0.05;
+    test::use_refracting_caps(&params, 0.425, 1.5, 0.03, 0.05);
     params.array.distance_mm = 0.85 - 0.08 / 1.5;
     return params;
 }
