@@ -7,14 +7,19 @@
 // --array 0.02 0.04 0.031 --refracting 0.02 0.004 0.01 1.5). The still life of
 // scenes/plenoptic_scene.inc. Thin=1 renders the thin microlenses the caps stand for instead
 // (f = d = 0.04 mm, the caps' paraxial focal length: the Lytro-class camera of BENCHMARKS.md
-// "Microimage truth"). From the repository root (Samples: the camera's samples [16]):
+// "Microimage truth"). Turn (degrees) and Shift_X, Shift_Y (mm) turn the array about the axis and
+// move it across (rotate <0, 0, Turn> translate <Shift_X, Shift_Y, 0>; [0]). From the repository
+// root (Samples: the camera's samples [16]):
 //   build/povray +Ibenchmarks/refracting_raw_41mpx.pov +Lscenes +Llenses +W7728 +H5368 \
-//       +Orefracting_41mpx.png [Declare=Samples=1] [Declare=Thin=1]
+//       +Orefracting_41mpx.png [Declare=Samples=1] [Declare=Thin=1] [Declare=Turn=0.2 ...]
 #version 3.7;
 global_settings { assumed_gamma 1.0 }
 #include "plenoptic_scene.inc"
 #ifndef (Samples) #declare Samples = 16; #end
 #ifndef (Thin) #declare Thin = 0; #end
+#ifndef (Turn) #declare Turn = 0; #end
+#ifndef (Shift_X) #declare Shift_X = 0; #end
+#ifndef (Shift_Y) #declare Shift_Y = 0; #end
 camera {
   plenoptic
   location Scene_Location
@@ -40,6 +45,8 @@ camera {
       }
       distance 0.031                 // the caps' back focal distance, mm
     #end
+    rotate <0, 0, Turn>
+    translate <Shift_X, Shift_Y, 0>
   }
   sensor { pixel_size 0.0014 }
   samples Samples

@@ -9,18 +9,21 @@
 //   plenoptic_microimage_truth --lens-file FILE --f-number N --focus-distance Z
 //       --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--thick] [--offset X_MM Y_MM] [--threads T]
 //       [--errors S F R SEED] [--refracting R CAP SUBSTRATE IOR] [--caps-to-sensor] [--reference]
-//       [--every-lens] [--no-symmetry] [--check N] [--csv OUT]
+//       [--every-lens] [--no-symmetry] [--turn DEG] [--shift X_MM Y_MM] [--check N] [--csv OUT]
 //
 // --offset shifts the sensor (sensor { offset }): a crop of a larger raw away from its centre,
-// e.g. its corner. --errors gives the array manufacturing errors (errors { position S focal_length F
-// rotation R seed SEED }). --reference measures every lens from scratch (reuse_neighbours false: the
-// integration as it was before the neighbours' radii were reused). --refracting replaces the thin
+// e.g. its corner. --turn and --shift turn the array about the axis and move it across
+// (microlens_array { rotate <0, 0, DEG> translate <X, Y, 0> }). --errors gives the array
+// manufacturing errors (errors { position S focal_length F rotation R seed SEED }). --reference
+// measures every lens from scratch (reuse_neighbours false: the integration as it was before the
+// neighbours' radii were reused). --refracting replaces the thin
 // microlenses by plano-convex caps (lens { surface { radius R } thickness CAP ior IOR substrate
 // SUBSTRATE }, the curved side towards the scene, or towards the sensor with --caps-to-sensor; F_MM of
 // --array is then unused). Refracting lenses on an array without errors are interpolated between
 // anchors (MicroimageOptions::anchor_step); --every-lens measures every lens instead (anchor_step 0).
 // Refracting lenses on an array centred on the axis are measured in one quarter of it only, the
-// others mirrored (MicroimageOptions::symmetry); --no-symmetry measures each lens where it is.
+// others mirrored (MicroimageOptions::symmetry), and one turned or moved off the axis has its anchors
+// measured in the same array turned back onto the axis; --no-symmetry measures each lens where it is.
 // --check N measures N lenses of the picture each (never interpolated: measured_microimages), drawn
 // at random from a fixed seed, and the picture's four corner lenses, and adds to the JSON the largest
 // differences of the run's answer from theirs (check_du_px, check_dv_px, check_fraction) and the
@@ -53,6 +56,7 @@ struct Options {
     bench::CameraOptions camera;
     double pitch_mm = 0, focal_mm = 0, distance_mm = 0;
     double offset_mm[2] = {0, 0};
+    double turn_deg = 0, shift_mm[2] = {0, 0};
     int threads = 0;
     bool errors = false;
     bool reference = false;
@@ -82,6 +86,11 @@ bool parse(int argc, char** argv, Options* o)
         } else if (arg == "--offset" && left >= 2) {
             o->offset_mm[0] = std::atof(argv[++a]);
             o->offset_mm[1] = std::atof(argv[++a]);
+        } else if (arg == "--turn" && left >= 1) {
+            o->turn_deg = std::atof(argv[++a]);
+        } else if (arg == "--shift" && left >= 2) {
+            o->shift_mm[0] = std::atof(argv[++a]);
+            o->shift_mm[1] = std::atof(argv[++a]);
         } else if (arg == "--threads" && left >= 1)
             o->threads = std::atoi(argv[++a]);
         else if (arg == "--errors" && left >= 4) {
@@ -134,7 +143,8 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "usage: plenoptic_microimage_truth --lens-file FILE --f-number N --focus-distance Z\n"
                              "         --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--thick] [--offset X_MM Y_MM]\n"
                              "         [--threads T] [--errors S F R SEED] [--refracting R CAP SUBSTRATE IOR]\n"
-                             "         [--caps-to-sensor] [--reference] [--every-lens] [--no-symmetry] [--check N] [--csv OUT]\n");
+                             "         [--caps-to-sensor] [--reference] [--every-lens] [--no-symmetry] [--turn DEG]\n"
+                             "         [--shift X_MM Y_MM] [--check N] [--csv OUT]\n");
         return 2;
     }
     Prescription lens;
@@ -157,6 +167,9 @@ int main(int argc, char** argv)
         p.array.refracting.ior = o.refracting_values[3];
         p.array.refracting.curved_towards_scene = !o.caps_to_sensor;
     }
+    p.array.rotate_deg[2] = o.turn_deg;
+    p.array.translate_mm[0] = o.shift_mm[0];
+    p.array.translate_mm[1] = o.shift_mm[1];
     if (o.errors) {
         p.array.has_errors = true;
         p.array.errors.position_sd_mm = o.error_values[0];

@@ -862,11 +862,12 @@ struct Anchors {
     std::int64_t step = 0, k0 = 0, k1 = 0, l0 = 0, l1 = 0;
     const std::unordered_map<std::uint64_t, AnchorValue>* values = nullptr;
 
-    // The first anchor (i0, j0) of the lens's 4 x 4, and where the lens lies in anchor units.
-    void stencil(GridType grid, LensIndex lens, std::int64_t* i0, std::int64_t* j0, double* x, double* y) const
+    // The first anchor (i0, j0) of the 4 x 4 of a lens at `at` (lattice units: X, Y above), and where
+    // it lies in anchor units.
+    void stencil(Vec2 at, std::int64_t* i0, std::int64_t* j0, double* x, double* y) const
     {
-        *x = lattice_x(grid, lens) / double(step);
-        *y = double(lens.l) / double(step);
+        *x = at.x / double(step);
+        *y = at.y / double(step);
         *i0 = std::max(k0, std::min(k1 - 3, std::int64_t(std::floor(*x)) - 1));
         *j0 = std::max(l0, std::min(l1 - 3, std::int64_t(std::floor(*y)) - 1));
     }
@@ -890,11 +891,11 @@ struct Anchors {
 // unit test); where a row of the 24 x 24 cell points begins to count them the centre steps by
 // several thousandths of a pixel from one lens to the next (a step between anchors, which neither
 // the cubic nor its fourth differences see), so lenses whose anchors count any are measured.
-bool interpolate(const Anchors& a, GridType grid, MicroimageTruth* truth, Vec2 lattice_px)
+bool interpolate(const Anchors& a, Vec2 at, MicroimageTruth* truth, Vec2 lattice_px)
 {
     std::int64_t i0, j0;
     double x, y;
-    a.stencil(grid, truth->lens, &i0, &j0, &x, &y);
+    a.stencil(at, &i0, &j0, &x, &y);
     // The anchors it reads, in a 6 x 6 block from (i0 - 1, j0 - 1); null where not read.
     const AnchorValue* block[6][6] = {};
     bool dark = false;
@@ -962,6 +963,95 @@ bool interpolates(const PlenopticCamera& m, const PlenopticCamera& light, const 
            !light.array.errors && (m.array.grid == GridType::Hexagonal || m.array.grid == GridType::Rectangular);
 }
 
+// Where the anchors are measured, and where a lens lies among them. Usually the camera itself, a
+// lens at its lattice point. An ideal refracting array turned about the optical axis by other
+// than a multiple of 90 degrees, or whose lens (0, 0) is off the axis, has no mirror symmetry; but
+// the main lens and the sensor's plane are symmetric under every turn about the axis (every model
+// is), so a lens's microimage is, turned, that of the same lens of the array turned back and moved
+// onto the axis (its canonical pose), where Symmetry holds. The anchors are then measured in that
+// array, and each lens interpolated at the point it occupies there (between lattice points: the
+// cubic is a smooth function of position, as the microimage is of where the lens is), then turned
+// back with the array. The rule's cell points turn with the array, its directions do not (they are
+// laid out in pixels), so the answers are those of the same rule in a turned frame: the same
+// accuracy, not the same bits (BENCHMARKS "The microimage truth by symmetry").
+class Canonical {
+public:
+    Canonical(const PlenopticCamera& m, const PlenopticCamera& light, const MicroimageOptions& options)
+        : m_(m), light_(light)
+    {
+        const ArrayPose& pose = m.array.pose;
+        const bool about_axis = pose.normal.x == 0 && pose.normal.y == 0 && pose.normal.z == 1 && !pose.tilted;
+        auto equal = [](Vec3 a, Vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; };
+        const bool same = equal(light.array.pose.centre_mm, pose.centre_mm) &&
+                          equal(light.array.pose.normal, pose.normal) &&
+                          equal(mul(light.array.pose.rotation, Vec3{1, 0, 0}), mul(pose.rotation, Vec3{1, 0, 0}));
+        if (!options.symmetry || !about_axis || !same || Symmetry(m, light, options).valid())
+            return;
+        const double none[3] = {0, 0, 0};
+        const ArrayPose canonical = make_array_pose(none, Vec3{0, 0, pose.centre_mm.z});
+        model_ = m;
+        model_.array.pose = canonical;
+        light_model_ = light;
+        light_model_.array.pose = canonical;
+        if (!Symmetry(model_, light_model_, options).valid())
+            return;
+        const Vec3 x = mul(pose.rotation, Vec3{1, 0, 0});
+        turn_[0] = x.x;
+        turn_[1] = x.y;
+        active_ = true;
+    }
+    bool active() const { return active_; }
+    // The cameras the anchors are measured in.
+    const PlenopticCamera& model() const { return active_ ? model_ : m_; }
+    const PlenopticCamera& light() const { return active_ ? light_model_ : light_; }
+    // Where the lens lies among those anchors, in lattice units (X, Y above).
+    Vec2 position(LensIndex lens) const
+    {
+        if (!active_)
+            return Vec2{lattice_x(m_.array.grid, lens), double(lens.l)};
+        const Vec2 c = canonical_local(lens);
+        return Vec2{c.x / m_.array.pitch_mm, c.y / m_.array.row_spacing_mm()};
+    }
+    // The lens's lattice centre projected onto the sensor from the exit pupil's centre (pixels,
+    // centre convention) in the anchors' camera: what the interpolated offset is added to.
+    bool centre_px(LensIndex lens, Vec2* px) const
+    {
+        if (!active_) {
+            const MicroimageCentre c = microimage_centre_px(m_, lens);
+            *px = Vec2{c.u, c.v};
+            return c.valid;
+        }
+        const Vec2 c = canonical_local(lens);
+        return project_to_sensor_px(model_, model_.array.to_optics(Vec3{c.x, c.y, 0}), px);
+    }
+    // A sensor point of the anchors' camera (pixels, centre convention) in this camera: turned
+    // about the axis with the array.
+    Vec2 to_camera_px(Vec2 px) const
+    {
+        if (!active_)
+            return px;
+        const Vec3 p = m_.sensor.point(px.x + 0.5, px.y + 0.5);
+        const PixelPoint out = m_.sensor.to_pixel(turn_[0] * p.x - turn_[1] * p.y, turn_[1] * p.x + turn_[0] * p.y);
+        return Vec2{out.u, out.v};
+    }
+
+private:
+    // The lens's lattice point in the canonical array's frame: its place in the optics frame turned
+    // back about the axis.
+    Vec2 canonical_local(LensIndex lens) const
+    {
+        const Vec2 c = m_.array.lattice_centre_local(lens);
+        const Vec3 q = m_.array.to_optics(Vec3{c.x, c.y, 0});
+        return Vec2{turn_[0] * q.x + turn_[1] * q.y, -turn_[1] * q.x + turn_[0] * q.y};
+    }
+
+    const PlenopticCamera& m_;
+    const PlenopticCamera& light_;
+    PlenopticCamera model_, light_model_;
+    bool active_ = false;
+    double turn_[2] = {1, 0};  // cos, sin of the array's turn about the axis
+};
+
 } // namespace
 
 std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const MicroimageOptions& options,
@@ -1028,13 +1118,25 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     // lenses not yet interpolated get the anchors they read (those not measured yet are measured),
     // and are interpolated where those vouch for the cubic; the rest go on to the next level (near
     // where the main lens begins to vignette, the light changes too fast for the coarser anchors).
-    // The lenses left at the end are measured. Every decision depends on the lenses alone.
-    double x_lo = INFINITY, x_hi = -INFINITY;
-    for (const MicroimageTruth& t : out) {
-        x_lo = std::min(x_lo, lattice_x(m.array.grid, t.lens));
-        x_hi = std::max(x_hi, lattice_x(m.array.grid, t.lens));
+    // The lenses left at the end are measured. Every decision depends on the lenses alone. The
+    // anchors are measured in canonical.model() (the camera itself, or its array turned back onto
+    // the axis: Canonical), the lenses left in the camera.
+    const Canonical canonical(m, light, options);
+    const PlenopticCamera& am = canonical.model();
+    const Symmetry anchor_symmetry(am, canonical.light(), options);
+    // Where each lens lies among the anchors; the anchors' range.
+    std::vector<Vec2> at(out.size());
+    double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        at[i] = canonical.position(out[i].lens);
+        x_lo = std::min(x_lo, at[i].x);
+        x_hi = std::max(x_hi, at[i].x);
+        y_lo = std::min(y_lo, at[i].y);
+        y_hi = std::max(y_hi, at[i].y);
     }
-    const std::int64_t l_lo = out.front().lens.l, l_hi = out.back().lens.l;
+    // Quarter lenses measured as anchors in the canonical camera (`known` holds the camera's own).
+    std::unordered_map<std::uint64_t, std::pair<MicroimageTruth, char>> known_canonical;
+    auto& anchor_known = canonical.active() ? known_canonical : known;
     const std::size_t total = out.size();
     std::unordered_map<std::uint64_t, AnchorValue> values;
     std::vector<std::size_t> pending(out.size());  // indices into `out` not yet found
@@ -1056,8 +1158,8 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         anchors.values = &values;
         anchors.k0 = std::int64_t(std::floor(x_lo / double(step))) - 1;
         anchors.k1 = std::int64_t(std::floor(x_hi / double(step))) + 2;
-        anchors.l0 = floor_div(l_lo, step) - 1;
-        anchors.l1 = floor_div(l_hi, step) + 2;
+        anchors.l0 = std::int64_t(std::floor(y_lo / double(step))) - 1;
+        anchors.l1 = std::int64_t(std::floor(y_hi / double(step))) + 2;
         if (anchors.k1 - anchors.k0 < 4 || anchors.l1 - anchors.l0 < 4)
             break;  // fewer than five anchors a side
         // The anchors the pending lenses read that are not measured yet, row by row.
@@ -1068,7 +1170,7 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
             for (std::size_t index : pending) {
                 std::int64_t i0, j0;
                 double x, y;
-                anchors.stencil(m.array.grid, out[index].lens, &i0, &j0, &x, &y);
+                anchors.stencil(at[index], &i0, &j0, &x, &y);
                 anchors.each(i0, j0, [&](std::int64_t i, std::int64_t j) {
                     const LensIndex lens = anchors.lens(i, j);
                     const std::uint64_t key = anchor_key(lens);
@@ -1082,34 +1184,37 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         }
         // Anchors that cost more than measuring the lenses they serve: measure those lenses. (What
         // a set of lenses costs: the lenses to measure for it, the quarter lenses with the symmetry.)
-        auto cost = [&](std::size_t count, const std::function<LensIndex(std::size_t)>& lens_at) {
-            if (!symmetry.valid())
+        auto cost = [&](const Symmetry& sym, const MicrolensArray& array,
+                        const std::unordered_map<std::uint64_t, std::pair<MicroimageTruth, char>>& done,
+                        std::size_t count, const std::function<LensIndex(std::size_t)>& lens_at) {
+            if (!sym.valid())
                 return count;
             std::unordered_map<std::uint64_t, char> seen;
             for (std::size_t i = 0; i < count; ++i) {
                 bool mirror_x, mirror_y;
-                const std::uint64_t key = anchor_key(Symmetry::quarter_lens(m.array, lens_at(i), &mirror_x, &mirror_y));
-                if (known.count(key) == 0)
+                const std::uint64_t key = anchor_key(Symmetry::quarter_lens(array, lens_at(i), &mirror_x, &mirror_y));
+                if (done.count(key) == 0)
                     seen.emplace(key, 1);
             }
             return seen.size();
         };
-        if (4 * cost(measured.size(), [&](std::size_t i) { return measured[i].lens; }) >
-            cost(pending.size(), [&](std::size_t i) { return out[pending[i]].lens; }))
+        if (4 * cost(anchor_symmetry, am.array, anchor_known, measured.size(),
+                     [&](std::size_t i) { return measured[i].lens; }) >
+            cost(symmetry, m.array, known, pending.size(), [&](std::size_t i) { return out[pending[i]].lens; }))
             break;
         std::sort(measured.begin(), measured.end(), [](const MicroimageTruth& p, const MicroimageTruth& q) {
             return p.lens.l != q.lens.l ? p.lens.l < q.lens.l : p.lens.k < q.lens.k;
         });
         std::vector<char> lobes;
-        if (!measure_symmetric(m, light, options, measured, step, share(std::min(level, 1) * total / 4), cancelled,
-                               &lobes, &known)) {
+        if (!measure_symmetric(am, canonical.light(), options, measured, step, share(std::min(level, 1) * total / 4),
+                               cancelled, &lobes, &anchor_known)) {
             out.clear();
             return out;
         }
         counts.anchors += measured.size();
         for (std::size_t n = 0; n < measured.size(); ++n) {
             const MicroimageTruth& t = measured[n];
-            const MicroimageCentre centre = microimage_centre_px(m, t.lens);
+            const MicroimageCentre centre = microimage_centre_px(am, t.lens);
             AnchorValue value;
             value.lobe = lobes[n] != 0;
             value.lit = t.lit && centre.valid;
@@ -1121,9 +1226,15 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         // The lenses left, kept in place (the list is 8 bytes a lens of the picture at first).
         std::size_t left = 0;
         for (std::size_t index : pending) {
-            const MicroimageCentre centre = microimage_centre_px(m, out[index].lens);
-            if (!interpolate(anchors, m.array.grid, &out[index], Vec2{centre.u, centre.v}))
+            Vec2 centre;
+            if (!canonical.centre_px(out[index].lens, &centre) ||
+                !interpolate(anchors, at[index], &out[index], centre)) {
                 pending[left++] = index;
+                continue;
+            }
+            const Vec2 c = canonical.to_camera_px(Vec2{out[index].u_px, out[index].v_px});
+            out[index].u_px = c.x;
+            out[index].v_px = c.y;
         }
         pending.resize(left);
         pending.shrink_to_fit();
@@ -1146,7 +1257,8 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     }
     for (std::size_t i = 0; i < pending.size(); ++i)
         out[pending[i]] = measured[i];
-    counts.quarter_lenses = symmetry.valid() ? known.size() : 0;
+    counts.quarter_lenses = canonical.active() ? known_canonical.size() + pending.size()
+                                               : (symmetry.valid() ? known.size() : 0);
     return out;
 }
 

@@ -67,7 +67,10 @@ struct MicroimageOptions {
     // errors): measure only the lenses of the quarter x >= 0, y >= 0 of the array's frame, and give
     // every other lens the microimage of its mirror image there, mirrored (the camera and the cell
     // rule are symmetric under those mirrors, so this is what measuring the lens gives, to
-    // rounding). false: each lens measured where it is.
+    // rounding). Such an array turned about the axis by other than a multiple of 90 degrees, or
+    // moved across it: its anchors are measured in the same array turned back onto the axis (as
+    // above), each lens interpolated where it sits there and turned back (the same rule in a
+    // turned frame: the same accuracy, not the same bits). false: each lens measured where it is.
     bool symmetry = true;
 };
 
@@ -97,7 +100,8 @@ struct MicroimageWork {
     std::size_t interpolated = 0;  // lenses of the picture interpolated between anchors
     std::size_t measured = 0;      // lenses of the picture measured each
     // With MicroimageOptions::symmetry in use: the lenses actually measured (quarter lenses, for the
-    // anchors and the lenses measured each); 0 otherwise.
+    // anchors and the lenses measured each; on an array turned or moved, the anchors' quarter lenses
+    // on the axis and the lenses measured where they are); 0 otherwise.
     std::size_t quarter_lenses = 0;
 };
 std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& model, const MicroimageOptions& options,

@@ -559,6 +559,85 @@ TEST(MicroimageTruth, RefractingMicroimagesAreMirrorImagesOfTheirQuarterLenses)
     }
 }
 
+// Refracting microlenses on an ideal array turned about the axis by other than a multiple of 90
+// degrees, or moved off it: the anchors are measured in the same array turned back onto the axis
+// (where the mirrors hold), each lens interpolated at the point it occupies there and turned back
+// (Canonical). Against each lens measured where it is, in the camera as it is (an answer that
+// uses neither the turn nor the anchors): the array moved across by a fraction of its pitch agrees
+// within the interpolation's 1e-3 px and 1e-4 of lit fraction; turned, within the rule's own
+// error, since the rule's directions are laid out in pixels and do not turn with the array (a
+// lens and its image turned by 10 degrees, each measured, differ by that much). A wrong turn or
+// shift would move centroids by tenths of a pixel: lenses' offsets from their lattice points
+// reach 0.4 px here, and one lens pitch is 10 px.
+TEST(MicroimageTruth, TurnedOrMovedRefractingArraysTakeTheirAnchorsOnTheAxis)
+{
+    ASSERT_TRUE(paraxial_image_distance(vignetting_triplet(), 3000).real);
+    CameraParams base = refracting_behind_triplet();
+    base.sensor.offset_mm[0] = 9;
+    base.sensor.offset_mm[1] = 7;
+    base.array.baffles = true;
+    struct Case {
+        const char* name;
+        double turn_deg, shift_mm[2];
+        double tolerance_px, tolerance_fraction;
+    };
+    const Case cases[] = {{"moved", 0, {0.08, 0.05}, 1e-3, 1e-4},
+                          {"turned 10 degrees", 10, {0, 0}, 2e-3, 3e-4},
+                          {"turned 0.2 degrees and moved", 0.2, {-0.11, 0.03}, 2e-3, 3e-4}};
+    for (const Case& c : cases) {
+        CameraParams p = base;
+        p.array.rotate_deg[2] = c.turn_deg;
+        p.array.translate_mm[0] = c.shift_mm[0];
+        p.array.translate_mm[1] = c.shift_mm[1];
+        const PlenopticCamera camera = with_film(make_camera(p), 240, 208);
+        MicroimageOptions options = default_microimage_options();
+        options.anchor_step = 4;
+        options.threads = 2;
+        MicroimageWork work;
+        const std::vector<MicroimageTruth> a = microimage_truth(camera, options, MicroimageProgress(),
+                                                                MicroimageCancel(), nullptr, &work);
+        ASSERT_GE(a.size(), 400u) << c.name;
+        EXPECT_GT(work.interpolated, a.size() / 2) << c.name;
+        EXPECT_GT(work.quarter_lenses, 0u) << c.name;  // anchors measured on the axis (0 without Canonical)
+        std::vector<LensIndex> lenses;
+        std::vector<std::size_t> which;
+        std::uint64_t state = 777;
+        for (int i = 0; i < 30; ++i) {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            which.push_back(std::size_t((state >> 33) % a.size()));
+        }
+        which.push_back(0);
+        which.push_back(a.size() - 1);
+        for (std::size_t i : which)
+            lenses.push_back(a[i].lens);
+        MicroimageOptions exact = options;
+        exact.anchor_step = 0;
+        const std::vector<MicroimageTruth> b = measured_microimages(camera, lenses, exact);
+        ASSERT_EQ(b.size(), which.size());
+        double worst_px = 0, worst_fraction = 0, spread = 0;
+        std::size_t lit = 0;
+        for (std::size_t n = 0; n < which.size(); ++n) {
+            const MicroimageTruth& x = a[which[n]];
+            ASSERT_TRUE(x.lens == b[n].lens && x.lit == b[n].lit) << c.name << " " << which[n];
+            worst_fraction = std::max(worst_fraction, std::fabs(x.lit_fraction - b[n].lit_fraction));
+            if (!x.lit)
+                continue;
+            ++lit;
+            worst_px = std::max(worst_px, std::max(std::fabs(x.u_px - b[n].u_px), std::fabs(x.v_px - b[n].v_px)));
+            const MicroimageCentre centre = microimage_centre_px(camera, x.lens);
+            spread = std::max(spread, std::hypot(b[n].u_px - centre.u, b[n].v_px - centre.v));
+        }
+        EXPECT_GT(lit, which.size() / 2) << c.name;
+        EXPECT_LT(worst_px, c.tolerance_px) << c.name;
+        EXPECT_LT(worst_fraction, c.tolerance_fraction) << c.name;
+        EXPECT_GT(spread, 0.1) << c.name;
+        std::printf("%s: %zu lenses, %zu anchors (%zu measured on the axis), %zu interpolated, %zu measured; "
+                    "%zu checked: largest difference %.2g px, lit fraction %.2g (offsets up to %.2f px)\n",
+                    c.name, a.size(), work.anchors, work.quarter_lenses - work.measured, work.interpolated,
+                    work.measured, which.size(), worst_px, worst_fraction, spread);
+    }
+}
+
 TEST(MicroimageTruth, LatticeFitRecoversAGivenLattice)
 {
     const PlenopticCamera m = make_camera(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52));
