@@ -85,6 +85,33 @@ struct LensFileCamera {
     int samples = 1;
 };
 
+// --refracting R CAP SUBSTRATE IOR [--caps-to-sensor]: the array's lenses as plano-convex caps
+// (microlens_array { lens { surface { radius R } thickness CAP ior IOR substrate SUBSTRATE } }),
+// the curved side towards the scene unless caps_to_sensor.
+struct RefractingOption {
+    bool given = false;
+    double radius_mm = 0, cap_mm = 0, substrate_mm = 0, ior = 0;
+    bool caps_to_sensor = false;
+};
+
+// As read_camera_option, for --refracting and --caps-to-sensor.
+inline bool read_refracting_option(int argc, char** argv, int* a, RefractingOption* o)
+{
+    const std::string arg = argv[*a];
+    const int left = argc - *a - 1;
+    if (arg == "--refracting" && left >= 4) {
+        o->given = true;
+        o->radius_mm = std::atof(argv[++*a]);
+        o->cap_mm = std::atof(argv[++*a]);
+        o->substrate_mm = std::atof(argv[++*a]);
+        o->ior = std::atof(argv[++*a]);
+    } else if (arg == "--caps-to-sensor")
+        o->caps_to_sensor = true;
+    else
+        return false;
+    return true;
+}
+
 inline CameraParams camera_params(const LensFileCamera& camera, const Prescription& lens)
 {
     const CameraOptions& c = camera.options;
@@ -113,6 +140,20 @@ inline CameraParams camera_params(const LensFileCamera& camera, const Prescripti
     }
     p.sampling.samples = camera.samples;
     return p;
+}
+
+// The array of *p (an array given) with refracting caps instead of its thin lenses, when given.
+inline void use_refracting(const RefractingOption& r, CameraParams* p)
+{
+    if (!r.given)
+        return;
+    p->array.lens = MicrolensType::Refracting;
+    p->array.focal_length_count = 0;
+    p->array.refracting.radius_mm = r.radius_mm;
+    p->array.refracting.cap_mm = r.cap_mm;
+    p->array.refracting.substrate_mm = r.substrate_mm;
+    p->array.refracting.ior = r.ior;
+    p->array.refracting.curved_towards_scene = !r.caps_to_sensor;
 }
 
 } // namespace bench

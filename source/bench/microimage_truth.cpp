@@ -62,11 +62,9 @@ struct Options {
     bool reference = false;
     bool every_lens = false;
     bool no_symmetry = false;
-    bool caps_to_sensor = false;
     int check = 0;
     int anchor_step = -1, refracting_points = 0, check_points = 0;
-    bool refracting = false;
-    double refracting_values[4] = {0, 0, 0, 0};  // radius, cap, substrate, ior
+    bench::RefractingOption refracting;
     double error_values[3] = {0, 0, 0};
     long long seed = 0;
     std::string csv;
@@ -77,7 +75,8 @@ bool parse(int argc, char** argv, Options* o)
     for (int a = 1; a < argc; ++a) {
         const std::string arg = argv[a];
         const int left = argc - a - 1;
-        if (bench::read_camera_option(argc, argv, &a, &o->camera))
+        if (bench::read_camera_option(argc, argv, &a, &o->camera) ||
+            bench::read_refracting_option(argc, argv, &a, &o->refracting))
             continue;
         if (arg == "--array" && left >= 3) {
             o->pitch_mm = std::atof(argv[++a]);
@@ -98,18 +97,12 @@ bool parse(int argc, char** argv, Options* o)
             for (double& value : o->error_values)
                 value = std::atof(argv[++a]);
             o->seed = std::atoll(argv[++a]);
-        } else if (arg == "--refracting" && left >= 4) {
-            o->refracting = true;
-            for (double& value : o->refracting_values)
-                value = std::atof(argv[++a]);
         } else if (arg == "--reference")
             o->reference = true;
         else if (arg == "--every-lens")
             o->every_lens = true;
         else if (arg == "--no-symmetry")
             o->no_symmetry = true;
-        else if (arg == "--caps-to-sensor")
-            o->caps_to_sensor = true;
         else if (arg == "--check-points" && left >= 1)
             o->check_points = std::atoi(argv[++a]);
         else if (arg == "--anchor-step" && left >= 1)
@@ -158,15 +151,7 @@ int main(int argc, char** argv)
     CameraParams p = bench::camera_params(camera, lens);
     p.sensor.offset_mm[0] = o.offset_mm[0];
     p.sensor.offset_mm[1] = o.offset_mm[1];
-    if (o.refracting) {
-        p.array.lens = MicrolensType::Refracting;
-        p.array.focal_length_count = 0;
-        p.array.refracting.radius_mm = o.refracting_values[0];
-        p.array.refracting.cap_mm = o.refracting_values[1];
-        p.array.refracting.substrate_mm = o.refracting_values[2];
-        p.array.refracting.ior = o.refracting_values[3];
-        p.array.refracting.curved_towards_scene = !o.caps_to_sensor;
-    }
+    bench::use_refracting(o.refracting, &p);
     p.array.rotate_deg[2] = o.turn_deg;
     p.array.translate_mm[0] = o.shift_mm[0];
     p.array.translate_mm[1] = o.shift_mm[1];

@@ -11,7 +11,7 @@
 //
 //   plenoptic_pass_fractions --lens-file FILE --f-number N --focus-distance Z
 //       --sensor W H PIXEL_MM [--array-matched PITCH_MM | --array PITCH_MM F_MM D_MM] [--thick]
-//       [--samples S] [--patch P] [--unaimed] [--lit-patch L]
+//       [--samples S] [--patch P] [--unaimed] [--lit-patch L] [--refracting R CAP SUBSTRATE IOR]
 //
 // --array-matched puts a hexagonal plenoptic 1.0 array at the focused image: thin microlenses of
 // focal length f = PITCH * the lens's working f-number (exit pupil to array over its diameter),
@@ -25,6 +25,9 @@
 // place, the counts over the lit pixels of an L x L patch there (a pixel is lit when any of the
 // points the uniform sampling looks at passes: pixel_receives_light with the aiming off), with the
 // smallest pass fraction of a lit pixel, the 5th percentile, and how many lit pixels pass 95 %.
+// --refracting makes the array's lenses plano-convex caps (microlens_array { lens { surface { radius R }
+// thickness CAP ior IOR substrate SUBSTRATE } }, curved side to the scene; with --array, whose F_MM is
+// then unused), which do not aim: their samples are spread uniformly over the pixel and the cell.
 // light_field_radius_mm is where the pupil bounds find that no light passes any more (-1 for the
 // thick lens, which has no such bounds; the bounds with an array are for points of its plane).
 
@@ -58,6 +61,7 @@ struct Options {
     int patch = 0;
     bool unaimed = false;
     int lit_patch = 0;
+    bench::RefractingOption refracting;
 };
 
 void usage()
@@ -65,7 +69,7 @@ void usage()
     std::fprintf(stderr,
                  "usage: plenoptic_pass_fractions --lens-file FILE --f-number N --focus-distance Z\n"
                  "         --sensor W H PIXEL_MM [--array-matched PITCH_MM | --array PITCH_MM F_MM D_MM] [--thick]\n"
-                 "         [--samples S] [--patch P] [--unaimed] [--lit-patch L]\n");
+                 "         [--samples S] [--patch P] [--unaimed] [--lit-patch L] [--refracting R CAP SUBSTRATE IOR]\n");
 }
 
 bool parse(int argc, char** argv, Options* o)
@@ -73,7 +77,8 @@ bool parse(int argc, char** argv, Options* o)
     for (int a = 1; a < argc; ++a) {
         const std::string arg = argv[a];
         const int left = argc - a - 1;
-        if (bench::read_camera_option(argc, argv, &a, &o->camera))
+        if (bench::read_camera_option(argc, argv, &a, &o->camera) ||
+            bench::read_refracting_option(argc, argv, &a, &o->refracting))
             continue;
         if (arg == "--array-matched" && left >= 1)
             o->array_pitch_mm = std::atof(argv[++a]);
@@ -94,6 +99,8 @@ bool parse(int argc, char** argv, Options* o)
     }
     if (o->array_focal_mm > 0 && !(o->array_distance_mm > 0))
         return false;
+    if (o->refracting.given && !(o->array_focal_mm > 0))
+        return false;  // the caps need --array's distance
     return o->camera.complete() && o->samples >= 2 && o->patch >= 0 && o->lit_patch >= 0 && o->array_pitch_mm >= 0;
 }
 
@@ -107,7 +114,10 @@ CameraParams camera(const Options& o, const Prescription& lens, double array_foc
     c.focal_mm = array_focal_mm;
     c.distance_mm = array_distance_mm;
     c.samples = o.samples;
-    return bench::camera_params(c, lens);
+    CameraParams p = bench::camera_params(c, lens);
+    if (array_focal_mm > 0)
+        bench::use_refracting(o.refracting, &p);
+    return p;
 }
 
 // Image-side f-number: exit pupil to the plane D behind the rear vertex, over the pupil's diameter
