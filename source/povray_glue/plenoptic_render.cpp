@@ -6,13 +6,28 @@
 #include <algorithm>
 
 #include "backend/frame.h"
+#include "backend/control/messagefactory.h"
 #include "backend/math/vector.h"
 #include "backend/scene/camera.h"
 #include "backend/scene/view.h"
+#include "base/povmscpp.h"
+#include "base/povmsgid.h"
 
 #include "base/povdebug.h"
 
 namespace pov {
+
+unsigned int Plenoptic_Tracing_Method(ViewData& view, POVMS_Object& options, unsigned int method)
+{
+    const SceneData& scene = *view.GetSceneData();
+    if (scene.parsedCamera.Type != PLENOPTIC_CAMERA)
+        return method;
+    if (options.TryGetBool(kPOVAttrib_Antialias, false))
+        MessageFactory(10, 370, "Render", scene.backendAddress, scene.frontendAddress, scene.sceneId, view.GetViewId())
+            .Warning(0, "plenoptic camera: antialiasing (+A) is ignored; the camera's own 'samples' sets how many rays "
+                        "each pixel takes.");
+    return 0;
+}
 
 std::shared_ptr<plenoptic::Render> Plenoptic_Start_Render(
     ViewData& view, unsigned int block_size, const std::vector<std::pair<unsigned int, unsigned int> >& finished_blocks)
