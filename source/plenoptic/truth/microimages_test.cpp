@@ -342,6 +342,52 @@ CameraParams refracting_behind_triplet()
     return params;
 }
 
+// `count` indices below `size` drawn from `seed` (a fixed generator: the same lenses on every run).
+std::vector<std::size_t> drawn_indices(std::size_t size, int count, std::uint64_t seed)
+{
+    std::vector<std::size_t> which;
+    for (int i = 0; i < count; ++i) {
+        seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+        which.push_back(std::size_t((seed >> 33) % size));
+    }
+    return which;
+}
+
+// The truth's lenses `which` (indices into `truth`) against each of them measured
+// (measured_microimages, anchor_step 0: no anchors): whether each is lit alike, the largest
+// difference along either axis (px) over the lit ones and of lit fraction over all, the lit ones'
+// lit fractions, and how far their measured microimages lie from their lattice centres.
+struct AgainstMeasured {
+    bool alike = true;
+    std::size_t lit = 0;
+    double worst_px = 0, worst_fraction = 0, smallest = INFINITY, largest = 0, spread = 0;
+};
+AgainstMeasured against_measured(const PlenopticCamera& camera, const std::vector<MicroimageTruth>& truth,
+                                 const std::vector<std::size_t>& which, MicroimageOptions options)
+{
+    std::vector<LensIndex> lenses;
+    for (std::size_t i : which)
+        lenses.push_back(truth[i].lens);
+    options.anchor_step = 0;
+    const std::vector<MicroimageTruth> b = measured_microimages(camera, lenses, options);
+    AgainstMeasured r;
+    r.alike = b.size() == which.size();
+    for (std::size_t n = 0; r.alike && n < which.size(); ++n) {
+        const MicroimageTruth& x = truth[which[n]];
+        r.alike = x.lens == b[n].lens && x.lit == b[n].lit;
+        r.worst_fraction = std::max(r.worst_fraction, std::fabs(x.lit_fraction - b[n].lit_fraction));
+        if (!x.lit)
+            continue;
+        ++r.lit;
+        r.smallest = std::min(r.smallest, x.lit_fraction);
+        r.largest = std::max(r.largest, x.lit_fraction);
+        r.worst_px = std::max(r.worst_px, std::max(std::fabs(x.u_px - b[n].u_px), std::fabs(x.v_px - b[n].v_px)));
+        const MicroimageCentre centre = microimage_centre_px(camera, x.lens);
+        r.spread = std::max(r.spread, std::hypot(b[n].u_px - centre.u, b[n].v_px - centre.v));
+    }
+    return r;
+}
+
 // Refracting microlenses on an array without errors: the lenses between anchors (every fourth lens
 // of every fourth row here) are interpolated. Every lens checked must agree with measuring it
 // (measured_microimages, what anchor_step 0 gives) within 0.001 px and 1e-4 of lit fraction, with
@@ -401,45 +447,25 @@ TEST(MicroimageTruth, RefractingLensesBetweenAnchorsAgreeWithMeasuringThem)
         }
         // Most lenses interpolated, and the anchors far fewer than the lenses.
         EXPECT_EQ(work.interpolated + work.measured, a.size()) << c.name;
-        if (c.mostly_interpolated)
+        if (c.mostly_interpolated) {
             EXPECT_GT(work.interpolated, a.size() / 2) << c.name;
+        }
         EXPECT_LT(4 * work.anchors, a.size()) << c.name;
         // Lenses drawn across the picture, every lens of its first row (the picture's edge, where
         // the stencils are one-sided) and the last lens (a corner), each measured.
-        std::vector<std::size_t> which;
-        std::uint64_t state = 12345;
-        for (int i = 0; i < 24; ++i) {
-            state = state * 6364136223846793005ull + 1442695040888963407ull;
-            which.push_back(std::size_t((state >> 33) % a.size()));
-        }
+        std::vector<std::size_t> which = drawn_indices(a.size(), 24, 12345);
         for (std::size_t i = 0; i < a.size() && a[i].lens.l == a[0].lens.l; ++i)
             which.push_back(i);
         which.push_back(a.size() - 1);
-        std::vector<LensIndex> lenses;
-        for (std::size_t i : which)
-            lenses.push_back(a[i].lens);
-        MicroimageOptions exact = one_thread;
-        exact.anchor_step = 0;
-        const std::vector<MicroimageTruth> b = measured_microimages(camera, lenses, exact);
-        ASSERT_EQ(b.size(), which.size());
-        double worst_px = 0, worst_fraction = 0, smallest = INFINITY, largest = 0;
-        for (std::size_t n = 0; n < which.size(); ++n) {
-            const MicroimageTruth& x = a[which[n]];
-            ASSERT_TRUE(x.lens == b[n].lens && x.lit == b[n].lit) << c.name << " " << which[n];
-            worst_fraction = std::max(worst_fraction, std::fabs(x.lit_fraction - b[n].lit_fraction));
-            if (!x.lit)
-                continue;
-            smallest = std::min(smallest, x.lit_fraction);
-            largest = std::max(largest, x.lit_fraction);
-            worst_px = std::max(worst_px, std::max(std::fabs(x.u_px - b[n].u_px), std::fabs(x.v_px - b[n].v_px)));
-        }
-        EXPECT_LT(worst_px, 1e-3) << c.name;
-        EXPECT_LT(worst_fraction, 1e-4) << c.name;
-        EXPECT_GT(smallest, 0.05) << c.name;
+        const AgainstMeasured r = against_measured(camera, a, which, one_thread);
+        ASSERT_TRUE(r.alike) << c.name;
+        EXPECT_LT(r.worst_px, 1e-3) << c.name;
+        EXPECT_LT(r.worst_fraction, 1e-4) << c.name;
+        EXPECT_GT(r.smallest, 0.05) << c.name;
         std::printf("%s: %zu lenses, %zu anchors, %zu interpolated, %zu measured; %zu checked: largest difference "
                     "%.2g px, lit fraction %.2g (lit fractions %.3f to %.3f)\n",
-                    c.name, a.size(), work.anchors, work.interpolated, work.measured, which.size(), worst_px,
-                    worst_fraction, smallest, largest);
+                    c.name, a.size(), work.anchors, work.interpolated, work.measured, which.size(), r.worst_px,
+                    r.worst_fraction, r.smallest, r.largest);
     }
     // With errors: every lens measured, as with anchor_step 0.
     CameraParams errors = scene_side;
@@ -599,42 +625,20 @@ TEST(MicroimageTruth, TurnedOrMovedRefractingArraysTakeTheirAnchorsOnTheAxis)
         ASSERT_GE(a.size(), 400u) << c.name;
         EXPECT_GT(work.interpolated, a.size() / 2) << c.name;
         EXPECT_GT(work.quarter_lenses, 0u) << c.name;  // anchors measured on the axis (0 without Canonical)
-        std::vector<LensIndex> lenses;
-        std::vector<std::size_t> which;
-        std::uint64_t state = 777;
-        for (int i = 0; i < 30; ++i) {
-            state = state * 6364136223846793005ull + 1442695040888963407ull;
-            which.push_back(std::size_t((state >> 33) % a.size()));
-        }
+        // Lenses drawn across the picture and its first and last lens, each measured where it is.
+        std::vector<std::size_t> which = drawn_indices(a.size(), 30, 777);
         which.push_back(0);
         which.push_back(a.size() - 1);
-        for (std::size_t i : which)
-            lenses.push_back(a[i].lens);
-        MicroimageOptions exact = options;
-        exact.anchor_step = 0;
-        const std::vector<MicroimageTruth> b = measured_microimages(camera, lenses, exact);
-        ASSERT_EQ(b.size(), which.size());
-        double worst_px = 0, worst_fraction = 0, spread = 0;
-        std::size_t lit = 0;
-        for (std::size_t n = 0; n < which.size(); ++n) {
-            const MicroimageTruth& x = a[which[n]];
-            ASSERT_TRUE(x.lens == b[n].lens && x.lit == b[n].lit) << c.name << " " << which[n];
-            worst_fraction = std::max(worst_fraction, std::fabs(x.lit_fraction - b[n].lit_fraction));
-            if (!x.lit)
-                continue;
-            ++lit;
-            worst_px = std::max(worst_px, std::max(std::fabs(x.u_px - b[n].u_px), std::fabs(x.v_px - b[n].v_px)));
-            const MicroimageCentre centre = microimage_centre_px(camera, x.lens);
-            spread = std::max(spread, std::hypot(b[n].u_px - centre.u, b[n].v_px - centre.v));
-        }
-        EXPECT_GT(lit, which.size() / 2) << c.name;
-        EXPECT_LT(worst_px, c.tolerance_px) << c.name;
-        EXPECT_LT(worst_fraction, c.tolerance_fraction) << c.name;
-        EXPECT_GT(spread, 0.1) << c.name;
+        const AgainstMeasured r = against_measured(camera, a, which, options);
+        ASSERT_TRUE(r.alike) << c.name;
+        EXPECT_GT(r.lit, which.size() / 2) << c.name;
+        EXPECT_LT(r.worst_px, c.tolerance_px) << c.name;
+        EXPECT_LT(r.worst_fraction, c.tolerance_fraction) << c.name;
+        EXPECT_GT(r.spread, 0.1) << c.name;
         std::printf("%s: %zu lenses, %zu anchors (%zu measured on the axis), %zu interpolated, %zu measured; "
                     "%zu checked: largest difference %.2g px, lit fraction %.2g (offsets up to %.2f px)\n",
                     c.name, a.size(), work.anchors, work.quarter_lenses - work.measured, work.interpolated,
-                    work.measured, which.size(), worst_px, worst_fraction, spread);
+                    work.measured, which.size(), r.worst_px, r.worst_fraction, r.spread);
     }
 }
 
