@@ -25,6 +25,14 @@ namespace {
 
 using test::plenoptic_camera;
 
+// The same microimage, bit for bit (the same lens's, from two runs).
+void expect_same_microimage(const MicroimageTruth& a, const MicroimageTruth& b)
+{
+    EXPECT_EQ(a.u_px, b.u_px);
+    EXPECT_EQ(a.v_px, b.v_px);
+    EXPECT_EQ(a.lit_fraction, b.lit_fraction);
+}
+
 struct ClosedFormCase {
     GridType grid;
     double micro_focal_mm;  // 0: pinholes
@@ -233,9 +241,7 @@ TEST(MicroimageTruth, ReusingNeighboursAgreesWithEveryLensFromScratch)
         for (std::size_t i = 0; i < a.size(); ++i) {
             ASSERT_TRUE(a[i].lens == b[i].lens && a[i].lit == b[i].lit) << c.name << " " << i;
             ASSERT_TRUE(a[i].lens == d[i].lens && a[i].lit == d[i].lit) << c.name << " " << i;
-            EXPECT_EQ(a[i].u_px, d[i].u_px);  // bit for bit
-            EXPECT_EQ(a[i].v_px, d[i].v_px);
-            EXPECT_EQ(a[i].lit_fraction, d[i].lit_fraction);
+            expect_same_microimage(a[i], d[i]);
             worst_fraction = std::max(worst_fraction, std::fabs(a[i].lit_fraction - b[i].lit_fraction));
             if (!a[i].lit)
                 continue;
@@ -303,9 +309,7 @@ TEST(MicroimageTruth, ReusingNeighboursAgreesFromScratchForRefractingAndTiltedLe
         for (std::size_t i = 0; i < a.size(); ++i) {
             ASSERT_TRUE(a[i].lens == b[i].lens && a[i].lit == b[i].lit) << c.name << " " << i;
             ASSERT_TRUE(a[i].lens == d[i].lens && a[i].lit == d[i].lit) << c.name << " " << i;
-            EXPECT_EQ(a[i].u_px, d[i].u_px);  // bit for bit
-            EXPECT_EQ(a[i].v_px, d[i].v_px);
-            EXPECT_EQ(a[i].lit_fraction, d[i].lit_fraction);
+            expect_same_microimage(a[i], d[i]);
             worst_fraction = std::max(worst_fraction, std::fabs(a[i].lit_fraction - b[i].lit_fraction));
             if (!a[i].lit)
                 continue;
@@ -439,9 +443,7 @@ TEST(MicroimageTruth, RefractingLensesBetweenAnchorsAgreeWithMeasuringThem)
             ASSERT_EQ(a.size(), d.size()) << c.name;
             for (std::size_t i = 0; i < a.size(); ++i) {
                 ASSERT_TRUE(a[i].lens == d[i].lens && a[i].lit == d[i].lit) << c.name << " " << i;
-                EXPECT_EQ(a[i].u_px, d[i].u_px);  // bit for bit
-                EXPECT_EQ(a[i].v_px, d[i].v_px);
-                EXPECT_EQ(a[i].lit_fraction, d[i].lit_fraction);
+                expect_same_microimage(a[i], d[i]);
             }
             EXPECT_EQ(work.interpolated, work_one.interpolated) << c.name;
         }
@@ -487,9 +489,7 @@ TEST(MicroimageTruth, RefractingLensesBetweenAnchorsAgreeWithMeasuringThem)
     EXPECT_EQ(work.measured, a.size());
     for (std::size_t i = 0; i < a.size(); ++i) {
         EXPECT_TRUE(a[i].lens == b[i].lens && a[i].lit == b[i].lit);
-        EXPECT_EQ(a[i].u_px, b[i].u_px);
-        EXPECT_EQ(a[i].v_px, b[i].v_px);
-        EXPECT_EQ(a[i].lit_fraction, b[i].lit_fraction);
+        expect_same_microimage(a[i], b[i]);
     }
 }
 
@@ -578,9 +578,7 @@ TEST(MicroimageTruth, RefractingMicroimagesAreMirrorImagesOfTheirQuarterLenses)
         const std::vector<MicroimageTruth> y = measured_microimages(camera, lenses, without);
         ASSERT_EQ(x.size(), y.size());
         for (std::size_t i = 0; i < x.size(); ++i) {
-            EXPECT_EQ(x[i].u_px, y[i].u_px);
-            EXPECT_EQ(x[i].v_px, y[i].v_px);
-            EXPECT_EQ(x[i].lit_fraction, y[i].lit_fraction);
+            expect_same_microimage(x[i], y[i]);
         }
     }
 }
