@@ -28,6 +28,13 @@
 // at random from a fixed seed, and the picture's four corner lenses, and adds to the JSON the largest
 // differences of the run's answer from theirs (check_du_px, check_dv_px, check_fraction) and the
 // CPU seconds the check took (not counted in cpu_s).
+// --brute CELL STEP measures the check's lenses once more by brute force, independently of the
+// truth's boundary search: the renderer's own ray (generate_ray_unaimed through the lens, a sensor
+// point lit through its own lens only, as the renderer counts it) from every point of a sensor
+// grid STEP pixels apart over a square 2.5 pitches wide about the lens's lattice centre, at each of
+// CELL x CELL cell points (the midpoint rule on the renderer's map of the cell): the lit points'
+// centroid. It adds the largest differences of the run's answer and of the check's from it
+// (brute_du_px, brute_dv_px, brute_check_du_px, brute_check_dv_px) and its CPU seconds.
 
 #include <chrono>
 #include <cmath>
@@ -38,14 +45,18 @@
 #include <ctime>
 #include <fstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <sys/resource.h>
 
 #include "bench/bench_camera.h"
 #include "plenoptic/camera/params.h"
 #include "plenoptic/camera/plenoptic_camera.h"
+#include "plenoptic/camera/rays.h"
 #include "plenoptic/lens/prescription.h"
 #include "plenoptic/optics.h"
+#include "plenoptic/projection/microimage_lattice.h"
 #include "plenoptic/truth/microimages.h"
 
 namespace {
@@ -64,6 +75,8 @@ struct Options {
     bool no_symmetry = false;
     int check = 0;
     int anchor_step = -1, refracting_points = 0, check_points = 0;
+    int brute_points = 0;
+    double brute_step_px = 0;
     bench::RefractingOption refracting;
     double error_values[3] = {0, 0, 0};
     long long seed = 0;
@@ -109,14 +122,70 @@ bool parse(int argc, char** argv, Options* o)
             o->anchor_step = std::atoi(argv[++a]);
         else if (arg == "--points" && left >= 1)
             o->refracting_points = std::atoi(argv[++a]);
-        else if (arg == "--check" && left >= 1)
+        else if (arg == "--brute" && left >= 2) {
+            o->brute_points = std::atoi(argv[++a]);
+            o->brute_step_px = std::atof(argv[++a]);
+        } else if (arg == "--check" && left >= 1)
             o->check = std::atoi(argv[++a]);
         else if (arg == "--csv" && left >= 1)
             o->csv = argv[++a];
         else
             return false;
     }
-    return o->camera.complete() && o->pitch_mm > 0 && o->focal_mm > 0 && o->distance_mm > 0 && o->threads >= 0 && o->check >= 0;
+    return o->camera.complete() && o->pitch_mm > 0 && o->focal_mm > 0 && o->distance_mm > 0 && o->threads >= 0 &&
+           o->check >= 0 && o->brute_points >= 0 && (o->brute_points == 0 || (o->brute_step_px > 0 && o->check > 0));
+}
+
+// The lens's microimage centroid by brute force (--brute): false when no grid point is lit.
+bool brute_centroid(const PlenopticCamera& m, LensIndex lens, int cell_points, double step_px, int threads,
+                    double* u_px, double* v_px)
+{
+    const MicroimageCentre c = microimage_centre_px(m, lens);
+    const double half = 1.25 * m.array.pitch_mm / m.sensor.pixel_size_mm[0];
+    const int n = int(std::ceil(2 * half / step_px));
+    struct Sum {
+        double count = 0, u = 0, v = 0;
+    };
+    std::vector<Sum> sums(std::size_t(std::max(1, threads)));
+    auto work = [&](int t) {
+        Sum& sum = sums[std::size_t(t)];
+        for (int j = t; j < n; j += int(sums.size()))
+            for (int i = 0; i < n; ++i) {
+                // Corner convention: pixel (i, j) spans [i, i + 1) x [j, j + 1).
+                const double u = c.u + 0.5 - half + (i + 0.5) * step_px, v = c.v + 0.5 - half + (j + 0.5) * step_px;
+                if (!m.overlap.modelled) {
+                    const OwnLens own = own_lens(m, m.sensor.point(u, v));
+                    if (!(own.found && own.lens == lens))
+                        continue;
+                }
+                for (int b = 0; b < cell_points; ++b)
+                    for (int a = 0; a < cell_points; ++a) {
+                        const CameraSample sample{u, v, (a + 0.5) / cell_points, (b + 0.5) / cell_points};
+                        if (generate_ray_unaimed(m, 0, 0, sample, &lens).passed) {
+                            sum.count += 1;
+                            sum.u += u;
+                            sum.v += v;
+                        }
+                    }
+            }
+    };
+    std::vector<std::thread> workers;
+    for (int t = 1; t < int(sums.size()); ++t)
+        workers.push_back(std::thread(work, t));
+    work(0);
+    for (std::thread& worker : workers)
+        worker.join();
+    Sum total;
+    for (const Sum& sum : sums) {
+        total.count += sum.count;
+        total.u += sum.u;
+        total.v += sum.v;
+    }
+    if (!(total.count > 0))
+        return false;
+    *u_px = total.u / total.count - 0.5;  // centre convention, as the truth's
+    *v_px = total.v / total.count - 0.5;
+    return true;
 }
 
 double cpu_seconds()
@@ -137,7 +206,8 @@ int main(int argc, char** argv)
                              "         --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--thick] [--offset X_MM Y_MM]\n"
                              "         [--threads T] [--errors S F R SEED] [--refracting R CAP SUBSTRATE IOR]\n"
                              "         [--caps-to-sensor] [--reference] [--every-lens] [--no-symmetry] [--turn DEG]\n"
-                             "         [--shift X_MM Y_MM] [--check N] [--csv OUT]\n");
+                             "         [--shift X_MM Y_MM] [--check N] [--check-points N] [--brute CELL STEP_PX]\n"
+                             "         [--csv OUT]\n");
         return 2;
     }
     Prescription lens;
@@ -201,6 +271,7 @@ int main(int argc, char** argv)
     }
     // The check: random lenses of the picture and its corners, each measured.
     double check_du = 0, check_dv = 0, check_fraction = 0, check_cpu = 0;
+    double brute_du = 0, brute_dv = 0, brute_check_du = 0, brute_check_dv = 0, brute_cpu = 0;
     std::size_t checked = 0;
     LensIndex worst{0, 0};
     if (o.check > 0 && !truth.empty()) {
@@ -248,6 +319,25 @@ int main(int argc, char** argv)
             }
             ++checked;
         }
+        if (o.brute_points > 0) {
+            const double b0 = cpu_seconds();
+            const int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+            for (std::size_t i = 0; i < which.size(); ++i) {
+                const MicroimageTruth& a = truth[which[i]];
+                const MicroimageTruth& b = each[i];
+                double u, v;
+                if (!brute_centroid(m, a.lens, o.brute_points, o.brute_step_px, threads, &u, &v)) {
+                    if (a.lit)
+                        brute_du = brute_dv = INFINITY;
+                    continue;
+                }
+                brute_du = std::max(brute_du, std::fabs(a.u_px - u));
+                brute_dv = std::max(brute_dv, std::fabs(a.v_px - v));
+                brute_check_du = std::max(brute_check_du, std::fabs(b.u_px - u));
+                brute_check_dv = std::max(brute_check_dv, std::fabs(b.v_px - v));
+            }
+            brute_cpu = cpu_seconds() - b0;
+        }
     }
     struct rusage usage;
     getrusage(RUSAGE_SELF, &usage);
@@ -255,6 +345,10 @@ int main(int argc, char** argv)
         std::printf("{\"checked\": %zu, \"check_du_px\": %.3g, \"check_dv_px\": %.3g, \"check_fraction\": %.3g, "
                     "\"check_cpu_s\": %.3f, \"check_worst_lens\": [%lld, %lld]}\n",
                     checked, check_du, check_dv, check_fraction, check_cpu, (long long)worst.k, (long long)worst.l);
+    if (checked > 0 && o.brute_points > 0)
+        std::printf("{\"brute_points\": %d, \"brute_step_px\": %g, \"brute_du_px\": %.3g, \"brute_dv_px\": %.3g, "
+                    "\"brute_check_du_px\": %.3g, \"brute_check_dv_px\": %.3g, \"brute_cpu_s\": %.3f}\n",
+                    o.brute_points, o.brute_step_px, brute_du, brute_dv, brute_check_du, brute_check_dv, brute_cpu);
     std::printf("{\"size\": [%d, %d], \"offset_mm\": [%.9g, %.9g], \"lenses\": %zu, \"lit_lenses\": %zu, "
                 "\"threads\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"peak_rss_mib\": %.1f, \"anchors\": %zu, "
                 "\"interpolated\": %zu, \"measured\": %zu, \"quarter_lenses\": %zu}\n",
