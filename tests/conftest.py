@@ -24,6 +24,8 @@ OPTIONS = {
     "povray": ("our povray binary", os.path.join(BUILD, "povray")),
     "project": ("the plenoptic-project binary", os.path.join(BUILD, "plenoptic-project")),
     "lens-data": ("the plenoptic-lens-data binary (plenoptic-lens's optics)", os.path.join(BUILD, "plenoptic-lens-data")),
+    "truth-bench": ("the plenoptic_microimage_truth bench program (source/bench)",
+                    os.path.join(BUILD, "source", "bench", "plenoptic_microimage_truth")),
     "work": ("scratch directory (created); default build/test-output/pytest/<test file>", None),
     "tools": ("the tools/ folder (the plenoptic-decode launcher)", os.path.join(SOURCE, "tools")),
     "python": ("the folder holding the plenoptic_lf package", os.path.join(SOURCE, "python")),
