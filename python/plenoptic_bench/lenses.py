@@ -67,7 +67,8 @@ def section_lenses_in(b, size, results, key, world, camera, cameras, lit):
         rows.append({"lenses": n, "lit_pixel_fraction": lit[n], "median_s": t, "peak_rss_mib": m, "runs_s": ts,
                      "us_per_lit_pixel": 1e6 * t / lit_pixels if lit_pixels else None})
     for r in rows:
-        r["ratio_to_100"] = r["median_s"] / rows[0]["median_s"]
+        # POV-Ray's trace time has millisecond steps: a quick run's 100 lenses may take 0.000 s.
+        r["ratio_to_100"] = r["median_s"] / rows[0]["median_s"] if rows[0]["median_s"] else None
         base = rows[0]["us_per_lit_pixel"]
         r["per_lit_pixel_ratio_to_100"] = r["us_per_lit_pixel"] / base if base and r["us_per_lit_pixel"] else None
     results[key] = {"size": size, "camera": camera, "scene": "empty" if world else "benchmark", "rows": rows}

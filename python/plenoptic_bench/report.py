@@ -31,8 +31,8 @@ def lens_table(L, o):
     L.append("| lenses | pixels lit | trace time, s | ratio to 100 lenses | time per lit pixel, us"
              " | ratio to 100 lenses (per lit pixel) | peak RSS, MiB |\n|---|---|---|---|---|---|---|")
     for r in o["rows"]:
-        L.append("| %d | %s | %.3f | %.3f | %s | %s | %.1f |" % (
-            r["lenses"], pct(r.get("lit_pixel_fraction")), r["median_s"], r["ratio_to_100"],
+        L.append("| %d | %s | %.3f | %s | %s | %s | %.1f |" % (
+            r["lenses"], pct(r.get("lit_pixel_fraction")), r["median_s"], fixed(r["ratio_to_100"]),
             fixed(r.get("us_per_lit_pixel")), fixed(r.get("per_lit_pixel_ratio_to_100")), r["peak_rss_mib"]))
     L.append("")
 
