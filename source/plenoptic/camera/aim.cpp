@@ -47,10 +47,10 @@ bool lens_aim(const PlenopticCamera& m, LensIndex lens, LensAim* out)
         // The bounds are for points of one plane: a lens off it (displaced along the axis) is not aimed at.
         if (!(std::fabs(centre.z - m.pupil_bounds->plane_z()) <= 1e-9 * (1 + std::fabs(centre.z))))
             return false;
-        PupilDisc discs[3];
+        PupilDisc discs[PupilBounds::kMaxDiscs];
         const int count = m.pupil_bounds->discs_holding(centre, circumradius, discs);
         disc = discs[0];
-        out->cuts = count == 3 ? 2 : 0;
+        out->cuts = count - 1;
         for (int k = 0; k < out->cuts; ++k) {
             const Vec3 q = m.array.to_local(discs[k + 1].centre);
             out->cut_m[k] = Vec2{q.x, q.y};
@@ -418,18 +418,18 @@ bool polygon_discs_x_range(const Vec2* corner, int n, const AimDisc* discs, int 
 }
 
 // The lens's finite discs of cell points for sensor point s (the disc and its cuts'); how many.
-int cell_discs(const LensAim& a, Vec3 s, AimDisc discs[3])
+int cell_discs(const LensAim& a, Vec3 s, AimDisc discs[1 + LensAim::kMaxCuts])
 {
     if (a.cuts == 0) {
         discs[0] = cell_disc(a, s, a.m, a.rho);
         return discs[0].radius < std::numeric_limits<double>::infinity() ? 1 : 0;
     }
     int count = 0;
-    const AimDisc all[3] = {lit_cell_disc(a, s), a.cuts > 0 ? lit_cell_cut(a, s, 0) : AimDisc{},
-                            a.cuts > 1 ? lit_cell_cut(a, s, 1) : AimDisc{}};
-    for (int k = 0; k < 1 + a.cuts; ++k)
-        if (all[k].radius < std::numeric_limits<double>::infinity())
-            discs[count++] = all[k];
+    for (int k = -1; k < a.cuts; ++k) {
+        const AimDisc d = k < 0 ? lit_cell_disc(a, s) : lit_cell_cut(a, s, k);
+        if (d.radius < std::numeric_limits<double>::infinity())
+            discs[count++] = d;
+    }
     return count;
 }
 
@@ -529,7 +529,7 @@ AimDisc lit_cell_cut(const LensAim& a, Vec3 s, int k)
 
 bool lit_cell_x_range(const LensAim& a, Vec3 s, double* x0, double* x1)
 {
-    AimDisc discs[3];
+    AimDisc discs[1 + LensAim::kMaxCuts];
     const int count = cell_discs(a, s, discs);
     return cell_x_range(a, discs, count, x0, x1);
 }
@@ -673,7 +673,7 @@ PixelFrame pixel_frame(const PlenopticCamera& m, double sensor_z, int i, int j)
 
 // One lens's part: where its light can land (the intersection of `sets`, in the pixel's frame) and
 // the x range of that part within the pixel.
-const int kMaxSets = 3;
+const int kMaxSets = 1 + LensAim::kMaxCuts;
 struct LensPart {
     int sets;
     RoundedPolygon set[kMaxSets];
@@ -1215,7 +1215,7 @@ ArrayRay aimed_cell_ray(const PlenopticCamera& m, const Vec3& p, LensIndex lens,
     const Vec3 s = array.to_local(p);
     if (!(a.z - s.z > 0))
         return array.microlens->sample_ray(array, p, lens, u, v);
-    AimDisc discs[3];
+    AimDisc discs[1 + LensAim::kMaxCuts];
     const int count = cell_discs(a, s, discs);
     bool whole = true;
     for (int k = 0; k < count && whole; ++k)

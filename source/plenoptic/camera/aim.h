@@ -12,7 +12,7 @@
 //     x(h, s) = g h - (Z / d) s + (Z / f) c,   g = 1 + Z / d - Z / f,
 // affine in h and in s. Light passes the main lens only where x lies in a disc (centre m, radius
 // rho) of that plane: the thin lens's aperture, the thick lens's exit pupil (both exact), a traced
-// lens's pupil bounds (PupilBounds::discs_holding over the cell, a disc and up to two cutting discs:
+// lens's pupil bounds (PupilBounds::discs_holding over the cell, a disc and up to four cutting discs:
 // conservative). So
 //  - for a sensor point, the cell points whose rays can pass lie in the disc of centre
 //    (m + (Z / d) s - (Z / f) c) / g and radius rho / |g| (lit_cell_disc), intersected with the
@@ -59,11 +59,12 @@ struct LensAim {
     double Z;
     Vec2 m;
     double rho;
-    // Behind a traced lens, off the axis: `cuts` (0 or 2) more discs of that plane, each also
+    // Behind a traced lens, off the axis: `cuts` (0, 2 or 4) more discs of that plane, each also
     // holding where light can pass (PupilBounds::discs_holding); light passes only in all of them.
+    static const int kMaxCuts = PupilBounds::kMaxDiscs - 1;
     int cuts;
-    Vec2 cut_m[2];
-    double cut_rho[2];
+    Vec2 cut_m[kMaxCuts];
+    double cut_rho[kMaxCuts];
 };
 
 // Whether the camera aims its samples (PlenopticCamera::sampling.aim): behind an image-forming main
@@ -91,7 +92,7 @@ bool region_chord(const RoundedPolygon& r, double x, double* y0, double* y1);
 
 // The region of sensor points (array-local x, y; the sensor d behind the lens plane, d > 0) from
 // which a ray through the lens's cell can pass the main lens's disc (k = -1) or cutting disc k (0
-// or 1): the cell polygon scaled by |g| d / Z about c + (c - m) d / Z, widened by rho d / Z.
+// to cuts - 1): the cell polygon scaled by |g| d / Z about c + (c - m) d / Z, widened by rho d / Z.
 RoundedPolygon lit_sensor_region(const LensAim& aim, double d, int k = -1);
 
 // A half-plane {p : dot(normal, p) <= offset}.
@@ -112,7 +113,7 @@ int own_sensor_cell(const PlenopticCamera& model, LensIndex lens, double sensor_
 // the ray from sensor point s (array-local, behind the lens) can pass the main lens; infinite
 // radius when every point can (g = 0).
 AimDisc lit_cell_disc(const LensAim& aim, Vec3 s);
-// The same for cutting disc k (0 or 1) of the lens's plane instead of its disc.
+// The same for cutting disc k (0 to cuts - 1) of the lens's plane instead of its disc.
 AimDisc lit_cell_cut(const LensAim& aim, Vec3 s, int k);
 
 // The x range (from the lens's centre) of the cell's part where light from sensor point s can pass

@@ -27,11 +27,14 @@ const int kAzimuths = 64;        // boundary directions refined by bisection
 const int kBisections = 24;      // steps of each bisection (2^-24 of the grid radius)
 const double kMargin = 1.01;     // radius margin for the bins, and again for points between them
 const int kMaxFieldDoublings = 60;
-// Tight discs (for aiming): boundary directions, field radii measured per span besides its two
-// bins, and the margin on each span's radius for what lies between the measured radii (validated
-// by brute force in pupil_bounds_test).
+// Tight discs (for aiming): boundary directions, tight spans per bin (the passing region changes
+// shape quickly where vignetting sets in: the double Gauss's and the fisheye's off-axis regions
+// needed spans a quarter of the bins' to be held closely; the radii measured are those the spans
+// of whole bins measured before, at each bin and three between), and the margin on each span's
+// radius for what lies between the measured radii (validated by brute force in pupil_bounds_test).
 const int kTightAzimuths = 256;
-const int kTightBetween = 3;
+const int kTightScan = 16 * kGrid;  // points along the x axis where the grid's centre is dark
+const int kTightSplit = 4;
 const double kTightMargin = 1.0001;
 // The cutting discs' further margin: their far side follows the region's edge across the field
 // less smoothly than the disc does (the double Gauss's near the axis left 0.3 um between the
@@ -111,6 +114,8 @@ bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* ce
     for (const Vec2& p : passing)
         grid_radius = std::max(grid_radius, std::hypot(p.x - cx, p.y));
     grid_radius += 2 * cell;  // a passing point lies within a cell diagonal of a passing grid point
+    // The farthest the region can reach from a point of the x axis: the search square's far corner.
+    auto square_reach = [&](double x) { return std::hypot(std::fabs(x - sx) + half, half) * (1 + 1e-9); };
     // The boundary measured along `azimuths` directions from (x0, 0), by bisection: the radius of a
     // disc about it that holds the region (infinite when the region is not star-shaped about it),
     // and the x extent of the boundary points.
@@ -126,7 +131,10 @@ bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* ce
         for (int k = 0; k < azimuths; ++k) {
             const double angle = 2 * kPi * k / azimuths;
             const double dx = std::cos(angle), dy = std::sin(angle);
-            double inside = 0, outside = grid_radius + std::fabs(x0 - cx);
+            // Tight: from beyond the search square's farthest corner, which holds the region (a
+            // sliver of a region near the field's edge, narrower than the grid's cells, reaches
+            // farther than the few grid points on it).
+            double inside = 0, outside = tight ? square_reach(x0) : grid_radius + std::fabs(x0 - cx);
             for (int s = 0; s < kBisections; ++s) {
                 const double mid = 0.5 * (inside + outside);
                 if (probe.passes(r, x0 + mid * dx, mid * dy))
@@ -200,21 +208,31 @@ bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* ce
     double x_lo = 0, x_hi = 0;
     std::vector<Vec2> corners;
     double x0 = cx;
-    if (tight && probe.passes(r, cx, 0)) {
+    // Tight: a point of the region on the x axis to measure from. The grid's centre, or where a scan
+    // along the axis finds light: near the field's edge the region is a sliver narrower than the
+    // grid's cells, which the grid sees at a few points only (so its centre and its radius, which
+    // the bounds keep, may miss the sliver's ends; the tight discs do not use them).
+    bool start_found = tight && probe.passes(r, cx, 0);
+    double start = cx;
+    for (int k = 0; tight && !start_found && k < kTightScan; ++k) {
+        start = sx - half + (k + 0.5) * 2 * half / kTightScan;
+        start_found = probe.passes(r, start, 0);
+    }
+    if (start_found) {
         // The grid's centre is off by up to a grid cell (which made neighbouring radii's discs
         // jump): measured from the middle of the region's x extent instead, found by bisection
         // along the x axis (the region is symmetric about it, so a convex one is widest there).
         double ends[2];
         for (int side = 0; side < 2; ++side) {
-            double inside = 0, outside = grid_radius;
+            double inside = 0, outside = square_reach(start);
             for (int s = 0; s < kBisections; ++s) {
                 const double mid = 0.5 * (inside + outside);
-                if (probe.passes(r, cx + (side ? mid : -mid), 0))
+                if (probe.passes(r, start + (side ? mid : -mid), 0))
                     inside = mid;
                 else
                     outside = mid;
             }
-            ends[side] = cx + (side ? outside : -outside);
+            ends[side] = start + (side ? outside : -outside);
         }
         x0 = 0.5 * (ends[0] + ends[1]);
     }
@@ -223,17 +241,19 @@ bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* ce
         x0 = cx;
         refined = refine(x0, &x_lo, &x_hi, &corners);
     }
-    if (!std::isfinite(refined))
-        refined = grid_radius;  // not star-shaped about its centre: keep the grid's bound
+    bool measured = std::isfinite(refined);
+    if (!measured)
+        refined = tight ? square_reach(x0) : grid_radius;  // not star-shaped about its centre: what surely holds it
     *centre_x = x0;
     if (hull) {
         hull->clear();
-        if (tight && refined < grid_radius)
+        if (tight && measured)
             hull->swap(corners);  // empty: no polygon (the region was not measured star-shaped)
     }
     // Tight: the measured boundary (the bisection's outer ends, the convex allowance between the
-    // directions); the bounds add kMargin.
-    *radius = std::min(grid_radius, tight ? refined : refined * kMargin);
+    // directions, the grid's passing points); the bounds add kMargin and keep the grid's radius
+    // where it is smaller.
+    *radius = tight ? refined : std::min(grid_radius, refined * kMargin);
     return true;
 }
 
@@ -248,33 +268,80 @@ void enclose(double c1, double r1, double c2, double r2, double* c, double* r)
 // The radius of the disc centred at (x, 0) holding the polygon `hull` (its farthest corner).
 double reach_from(const std::vector<Vec2>& hull, double x)
 {
-    double reach = 0;
+    double reach2 = 0;  // squared (millimetres: neither overflows nor underflows)
     for (const Vec2& p : hull)
-        reach = std::max(reach, std::hypot(p.x - x, p.y));
-    return reach;
+        reach2 = std::max(reach2, (p.x - x) * (p.x - x) + p.y * p.y);
+    return std::sqrt(reach2) * (1 + 1e-15);
 }
 
-// The area of the part of the disc (c0, r0) within the disc (c1, r1), both on the x axis and both
-// holding (x0, 0) (a sum over directions from it).
-double area_within(double x0, double c0, double r0, double c1, double r1)
+// The radius of the discs centred at (x, y) and (x, -y) that both hold `hull` (the farther of a
+// point from either centre is |p.x - x| across and |p.y| + |y| along y).
+double reach_from_pair(const std::vector<Vec2>& hull, double x, double y)
 {
-    const int n = 256;
+    double reach2 = 0;
+    for (const Vec2& p : hull) {
+        const double dy = std::fabs(p.y) + std::fabs(y);
+        reach2 = std::max(reach2, (p.x - x) * (p.x - x) + dy * dy);
+    }
+    return std::sqrt(reach2) * (1 + 1e-15);
+}
+
+// The area of the intersection of `discs` (centre x, y and radius each), all holding (x0, 0): a
+// sum over kAreaDirections directions from it.
+struct Circle {
+    double x, y, r;
+};
+const int kAreaDirections = 64;  // (the areas only rank the choices of cutting discs)
+double area_of(double x0, const Circle* discs, int count)
+{
+    static const std::vector<Vec2> directions = [] {
+        std::vector<Vec2> u;
+        for (int k = 0; k < kAreaDirections; ++k) {
+            const double a = 2 * kPi * (k + 0.5) / kAreaDirections;
+            u.push_back(Vec2{std::cos(a), std::sin(a)});
+        }
+        return u;
+    }();
     double area = 0;
-    for (int k = 0; k < n; ++k) {
-        const double a = 2 * kPi * (k + 0.5) / n, dx = std::cos(a);
+    for (const Vec2& u : directions) {
         double t = INFINITY;
-        for (const double* d : {&c0, &c1}) {
-            const double c = *d, r = d == &c0 ? r0 : r1;
-            const double b = (x0 - c) * dx, q = (x0 - c) * (x0 - c) - r * r;  // |x0 + t u - c|^2 = r^2
+        for (int d = 0; d < count; ++d) {  // |(x0, 0) + t u - centre|^2 = r^2
+            const double wx = x0 - discs[d].x, wy = -discs[d].y;
+            const double b = wx * u.x + wy * u.y, q = wx * wx + wy * wy - discs[d].r * discs[d].r;
             t = std::min(t, -b + std::sqrt(std::max(0.0, b * b - q)));
         }
         area += 0.5 * t * t;
     }
-    return area * 2 * kPi / n;
+    return area * 2 * kPi / kAreaDirections;
 }
 
-// Offsets of the cutting discs' centres from the region's, in units of its disc's radius.
-const double kCutOffsets[] = {0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1, 1.5, 2, 3};
+// The smallest disc holding two discs (centres a and b).
+Circle enclose_circles(const Circle& a, const Circle& b)
+{
+    const double d = std::hypot(b.x - a.x, b.y - a.y);
+    if (d + b.r <= a.r)
+        return a;
+    if (d + a.r <= b.r)
+        return b;
+    const double r = 0.5 * (d + a.r + b.r), t = (r - a.r) / d;
+    return Circle{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), r};
+}
+
+// Offsets of the cutting discs' centres from the region's, in units of its disc's radius: kCutOffsets
+// values in geometric steps from kCutOffsetLow to kCutOffsetHigh, refined about the best (a fixed
+// list of ten missed the fisheye's best offsets by enough to cost 1.5 points of its edge's aimed
+// samples).
+const int kCutOffsets = 20;
+const int kCutRefinements = 3;
+// The pair of cutting discs off the axis: directions (kPairAngles - 1 between 0 and 180 degrees from
+// +x), offsets (kPairOffsets in geometric steps, in units of the disc's radius), refined about the
+// best kPairRefinements times, and the least share of the area it must take off to be kept.
+const int kPairAngles = 6;
+const int kPairOffsets = 10;
+const int kPairRefinements = 3;
+const double kPairOffsetLow = 0.05, kPairOffsetHigh = 4;
+const double kPairGain = 1e-3;
+const double kCutOffsetLow = 0.02, kCutOffsetHigh = 4;
 
 } // namespace
 
@@ -325,103 +392,189 @@ PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, doubl
     }
     if (!tight)
         return;
-    // Tight spans: the tight discs at both bins and kTightBetween radii between them, enclosed,
-    // widened by kTightMargin. Where no light passes at a measured radius but does at another of
-    // the span, the span holds the lit ones (as the bounds do at the field's edge). And two
-    // cutting discs per span, centred on either side of the region along x (a cat's eye is
-    // narrower along x than its disc), each holding the measured polygons of the span's radii:
-    // the offset from the region's centre that leaves the least of the middle radius's disc
-    // within the cut, the same offset at every radius of the span.
+    // Tight spans, kTightSplit to a bin. At each end of a span the region is measured (bin_disc,
+    // tight): its disc and a polygon holding it. From the span's first lit end come
+    // two cutting discs centred on the axis on either side of the region (a cat's eye is narrower
+    // along x than its disc), each at the offset from the region's centre that leaves the least of
+    // its disc within it; and, where it takes off at least kPairGain more of the area, a pair of
+    // cutting discs off the axis, mirror images (the discs on the axis overhang a cat's eye's
+    // corners); each holds the polygons of every end with the same centre offset. A disc with
+    // its centre's y fixed is its x extent [lo, hi]; across the span each extent is taken linear
+    // between its ends' (a cell meets a few per cent of a span), widened by the error a line can
+    // make there: a quarter of the smaller of the extent's two second differences at the span's ends
+    // (its |f''| h^2 / 8 bound, twice; the smaller, as a kink beside the span, where another
+    // aperture begins to cut, shows in one of them only, a kink or a curvature within the span in
+    // both), measured with the same offset at the neighbouring ends. Widened by kTightMargin (and
+    // the cuts by kCutMargin) for what lies between the measured radii. Where only one end is lit,
+    // a neighbour is dark (the field's edge) or lacks a polygon, the span is one disc holding its
+    // lit ends' discs, as the bounds hold. Without polygons the cuts are the disc.
     struct Measured {
         bool lit;
         double centre_x, radius;
         std::vector<Vec2> hull;
     };
-    std::vector<Measured> at_bins(kBins + 1);
-    for (int i = 0; i <= kBins; ++i) {
-        Measured& m = at_bins[size_t(i)];
-        m.lit = bins[size_t(i)].radius > 0 && bin_disc(lens, probe, i * step_mm_, &m.centre_x, &m.radius, true, &m.hull);
+    tight_step_mm_ = step_mm_ / kTightSplit;
+    const int tight_spans = kBins * kTightSplit;
+    std::vector<Measured> at(size_t(tight_spans + 1));
+    for (int i = 0; i <= tight_spans; ++i) {
+        report_setup("tight pupil bounds", i, tight_spans + 1);
+        Measured& m = at[size_t(i)];
+        // Beyond the bounds' field no ray is traced (may_pass refuses them all).
+        m.lit = !(i * tight_step_mm_ > field_radius_mm_) &&
+                bin_disc(lens, probe, i * tight_step_mm_, &m.centre_x, &m.radius, true, &m.hull) && m.radius > 0;
     }
-    for (int i = 0; i < kBins; ++i) {
-        std::vector<Measured> at(size_t(kTightBetween + 2));
-        for (int k = 0; k <= kTightBetween + 1; ++k) {
-            if (k == 0)
-                at[0] = at_bins[size_t(i)];
-            else if (k == kTightBetween + 1)
-                at[size_t(k)] = at_bins[size_t(i + 1)];
-            else {
-                Measured& m = at[size_t(k)];
-                m.lit = bin_disc(lens, probe, (i + double(k) / (kTightBetween + 1)) * step_mm_, &m.centre_x, &m.radius,
-                                 true, &m.hull);
-            }
+    report_setup("tight pupil bounds", tight_spans + 1, tight_spans + 1);
+    const double aspheric_margin = aspheric ? kAsphereMargin : 1;
+    auto lit = [&](int i) { return i >= 0 && i <= tight_spans && at[size_t(i)].lit; };
+    // The x extent, at end i, of the region's disc (offset 0, no hull) or of a cutting disc centred
+    // `offset` from the region's centre holding its polygon.
+    auto extent = [&](int i, double offset, bool cut, double y, double* lo, double* hi) {
+        const Measured& m = at[size_t(i)];
+        const double c = m.centre_x + offset;
+        // Off the axis, the larger reach of the disc and its mirror image (the polygon is symmetric
+        // about the axis only to the bisections' rounding).
+        const double r = !cut ? m.radius : y != 0 ? reach_from_pair(m.hull, c, y) : reach_from(m.hull, c);
+        *lo = c - r;
+        *hi = c + r;
+    };
+    // The ramp of span i for one disc (cut: a cutting disc at `offset`); margin on its radius.
+    auto ramp = [&](int i, double offset, bool cut, double margin, double y = 0) {
+        Ramp out;
+        out.y = y;
+        double lo[4], hi[4];
+        bool use[4];  // end i - 1 + k lit (and, for a cut, with its polygon)
+        for (int k = 0; k < 4; ++k) {
+            use[k] = lit(i - 1 + k) && !(cut && at[size_t(i - 1 + k)].hull.empty());
+            if (use[k])
+                extent(i - 1 + k, offset, cut, y, &lo[k], &hi[k]);
         }
-        Bin span{0, 0}, cut_lo{0, 0}, cut_hi{0, 0};
-        bool any = false, cuts = true;
-        for (const Measured& m : at) {
-            if (!m.lit || !(m.radius > 0))
+        if (use[0] && use[1] && use[2] && use[3]) {
+            // The smaller of the two (see above).
+            const double d_lo = std::min(std::fabs(lo[0] - 2 * lo[1] + lo[2]), std::fabs(lo[1] - 2 * lo[2] + lo[3]));
+            const double d_hi = std::min(std::fabs(hi[0] - 2 * hi[1] + hi[2]), std::fabs(hi[1] - 2 * hi[2] + hi[3]));
+            for (int e = 0; e < 2; ++e) {
+                const double c = 0.5 * (lo[1 + e] + hi[1 + e]), r = 0.5 * (hi[1 + e] - lo[1 + e]) * margin;
+                out.lo[e] = c - r - 0.25 * d_lo;
+                out.hi[e] = c + r + 0.25 * d_hi;
+            }
+            out.lit = true;
+            return out;
+        }
+        // One disc holding the lit ends' (widened by the margin).
+        double c = 0, r = 0;
+        bool any = false;
+        for (int k = 1; k <= 2; ++k) {
+            if (!use[k])
                 continue;
+            const double ck = 0.5 * (lo[k] + hi[k]), rk = 0.5 * (hi[k] - lo[k]);
             if (any)
-                enclose(span.centre_x, span.radius, m.centre_x, m.radius, &span.centre_x, &span.radius);
-            else
-                span = Bin{m.centre_x, m.radius};
+                enclose(c, r, ck, rk, &c, &r);
+            else {
+                c = ck;
+                r = rk;
+            }
             any = true;
-            cuts = cuts && !m.hull.empty();
         }
-        // The offsets, chosen at the middle lit radius.
-        double off_lo = 0, off_hi = 0;
-        if (any && cuts) {
-            const Measured* middle = nullptr;  // the lit radius nearest the middle
-            for (int k = 0; k <= kTightBetween + 1; ++k)
-                if (at[size_t(k)].lit && at[size_t(k)].radius > 0 &&
-                    (!middle || std::abs(2 * k - kTightBetween - 1) < std::abs(2 * int(middle - at.data()) - kTightBetween - 1)))
-                    middle = &at[size_t(k)];
-            const double x0 = middle->centre_x, r0 = middle->radius;
-            double best_lo = INFINITY, best_hi = INFINITY;
-            for (double f : kCutOffsets) {
-                const double lo_c = x0 - f * r0, hi_c = x0 + f * r0;
-                const double lo_a = area_within(x0, x0, r0, lo_c, reach_from(middle->hull, lo_c));
-                const double hi_a = area_within(x0, x0, r0, hi_c, reach_from(middle->hull, hi_c));
-                if (lo_a < best_lo) {
-                    best_lo = lo_a;
-                    off_lo = f * r0;
+        out.lit = any;
+        out.lo[0] = out.lo[1] = c - r * margin;
+        out.hi[0] = out.hi[1] = c + r * margin;
+        return out;
+    };
+    for (int i = 0; i < tight_spans; ++i) {
+        const int first = lit(i) ? i : i + 1;
+        // Both ends' polygons measured (where lit): cutting discs.
+        const bool polygons = lit(first) && !at[size_t(first)].hull.empty() && (!lit(i + 1) || !at[size_t(i + 1)].hull.empty());
+        Ramp span = ramp(i, 0, false, kTightMargin * aspheric_margin);
+        if (!span.lit) {
+            // None measured lit: the bounds' own disc.
+            const Bin& b = spans_[size_t(i / kTightSplit)];
+            span.lit = b.radius > 0;
+            span.lo[0] = span.lo[1] = b.centre_x - b.radius;
+            span.hi[0] = span.hi[1] = b.centre_x + b.radius;
+        }
+        Ramp cut_lo = span, cut_hi = span;  // without polygons the cuts are the span's disc
+        Ramp pair;                          // none (lit false) unless it pays
+        if (!aspheric && polygons) {
+            const Measured& m = at[size_t(first)];
+            const double x0 = m.centre_x, r0 = m.radius;
+            const double c0 = x0, d0 = r0;  // the disc
+            // Each side's offset: kCutOffsets in geometric steps, then kCutRefinements rounds of the
+            // two offsets a third of a step either side of the best.
+            auto cut_offset = [&](double side) {
+                double best = INFINITY, best_f = 0;
+                auto consider = [&](double f) {
+                    const double c = x0 + side * f * r0;
+                    const Circle two[2] = {{c0, 0, d0}, {c, 0, reach_from(m.hull, c)}};
+                    const double area = area_of(x0, two, 2);
+                    if (area < best) {
+                        best = area;
+                        best_f = f;
+                    }
+                };
+                const double ratio = std::pow(kCutOffsetHigh / kCutOffsetLow, 1 / (kCutOffsets - 1.0));
+                for (int q = 0; q < kCutOffsets; ++q)
+                    consider(kCutOffsetLow * std::pow(ratio, q));
+                double step = std::log(ratio);
+                for (int round = 0; round < kCutRefinements; ++round) {
+                    step /= 3;
+                    const double f = best_f;
+                    consider(f * std::exp(-step));
+                    consider(f * std::exp(step));
                 }
-                if (hi_a < best_hi) {
-                    best_hi = hi_a;
-                    off_hi = f * r0;
+                return best_f * r0;
+            };
+            const double off_lo = cut_offset(-1), off_hi = cut_offset(1);
+            cut_lo = ramp(i, -off_lo, true, kTightMargin * kCutMargin);
+            cut_hi = ramp(i, off_hi, true, kTightMargin * kCutMargin);
+            // A pair of cutting discs off the axis, mirror images (where the region has corners, as a
+            // cat's eye has, the discs on the axis overhang them): the direction and offset from the
+            // region's centre that leave the least of the other three discs' intersection, if that
+            // is less by kPairGain.
+            Circle held[5] = {{c0, 0, d0}, {x0 - off_lo, 0, reach_from(m.hull, x0 - off_lo)},
+                              {x0 + off_hi, 0, reach_from(m.hull, x0 + off_hi)}, {}, {}};
+            const double without = area_of(x0, held, 3);
+            double best = without * (1 - kPairGain), pair_x = 0, pair_y = 0;
+            // A grid of directions and offsets, then kPairRefinements rounds of a 3 x 3 grid about
+            // the best, each a third as wide.
+            auto consider = [&](double angle, double f) {
+                if (!(angle > 0 && angle < kPi))
+                    return;
+                const double px = x0 + f * r0 * std::cos(angle), py = f * r0 * std::sin(angle);
+                const double reach = reach_from_pair(m.hull, px, py);
+                held[3] = Circle{px, py, reach};
+                held[4] = Circle{px, -py, reach};
+                const double area = area_of(x0, held, 5);
+                if (area < best) {
+                    best = area;
+                    pair_x = px - x0;
+                    pair_y = py;
                 }
+            };
+            const double angle_step = kPi / kPairAngles;
+            const double ratio = std::pow(kPairOffsetHigh / kPairOffsetLow, 1 / (kPairOffsets - 1.0));
+            for (int t = 1; t < kPairAngles; ++t)
+                for (int q = 0; q < kPairOffsets; ++q)
+                    consider(angle_step * t, kPairOffsetLow * std::pow(ratio, q));
+            double d_angle = angle_step, d_log = std::log(ratio);
+            for (int round = 0; round < kPairRefinements && pair_y > 0; ++round) {
+                d_angle /= 3;
+                d_log /= 3;
+                const double angle = std::atan2(pair_y, pair_x), f = std::hypot(pair_x, pair_y) / r0;
+                for (int a = -1; a <= 1; ++a)
+                    for (int q = -1; q <= 1; ++q)
+                        if (a != 0 || q != 0)
+                            consider(angle + a * d_angle, f * std::exp(q * d_log));
             }
-            bool first = true;
-            for (const Measured& m : at) {
-                if (!m.lit || !(m.radius > 0))
-                    continue;
-                const Bin lo{m.centre_x - off_lo, reach_from(m.hull, m.centre_x - off_lo)};
-                const Bin hi{m.centre_x + off_hi, reach_from(m.hull, m.centre_x + off_hi)};
-                if (first) {
-                    cut_lo = lo;
-                    cut_hi = hi;
-                } else {
-                    enclose(cut_lo.centre_x, cut_lo.radius, lo.centre_x, lo.radius, &cut_lo.centre_x, &cut_lo.radius);
-                    enclose(cut_hi.centre_x, cut_hi.radius, hi.centre_x, hi.radius, &cut_hi.centre_x, &cut_hi.radius);
-                }
-                first = false;
-            }
+            if (pair_y > 0)
+                pair = ramp(i, pair_x, true, kTightMargin * kCutMargin, pair_y);
         }
-        span.radius *= kTightMargin;
-        cut_lo.radius *= kTightMargin * kCutMargin;
-        cut_hi.radius *= kTightMargin * kCutMargin;
-        if (aspheric) {
-            span.radius *= kAsphereMargin;
-            cut_lo.radius *= kAsphereMargin;
-            cut_hi.radius *= kAsphereMargin;
-        }
-        if (!(span.radius > 0))
-            span = spans_[size_t(i)];  // none measured lit: the bounds' own disc
-        // Without polygons (a region not measured star-shaped) the cuts are the span's disc.
-        if (!(cut_lo.radius > 0 && cut_hi.radius > 0) || aspheric)
-            cut_lo = cut_hi = span;
-        tight_spans_.push_back(span);
-        cut_lo_spans_.push_back(cut_lo);
-        cut_hi_spans_.push_back(cut_hi);
+        tight_ramps_.push_back(span);
+        cut_lo_ramps_.push_back(cut_lo);
+        cut_hi_ramps_.push_back(cut_hi);
+        if (pair.lit)
+            pair.pair = true;
+        pair_ramps_.push_back(pair.lit ? pair : span);
+        pairs_ = pairs_ || pair.lit;
     }
 }
 
@@ -442,22 +595,30 @@ PupilDisc PupilBounds::disc_for(Vec3 point) const
 PupilDisc PupilBounds::disc_holding(Vec3 centre, double radius, bool tight) const
 {
     if (tight && has_tight())
-        return holding(tight_spans_, step_mm_, centre, radius, true);
-    return holding(spans_, step_mm_, centre, radius, false);
+        return holding(tight_ramps_, centre, radius, false);
+    return holding(spans_, step_mm_, centre, radius);
 }
 
-int PupilBounds::discs_holding(Vec3 centre, double radius, PupilDisc out[3]) const
+int PupilBounds::discs_holding(Vec3 centre, double radius, PupilDisc out[kMaxDiscs]) const
 {
     out[0] = disc_holding(centre, radius, true);
     if (!has_tight() || !(out[0].radius > 0) || !(std::sqrt(centre.x * centre.x + centre.y * centre.y) > std::fabs(radius)))
         return 1;
-    out[1] = holding(cut_lo_spans_, step_mm_, centre, radius, true);
-    out[2] = holding(cut_hi_spans_, step_mm_, centre, radius, true);
-    return out[1].radius > 0 && out[2].radius > 0 ? 3 : 1;
+    out[1] = holding(cut_lo_ramps_, centre, radius, false);
+    out[2] = holding(cut_hi_ramps_, centre, radius, false);
+    if (!(out[1].radius > 0 && out[2].radius > 0))
+        return 1;
+    if (!pairs_)
+        return 3;
+    bool pair = false;  // some span the cell meets has a pair of its own (the others lend their disc)
+    out[3] = holding(pair_ramps_, centre, radius, false, &pair);
+    if (!pair)
+        return 3;
+    out[4] = holding(pair_ramps_, centre, radius, true);
+    return out[3].radius > 0 && out[4].radius > 0 ? 5 : 3;
 }
 
-PupilDisc PupilBounds::holding(const std::vector<Bin>& spans, double step_mm, Vec3 centre, double radius,
-                               bool exact_turn) const
+PupilDisc PupilBounds::holding(const std::vector<Bin>& spans, double step_mm, Vec3 centre, double radius) const
 {
     // disc_for(q) lies in span floor(|q| / step) turned to q's azimuth. For |q - c| <= radius the
     // spans are those from (|c| - radius) to (|c| + radius), and the unit vector of q is within
@@ -472,10 +633,7 @@ PupilDisc PupilBounds::holding(const std::vector<Bin>& spans, double step_mm, Ve
         return PupilDisc{Vec3{0, 0, pupil_z_}, 0};
     const int first = int(lo), last = std::min(bins - 1, int(hi));
     const bool about_axis = !(r > radius);
-    // Tight: the unit vectors' distance itself, 2 sin(a / 2) for the largest angle a = asin(radius / r).
-    const double turn = about_axis ? 0
-                        : exact_turn ? 2 * std::sin(0.5 * std::asin(radius / r)) * (1 + 1e-9)
-                                     : std::min(2.0, 2 * radius / r);
+    const double turn = about_axis ? 0 : std::min(2.0, 2 * radius / r);
     double near = INFINITY, far = -INFINITY;  // along c's direction (or |.| about the axis)
     for (int k = first; k <= last; ++k) {
         const Bin& span = spans[size_t(k)];
@@ -495,6 +653,47 @@ PupilDisc PupilBounds::holding(const std::vector<Bin>& spans, double step_mm, Ve
     const double along = 0.5 * (near + far);
     const double ux = about_axis ? 0 : centre.x / r, uy = about_axis ? 0 : centre.y / r;
     return PupilDisc{Vec3{along * ux, along * uy, pupil_z_}, 0.5 * (far - near)};
+}
+
+PupilDisc PupilBounds::holding(const std::vector<Ramp>& ramps, Vec3 centre, double radius, bool mirror,
+                               bool* pair) const
+{
+    // As holding() over spans, with each span's disc taken over the part of it the cell's radii
+    // cover (its extent at that part's ends: it is linear between), turned to the cell's azimuth
+    // and widened by how far its centre turns across the cell; the discs of the spans met, enclosed.
+    // A disc off the axis (Ramp::y; mirror: at -y) turns about the axis as its centre does.
+    const double r = std::sqrt(centre.x * centre.x + centre.y * centre.y);
+    radius = std::fabs(radius);
+    const int spans = int(ramps.size());
+    const double lo = std::max(0.0, r - radius) / tight_step_mm_, hi = (r + radius) / tight_step_mm_;
+    if (!(lo < spans) || !std::isfinite(hi))
+        return PupilDisc{Vec3{0, 0, pupil_z_}, 0};
+    const int first = int(lo), last = std::min(spans - 1, int(hi));
+    const bool about_axis = !(r > radius);
+    // The unit vectors' distance itself, 2 sin(a / 2) for the largest angle a = asin(radius / r).
+    const double turn = about_axis ? 0 : 2 * std::sin(0.5 * std::asin(radius / r)) * (1 + 1e-9);
+    Circle held{0, 0, -1};
+    for (int k = first; k <= last; ++k) {
+        const Ramp& span = ramps[size_t(k)];
+        if (!span.lit)
+            continue;
+        if (pair)
+            *pair = *pair || span.pair;
+        const double t0 = std::min(1.0, std::max(0.0, lo - k)), t1 = std::min(1.0, std::max(0.0, hi - k));
+        const double x_lo = std::min(span.lo[0] + t0 * (span.lo[1] - span.lo[0]), span.lo[0] + t1 * (span.lo[1] - span.lo[0]));
+        const double x_hi = std::max(span.hi[0] + t0 * (span.hi[1] - span.hi[0]), span.hi[0] + t1 * (span.hi[1] - span.hi[0]));
+        Circle disc{0.5 * (x_lo + x_hi), mirror ? -span.y : span.y, 0.5 * (x_hi - x_lo)};
+        if (about_axis)  // the cell may hold the axis: a disc about it holding every turn of this one
+            disc = Circle{0, 0, std::hypot(disc.x, disc.y) + disc.r};
+        else
+            disc.r += std::hypot(disc.x, disc.y) * turn;
+        held = held.r < 0 ? disc : enclose_circles(held, disc);
+    }
+    if (!(held.r >= 0))
+        return PupilDisc{Vec3{0, 0, pupil_z_}, 0};
+    // (x, y) of the +x frame turned to the cell's azimuth.
+    const double ux = about_axis ? 1 : centre.x / r, uy = about_axis ? 0 : centre.y / r;
+    return PupilDisc{Vec3{held.x * ux - held.y * uy, held.x * uy + held.y * ux, pupil_z_}, held.r * (1 + 1e-12)};
 }
 
 bool PupilBounds::may_pass(Vec3 point, Vec3 direction) const

@@ -29,14 +29,14 @@ public:
     // (the round stop holds it), so `traced` should be built without blades.
     PupilBounds(const Prescription& lens, const MainLens& traced, double plane_z);
     // The same bounds and, with `tight`, also tight discs for samples aimed where light passes
-    // (camera/aim.h; disc_holding with tight true): each bin's region measured along
-    // kTightAzimuths directions from the middle of its x extent, bounded between two directions by
-    // where the neighbouring chords' lines meet (a convex region's boundary cannot pass them,
-    // corners included) instead of the 1 % margins; each span's disc holds the discs measured at
-    // its bins and three field radii between them, widened by kTightMargin; and two cutting discs
-    // per span (discs_holding). Conservative as the bounds are, by brute force
-    // (pupil_bounds_test, the triplet and the catalogue's lenses); about 8 times the bounds'
-    // traces to make.
+    // (camera/aim.h; disc_holding with tight true), on spans a quarter of the bins': each span end's
+    // region measured along kTightAzimuths directions from the middle of its x extent, bounded
+    // between two directions by where the neighbouring chords' lines meet (a convex region's
+    // boundary cannot pass them, corners included) instead of the 1 % margins; each span's disc
+    // holds those polygons, its extent linear across the span with an allowance for its curvature,
+    // widened by kTightMargin; and two or four cutting discs per span (discs_holding). Conservative
+    // as the bounds are, by brute force (pupil_bounds_test, the triplet and the catalogue's
+    // lenses); about 8 times the bounds' traces to make.
     PupilBounds(const Prescription& lens, const MainLens& traced, double plane_z, bool tight);
 
     // The disc for a point of that plane (its z is not looked at): it holds every point of the
@@ -48,11 +48,14 @@ public:
     // With `tight`, from the tight discs when the bounds were made with them (otherwise the same).
     PupilDisc disc_holding(Vec3 centre, double radius, bool tight = false) const;
     // Whether the bounds hold tight discs too.
-    bool has_tight() const { return !tight_spans_.empty(); }
-    // With tight discs: the tight disc_holding and, for a cell off the axis, two cutting discs that
-    // also hold disc_for's region for every point of the cell (a cat's eye is their intersection
-    // more closely than a disc); returns how many of out[0..2] it wrote (1 or 3).
-    int discs_holding(Vec3 centre, double radius, PupilDisc out[3]) const;
+    bool has_tight() const { return !tight_ramps_.empty(); }
+    // With tight discs: the tight disc_holding and, for a cell off the axis, two cutting discs
+    // centred on the line from the axis through the cell and, where they pay, two more centred off
+    // it (mirror images), each also holding disc_for's region for every point of the cell (a cat's
+    // eye is their intersection more closely than a disc); returns how many of out[0..4] it wrote
+    // (1, 3 or 5).
+    static const int kMaxDiscs = 5;
+    int discs_holding(Vec3 centre, double radius, PupilDisc out[kMaxDiscs]) const;
 
     // False when the ray from `point` (of the bounds' plane) along `direction` certainly misses the
     // lens: it crosses the exit pupil's plane outside disc_for(point). True otherwise (the ray may
@@ -76,12 +79,28 @@ private:
     double plane_z_;
     double pupil_z_;
     double step_mm_;
+    double tight_step_mm_ = 0;  // the tight spans' (a fraction of step_mm_)
     double field_radius_mm_;
     double reach_mm_;
     std::vector<Bin> spans_;  // span i: a disc holding bins i and i + 1 (points between them)
-    std::vector<Bin> tight_spans_;  // the same, tight (empty unless asked for)
-    std::vector<Bin> cut_lo_spans_, cut_hi_spans_;  // the cutting discs (centred below and above)
-    PupilDisc holding(const std::vector<Bin>& spans, double step_mm, Vec3 centre, double radius, bool exact_turn) const;
+    // A tight span's disc (centred on the x axis) as its x extent [lo, hi], linear from the span's
+    // start (index 0) to its end (1); lit false: no light passes anywhere in the span.
+    struct Ramp {
+        bool lit = false;
+        double lo[2] = {0, 0}, hi[2] = {0, 0};
+        double y = 0;  // the centre's distance from the x axis (the off-axis pair: its upper disc)
+        bool pair = false;  // an off-axis pair of the span's own (not its disc standing in)
+    };
+    std::vector<Ramp> tight_ramps_;  // tight spans of tight_step_mm_ (empty unless asked for)
+    std::vector<Ramp> cut_lo_ramps_, cut_hi_ramps_;  // the cutting discs (centred below and above)
+    // The pair of cutting discs off the axis, per span (a span without one: its disc); pairs_: some
+    // span has one.
+    std::vector<Ramp> pair_ramps_;
+    bool pairs_ = false;
+    PupilDisc holding(const std::vector<Bin>& spans, double step_mm, Vec3 centre, double radius) const;
+    // pair (if given): set when a span met has a pair of its own.
+    PupilDisc holding(const std::vector<Ramp>& ramps, Vec3 centre, double radius, bool mirror,
+                      bool* pair = nullptr) const;
 };
 
 } // namespace plenoptic
