@@ -496,15 +496,14 @@ PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, doubl
         Ramp pair;                          // none (lit false) unless it pays
         if (!aspheric && polygons) {
             const Measured& m = at[size_t(first)];
-            const double x0 = m.centre_x, r0 = m.radius;
-            const double c0 = x0, d0 = r0;  // the disc
+            const double x0 = m.centre_x, r0 = m.radius;  // the disc
             // Each side's offset: kCutOffsets in geometric steps, then kCutRefinements rounds of the
             // two offsets a third of a step either side of the best.
             auto cut_offset = [&](double side) {
                 double best = INFINITY, best_f = 0;
                 auto consider = [&](double f) {
                     const double c = x0 + side * f * r0;
-                    const Circle two[2] = {{c0, 0, d0}, {c, 0, reach_from(m.hull, c)}};
+                    const Circle two[2] = {{x0, 0, r0}, {c, 0, reach_from(m.hull, c)}};
                     const double area = area_of(x0, two, 2);
                     if (area < best) {
                         best = area;
@@ -530,7 +529,7 @@ PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, doubl
             // cat's eye has, the discs on the axis overhang them): the direction and offset from the
             // region's centre that leave the least of the other three discs' intersection, if that
             // is less by kPairGain.
-            Circle held[5] = {{c0, 0, d0}, {x0 - off_lo, 0, reach_from(m.hull, x0 - off_lo)},
+            Circle held[5] = {{x0, 0, r0}, {x0 - off_lo, 0, reach_from(m.hull, x0 - off_lo)},
                               {x0 + off_hi, 0, reach_from(m.hull, x0 + off_hi)}, {}, {}};
             const double without = area_of(x0, held, 3);
             double best = without * (1 - kPairGain), pair_x = 0, pair_y = 0;
