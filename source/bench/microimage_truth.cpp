@@ -35,6 +35,10 @@
 // CELL x CELL cell points (the midpoint rule on the renderer's map of the cell): the lit points'
 // centroid. It adds the largest differences of the run's answer and of the check's from it
 // (brute_du_px, brute_dv_px, brute_check_du_px, brute_check_dv_px) and its CPU seconds.
+// --brute-jittered draws each cell point at random in its stratum of the midpoint rule, anew for each
+// sensor point (from a hash of the lens, the sensor point and the stratum): a rule that shares no
+// cell points with the truth's, so that where a lens's light is cut across the cell (displaced
+// neighbours, paths that leave the cell) the two do not step together.
 
 #include <chrono>
 #include <cmath>
@@ -77,6 +81,7 @@ struct Options {
     int anchor_step = -1, refracting_points = 0, check_points = 0;
     int brute_points = 0;
     double brute_step_px = 0;
+    bool brute_jittered = false;
     bench::RefractingOption refracting;
     double error_values[3] = {0, 0, 0};
     long long seed = 0;
@@ -125,7 +130,9 @@ bool parse(int argc, char** argv, Options* o)
         else if (arg == "--brute" && left >= 2) {
             o->brute_points = std::atoi(argv[++a]);
             o->brute_step_px = std::atof(argv[++a]);
-        } else if (arg == "--check" && left >= 1)
+        } else if (arg == "--brute-jittered")
+            o->brute_jittered = true;
+        else if (arg == "--check" && left >= 1)
             o->check = std::atoi(argv[++a]);
         else if (arg == "--csv" && left >= 1)
             o->csv = argv[++a];
@@ -137,8 +144,20 @@ bool parse(int argc, char** argv, Options* o)
 }
 
 // The lens's microimage centroid by brute force (--brute): false when no grid point is lit.
-bool brute_centroid(const PlenopticCamera& m, LensIndex lens, int cell_points, double step_px, int threads,
-                    double* u_px, double* v_px)
+// A number in [0, 1) from four integers (splitmix64's finaliser over their mix): the same for the same
+// arguments on any thread.
+double hashed_uniform(std::uint64_t a, std::uint64_t b, std::uint64_t c, std::uint64_t d)
+{
+    std::uint64_t z = a * 0x9e3779b97f4a7c15ull ^ (b + 0x632be59bd9b4e019ull) * 0xbf58476d1ce4e5b9ull ^
+                      (c + 0x8cb92ba72f3d8dd7ull) * 0x94d049bb133111ebull ^ (d + 0x2545f4914f6cdd1dull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return double(z >> 11) * (1.0 / 9007199254740992.0);
+}
+
+bool brute_centroid(const PlenopticCamera& m, LensIndex lens, int cell_points, double step_px, bool jittered,
+                    int threads, double* u_px, double* v_px)
 {
     const MicroimageCentre c = microimage_centre_px(m, lens);
     const double half = 1.25 * m.array.pitch_mm / m.sensor.pixel_size_mm[0];
@@ -160,7 +179,17 @@ bool brute_centroid(const PlenopticCamera& m, LensIndex lens, int cell_points, d
                 }
                 for (int b = 0; b < cell_points; ++b)
                     for (int a = 0; a < cell_points; ++a) {
-                        const CameraSample sample{u, v, (a + 0.5) / cell_points, (b + 0.5) / cell_points};
+                        // The cell point: the stratum's middle, or (--brute-jittered) a point drawn in
+                        // it for this sensor point alone, so that no edge of the lens's light lines up
+                        // with the strata.
+                        double ja = 0.5, jb = 0.5;
+                        if (jittered) {
+                            const std::uint64_t key = std::uint64_t(j) * 1000003u + std::uint64_t(i);
+                            const std::uint64_t where = std::uint64_t(b) * 65537u + std::uint64_t(a);
+                            ja = hashed_uniform(std::uint64_t(lens.k), std::uint64_t(lens.l), key, 2 * where);
+                            jb = hashed_uniform(std::uint64_t(lens.k), std::uint64_t(lens.l), key, 2 * where + 1);
+                        }
+                        const CameraSample sample{u, v, (a + ja) / cell_points, (b + jb) / cell_points};
                         if (generate_ray_unaimed(m, 0, 0, sample, &lens).passed) {
                             sum.count += 1;
                             sum.u += u;
@@ -207,6 +236,7 @@ int main(int argc, char** argv)
                              "         [--threads T] [--errors S F R SEED] [--refracting R CAP SUBSTRATE IOR]\n"
                              "         [--caps-to-sensor] [--reference] [--every-lens] [--no-symmetry] [--turn DEG]\n"
                              "         [--shift X_MM Y_MM] [--check N] [--check-points N] [--brute CELL STEP_PX]\n"
+                             "         [--brute-jittered]\n"
                              "         [--csv OUT]\n");
         return 2;
     }
@@ -326,7 +356,7 @@ int main(int argc, char** argv)
                 const MicroimageTruth& a = truth[which[i]];
                 const MicroimageTruth& b = each[i];
                 double u, v;
-                if (!brute_centroid(m, a.lens, o.brute_points, o.brute_step_px, threads, &u, &v)) {
+                if (!brute_centroid(m, a.lens, o.brute_points, o.brute_step_px, o.brute_jittered, threads, &u, &v)) {
                     if (a.lit)
                         brute_du = brute_dv = INFINITY;
                     continue;
@@ -346,9 +376,9 @@ int main(int argc, char** argv)
                     "\"check_cpu_s\": %.3f, \"check_worst_lens\": [%lld, %lld]}\n",
                     checked, check_du, check_dv, check_fraction, check_cpu, (long long)worst.k, (long long)worst.l);
     if (checked > 0 && o.brute_points > 0)
-        std::printf("{\"brute_points\": %d, \"brute_step_px\": %g, \"brute_du_px\": %.3g, \"brute_dv_px\": %.3g, "
+        std::printf("{\"brute_points\": %d, \"brute_step_px\": %g, \"brute_jittered\": %s, \"brute_du_px\": %.3g, \"brute_dv_px\": %.3g, "
                     "\"brute_check_du_px\": %.3g, \"brute_check_dv_px\": %.3g, \"brute_cpu_s\": %.3f}\n",
-                    o.brute_points, o.brute_step_px, brute_du, brute_dv, brute_check_du, brute_check_dv, brute_cpu);
+                    o.brute_points, o.brute_step_px, o.brute_jittered ? "true" : "false", brute_du, brute_dv, brute_check_du, brute_check_dv, brute_cpu);
     std::printf("{\"size\": [%d, %d], \"offset_mm\": [%.9g, %.9g], \"lenses\": %zu, \"lit_lenses\": %zu, "
                 "\"threads\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"peak_rss_mib\": %.1f, \"anchors\": %zu, "
                 "\"interpolated\": %zu, \"measured\": %zu, \"quarter_lenses\": %zu}\n",

@@ -3,6 +3,7 @@
 
 #include "plenoptic/core/lattice.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace plenoptic {
@@ -137,6 +138,60 @@ Vec2 sample_cell_uniform(GridType grid, double pitch, double u1, double u2)
     const Vec2 to = corner[(edge + 1) % 6];
     const double inradius = r * pitch / 2;
     return Vec2{inradius * (from.x + along * (to.x - from.x)), inradius * (from.y + along * (to.y - from.y))};
+}
+
+double cell_ring(GridType grid, double pitch, Vec2 h)
+{
+    const double x = std::fabs(h.x) / (0.5 * pitch), y = std::fabs(h.y) / (0.5 * pitch);
+    if (grid != GridType::Hexagonal)
+        return std::fmax(x, y);
+    // The largest distance to the lines through the centre along the sides (normals at 0 and +-60
+    // degrees), over the inradius.
+    return std::fmax(x, 0.5 * x + 0.5 * kSqrt3 * y);
+}
+
+Vec2 cell_uniform_inverse(GridType grid, double pitch, Vec2 h)
+{
+    if (grid != GridType::Hexagonal)
+        return Vec2{h.x / pitch + 0.5, h.y / pitch + 0.5};
+    const double r = cell_ring(grid, pitch, h);
+    if (r == 0)
+        return Vec2{0.5, 0.5};
+    // The side of the ring the point lies on (side e runs from the corner at -30 + 60 e degrees to
+    // the next), where along it, and so the fraction t of the ring from the middle of its right side.
+    static const Vec2 corner[6] = {
+        {1, -1 / kSqrt3}, {1, 1 / kSqrt3}, {0, 2 / kSqrt3}, {-1, 1 / kSqrt3}, {-1, -1 / kSqrt3}, {0, -2 / kSqrt3}};
+    double turns = (std::atan2(h.y, h.x) + kPi / 6) / (kPi / 3);
+    if (turns < 0)
+        turns += 6;
+    const int edge = std::min(5, int(turns));
+    const Vec2 from = corner[edge], to = corner[(edge + 1) % 6];
+    const double px = h.x / (0.5 * pitch * r), py = h.y / (0.5 * pitch * r);
+    const double ex = to.x - from.x, ey = to.y - from.y;
+    const double along = std::fmin(1.0, std::fmax(0.0, ((px - from.x) * ex + (py - from.y) * ey) / (ex * ex + ey * ey)));
+    double t = (edge + along - 0.5) / 6;
+    if (t < 0)
+        t += 1;
+    // The same fraction of the square ring of L-infinity radius r, counter-clockwise from (r, 0).
+    const double s = 8 * r * t;
+    double a, b;
+    if (s < r) {
+        a = r;
+        b = s;
+    } else if (s < 3 * r) {
+        a = 2 * r - s;
+        b = r;
+    } else if (s < 5 * r) {
+        a = -r;
+        b = 4 * r - s;
+    } else if (s < 7 * r) {
+        a = s - 6 * r;
+        b = -r;
+    } else {
+        a = r;
+        b = s - 8 * r;
+    }
+    return Vec2{0.5 * (a + 1), 0.5 * (b + 1)};
 }
 
 int cell_polygon(GridType grid, double pitch, Vec2 corners[6])

@@ -62,6 +62,15 @@ LensIndex nearest_lens(GridType grid, double pitch, double x, double y);
 // of the unit square go to concentric hexagons, arc length to arc length.
 Vec2 sample_cell_uniform(GridType grid, double pitch, double u1, double u2);
 
+// The inverse of sample_cell_uniform: the (u1, u2) that it maps to the cell point h (relative to
+// the lens centre, inside the cell), to rounding.
+Vec2 cell_uniform_inverse(GridType grid, double pitch, Vec2 h);
+
+// The ring of the cell's map through the point h (relative to the lens centre): the cell scaled by
+// r about its centre has h on its boundary (0 at the centre, 1 on the cell's edge); the square
+// ring max(|2 u1 - 1|, |2 u2 - 1|) of the sample that sample_cell_uniform maps to h.
+double cell_ring(GridType grid, double pitch, Vec2 h);
+
 // Cell corners relative to the lens centre, counter-clockwise; returns 4 or 6.
 int cell_polygon(GridType grid, double pitch, Vec2 corners[6]);
 

@@ -155,6 +155,30 @@ INSTANTIATE_TEST_SUITE_P(BothGrids, LatticeLookup, ::testing::Values(GridType::R
                              return std::string(info.param == GridType::Hexagonal ? "Hexagonal" : "Rectangular");
                          });
 
+// The inverse of the cell map: back to the sample it came from; and the ring through a point is where
+// the cell, scaled about its centre, has that point on its edge (found by the lattice lookup).
+TEST_P(LatticeLookup, CellMapInvertsAndRingsAreScaledCells)
+{
+    const GridType grid = GetParam();
+    const double p = 0.014;
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    for (int i = 0; i < 2000; ++i) {
+        const double u = i < 576 ? (i % 24 + 0.5) / 24 : uniform(rng), v = i < 576 ? (i / 24 + 0.5) / 24 : uniform(rng);
+        const Vec2 h = sample_cell_uniform(grid, p, u, v);
+        const Vec2 back = cell_uniform_inverse(grid, p, h);
+        EXPECT_NEAR(back.x, u, 1e-12) << u << ", " << v;
+        EXPECT_NEAR(back.y, v, 1e-12) << u << ", " << v;
+        const double ring = cell_ring(grid, p, h);
+        EXPECT_NEAR(ring, std::fmax(std::fabs(2 * u - 1), std::fabs(2 * v - 1)), 1e-12);
+        if (ring < 1e-3)
+            continue;
+        const Vec2 edge{h.x / ring, h.y / ring};
+        EXPECT_EQ(nearest_lens(grid, p, (1 - 1e-9) * edge.x, (1 - 1e-9) * edge.y), (LensIndex{0, 0}));
+        EXPECT_NE(nearest_lens(grid, p, (1 + 1e-9) * edge.x, (1 + 1e-9) * edge.y), (LensIndex{0, 0}));
+    }
+}
+
 TEST(Lattice, HexagonalCellIsPointyTop)
 {
     const double p = 1.0, R = p / kSqrt3;

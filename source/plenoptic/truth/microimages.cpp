@@ -510,6 +510,73 @@ std::vector<CellNode> cell_nodes(const PlenopticCamera& m, const MicroimageOptio
     return nodes;
 }
 
+// Refracting microlenses on an array with displaced lenses: the renderer samples a lens's cell (the
+// lattice's cell shape about the lens's actual centre, in the lens's own plane) and passes only the
+// points that lie in the lens's own cell, nearer its actual centre than any neighbour's
+// (array/refracting_microlens.cpp). The light comes through the part of the cell that does: a
+// convex polygon about the centre, the cell cut by the bisectors with the displaced neighbours.
+// Leaving out the cell points that fall outside it would count whole points in or out, a step of
+// a 576th of the light each (up to some 0.04 px where the microimages fill their cells, BENCHMARKS
+// "Cell points on displaced lenses"). Instead each cell point h moves along its ray from the centre
+// by the cut polygon's radius over the cell's there, s = rho_cut / rho_cell <= 1, and weighs s^2
+// more (the map (r, theta) -> (s(theta) r, theta) scales areas by s^2): the same midpoint rule on
+// the cut cell, whose integrand bends where the polygon turns but no longer steps. Returns whether
+// any point moved (the nodes are `nodes` themselves otherwise).
+bool nodes_in_own_cell(const MicrolensArray& a, LensIndex lens, const std::vector<CellNode>& nodes,
+                       std::vector<CellNode>* out)
+{
+    const LensFrame frame = a.frame(lens);
+    // A cell point h (the lens's plane) lies at frame.centre + axes h (the array's frame), on the
+    // lens's side of the bisector with neighbour n when (axes h) . delta <= |delta|^2 / 2, delta =
+    // its centre less this one (in the plane), that is h . delta' <= |delta|^2 / 2 with delta' the
+    // plane part of axes^T delta. (Every displacement is below a quarter of the pitch, so only the
+    // adjacent lenses' bisectors can cut the cell: MicrolensArray::nearest.)
+    LensIndex adjacent[8];
+    const int count = adjacent_lenses(a.grid, lens, adjacent);
+    Vec2 normal[8];
+    double half_sq[8];
+    for (int j = 0; j < count; ++j) {
+        const Vec3 c = a.centre_local3(adjacent[j]);
+        const Vec3 delta{c.x - frame.centre.x, c.y - frame.centre.y, 0};
+        const Vec3 in_plane = frame.tilted ? mul_transposed(frame.axes, delta) : delta;
+        normal[j] = Vec2{in_plane.x, in_plane.y};
+        half_sq[j] = 0.5 * (delta.x * delta.x + delta.y * delta.y);
+    }
+    auto own = [&](Vec2 h) {
+        const Vec3 in_plane{h.x, h.y, 0};
+        const Vec3 local = frame.centre + (frame.tilted ? mul(frame.axes, in_plane) : in_plane);
+        return a.nearest(local.x, local.y) == lens;
+    };
+    bool moved = false;
+    out->assign(nodes.begin(), nodes.end());
+    for (CellNode& node : *out) {
+        const Vec2 h = a.cell_point(node.lens_u, node.lens_v);
+        const double ring = cell_ring(a.grid, a.pitch_mm, h);
+        double scale = 1;
+        for (int j = 0; j < count; ++j) {
+            const double along = h.x * normal[j].x + h.y * normal[j].y;
+            if (along > 0)
+                scale = std::min(scale, ring * half_sq[j] / along);
+        }
+        if (!(scale < 1))
+            continue;
+        // The moved point as the renderer will make it from its sample, inside the lens's own cell
+        // (a point on the polygon's edge may round to the neighbour's side: moved in a hair).
+        Vec2 sample{node.lens_u, node.lens_v};
+        for (int attempt = 0; attempt < 4; ++attempt) {
+            sample = cell_uniform_inverse(a.grid, a.pitch_mm, Vec2{scale * h.x, scale * h.y});
+            if (own(a.cell_point(sample.x, sample.y)))
+                break;
+            scale *= 1 - 1e-9;
+        }
+        node.lens_u = sample.x;
+        node.lens_v = sample.y;
+        node.divisor /= scale * scale;
+        moved = true;
+    }
+    return moved;
+}
+
 } // namespace
 
 MicroimageOptions default_microimage_options()
@@ -537,7 +604,7 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
 {
     if (out.empty())
         return true;
-    const std::vector<CellNode> nodes = cell_nodes(m, options);
+    const std::vector<CellNode> all_nodes = cell_nodes(m, options);
     // Per cell point, the radii of its region in the last kHistory lenses of a run, newest first
     // (fewer at the run's start or after a lens without that region), and a prediction.
     const std::size_t kHistory = 2;
@@ -547,8 +614,13 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
     };
     if (lobes)
         lobes->assign(out.size(), 0);
-    auto measure = [&](std::size_t index, Radii* radii) {
+    // Refracting lenses that may be displaced: each lens's cell points moved into its own cell.
+    const bool cut_cells = light.array.errors && light.array.errors->max_shift_mm() > 0 &&
+                           refracting_shape(*light.array.microlens) != nullptr;
+    auto measure = [&](std::size_t index, Radii* radii, std::vector<CellNode>* own_nodes) {
         MicroimageTruth& truth = out[index];
+        const std::vector<CellNode>& nodes =
+            cut_cells && nodes_in_own_cell(light.array, truth.lens, all_nodes, own_nodes) ? *own_nodes : all_nodes;
         bool found_lobe = false;
         const MicroimageCentre lattice = microimage_centre_px(m, truth.lens);
         const Vec2 centre{lattice.u, lattice.v};
@@ -646,7 +718,8 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
     // The calling thread (`reports`) works too: it polls `cancelled` between lenses and reports.
     auto work = [&](bool reports) {
         Radii radii;
-        radii.history.resize(nodes.size());
+        radii.history.resize(all_nodes.size());
+        std::vector<CellNode> own_nodes;
         for (std::size_t r = next++; r + 1 < runs.size() && !stop; r = next++) {
             for (std::vector<std::vector<double>>& past : radii.history)
                 past.clear();
@@ -655,7 +728,7 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
                     stop = true;
                     break;
                 }
-                measure(i, reuse ? &radii : nullptr);
+                measure(i, reuse ? &radii : nullptr, &own_nodes);
                 const std::size_t now = ++done;
                 if (reports && progress && now * 10 / out.size() > reported * 10 / out.size()) {
                     reported = now;
