@@ -1120,9 +1120,11 @@ struct CachedPlans {
 
 } // namespace
 
-PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, double pixel_v, const LensIndex* forced)
+namespace {
+
+// The pixel's plan through `forced` (or its own lenses), from this thread's cache or made now.
+const PixelPlan& cached_plan(const PlenopticCamera& m, int i, int j, const LensIndex* forced)
 {
-    PixelAim out{i + pixel_u, j + pixel_v, 1, false, LensIndex{0, 0}, true};
     static thread_local CachedPlans cache;
     if (!(cache.valid && cache.i == i && cache.j == j && key_is(cache.key, m))) {
         cache.valid = true;
@@ -1146,7 +1148,20 @@ PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, doubl
         e.lens = forced ? *forced : LensIndex{0, 0};
         plan_pixel(m, i, j, forced, &e.plan);
     }
-    const PixelPlan& plan = cache.entries[size_t(found)].plan;
+    return cache.entries[size_t(found)].plan;
+}
+
+} // namespace
+
+bool aim_reaches_pixel(const PlenopticCamera& m, int i, int j, LensIndex lens)
+{
+    return cached_plan(m, i, j, &lens).kind != PixelPlan::Dark;
+}
+
+PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, double pixel_v, const LensIndex* forced)
+{
+    PixelAim out{i + pixel_u, j + pixel_v, 1, false, LensIndex{0, 0}, true};
+    const PixelPlan& plan = cached_plan(m, i, j, forced);
     if (plan.kind == PixelPlan::Uniform)
         return out;
     if (plan.forced) {

@@ -141,6 +141,11 @@ struct PixelAim {
 };
 PixelAim aim_pixel(const PlenopticCamera& model, int i, int j, double pixel_u, double pixel_v, const LensIndex* forced);
 
+// False when no light through `lens` can reach pixel (i, j): the pixel meets none of the lens's
+// conservative region where its light lands (aim_pixel through that lens would give no point).
+// True when it may. The plan is kept for the pixel's samples (the same cache as aim_pixel's).
+bool aim_reaches_pixel(const PlenopticCamera& model, int i, int j, LensIndex lens);
+
 // The ray from sensor point p through `lens` for aperture sample (u, v), drawn from the part of
 // the cell where light from p can pass (lit_cell_disc and the cuts', over lit_cell_x_range), with
 // *weight that part's sampled measure over the cell's area; the uniform sample_ray (weight 1) when that part holds the whole cell or

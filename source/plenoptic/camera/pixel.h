@@ -6,6 +6,7 @@
 
 #include <algorithm>
 
+#include "plenoptic/camera/aim.h"
 #include "plenoptic/camera/rays.h"
 
 namespace plenoptic {
@@ -277,6 +278,16 @@ Channels<N> shade_samples(const PlenopticCamera& model, int i, int j, TraceFn& t
     int lens_count = 1;
     if (model.overlap.modelled) {
         lens_count = overlap_lenses(model, i, j, lenses, kMaxOverlapLenses);
+        if (model.sampling.aim) {
+            // A lens whose light provably misses the pixel (its aim finds no part of the pixel
+            // where that light lands) adds nothing to the sum over lenses, and its samples would
+            // all be blocked: it is left out, and the others take its samples.
+            int kept = 0;
+            for (int s = 0; s < lens_count; ++s)
+                if (aim_reaches_pixel(model, i, j, lenses[s]))
+                    lenses[kept++] = lenses[s];
+            lens_count = kept;
+        }
         if (lens_count == 0)
             return zero_channels<N>();
     }
@@ -436,7 +447,8 @@ Channels<N> pixel_channels(const PlenopticCamera& model, int i, int j, TraceFn& 
 // times its lit area from the table, averaged over a 4 x 4 grid (detail::lit_area_value). With one sample,
 // the chief ray alone (weighted by the lit area at the pixel's centre).
 // With overlap modelling, sample n goes through the pixel's lens n mod L (L lenses from
-// overlap_lenses) as sample n / L of that lens's own sample stream (detail::lens_sample), and
+// overlap_lenses; with aimed samples, less those whose light cannot reach the pixel:
+// aim_reaches_pixel) as sample n / L of that lens's own sample stream (detail::lens_sample), and
 // the value is the sum over lenses of each lens's mean; t is clamped to [0, 1]. A pixel that no
 // lens reaches is black and opaque, never background. With spectral sampling, the samples are shared
 // among the wavelength bands (detail::spectral_pixel).

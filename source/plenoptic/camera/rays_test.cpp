@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "plenoptic/camera/aim.h"
 #include "plenoptic/camera/rays.h"
 #include "plenoptic/core/test_util.h"
 
@@ -465,6 +466,58 @@ TEST(Optics, OverlapPruningNeverDropsALensThatDeliversLight)
             check_overlap_pruning((name + ", errors").c_str(), refracting, 1.01);
         }
     }
+}
+
+// With aimed samples a pixel leaves out the overlap lenses whose aim finds no part of it where their
+// light lands (aim_reaches_pixel, camera/pixel.h). Checked by brute force: through every lens left
+// out, 256 uniform samples of the pixel and the cell (the renderer's unaimed rays, forced through
+// that lens) all miss; and the test is not empty: lenses are left out, and lenses kept are lit.
+void check_aim_leaves_out_only_dark_lenses(const char* name, CameraParams params)
+{
+    params.sensor.pixel_size_mm[0] = params.sensor.pixel_size_mm[1] = 0.01;
+    ASSERT_EQ(check_camera(params), "") << name;
+    const PlenopticCamera m = with_film(make_camera(params), 160, 120);
+    ASSERT_TRUE(m.overlap.modelled) << name;
+    ASSERT_TRUE(m.sampling.aim) << name;
+    LensIndex lenses[kMaxOverlapLenses];
+    int left_out = 0, kept_lit = 0, failures = 0;
+    for (int j = 1; j < 120 && failures < 5; j += 7) {
+        for (int i = 2; i < 160 && failures < 5; i += 6) {
+            const int count = overlap_lenses(m, i, j, lenses, kMaxOverlapLenses);
+            for (int s = 0; s < count; ++s) {
+                bool lit = false;
+                for (int n = 0; n < 256 && !lit; ++n)
+                    lit = generate_ray_unaimed(m, i, j, make_sample(i, j, n, 256), &lenses[s]).passed;
+                if (aim_reaches_pixel(m, i, j, lenses[s])) {
+                    kept_lit += lit;
+                    continue;
+                }
+                ++left_out;
+                if (lit) {
+                    ++failures;
+                    ADD_FAILURE() << name << ": pixel " << i << "," << j << " receives light through lens ("
+                                  << lenses[s].k << "," << lenses[s].l << "), which its aim says cannot reach it";
+                }
+            }
+        }
+    }
+    EXPECT_GT(left_out, 0) << name;
+    EXPECT_GT(kept_lit, 0) << name;
+}
+
+TEST(Optics, AimLeavesOutOnlyOverlapLensesThatCannotLightThePixel)
+{
+    check_aim_leaves_out_only_dark_lenses("matched plenoptic 1.0", plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 5, 50));
+    check_aim_leaves_out_only_dark_lenses("plenoptic 1.0 at f/2.5", plenoptic_camera(GridType::Rectangular, 0.1, 0.5, 0.5, 50, 2.5, 50));
+    const Prescription triplet = test::vignetting_triplet();
+    CameraParams real = plenoptic_camera(GridType::Hexagonal, 0.1, 0.5, 0.5, 50, 4, paraxial_image_distance(triplet, 3000).mm);
+    test::use_prescription(&real, triplet);
+    check_aim_leaves_out_only_dark_lenses("traced triplet", real);
+    real.array.has_errors = true;
+    real.array.errors.position_sd_mm = 0.004;
+    real.array.errors.focal_sd = 0.03;
+    real.array.errors.seed = 7;
+    check_aim_leaves_out_only_dark_lenses("traced triplet, lenses with errors", real);
 }
 
 TEST(Optics, OverlapLensesListsTheOwnLensFirst)
