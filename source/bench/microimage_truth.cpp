@@ -9,7 +9,7 @@
 //   plenoptic_microimage_truth --lens-file FILE --f-number N --focus-distance Z
 //       --sensor W H PIXEL_MM --array PITCH_MM F_MM D_MM [--thick] [--offset X_MM Y_MM] [--threads T]
 //       [--errors S F R SEED] [--refracting R CAP SUBSTRATE IOR] [--caps-to-sensor] [--reference]
-//       [--every-lens] [--no-symmetry] [--turn DEG] [--shift X_MM Y_MM] [--check N] [--csv OUT]
+//       [--every-lens] [--error-anchors N] [--no-symmetry] [--turn DEG] [--shift X_MM Y_MM] [--check N] [--csv OUT]
 //
 // --offset shifts the sensor (sensor { offset }): a crop of a larger raw away from its centre,
 // e.g. its corner. --turn and --shift turn the array about the axis and move it across
@@ -21,6 +21,8 @@
 // SUBSTRATE }, the curved side towards the scene, or towards the sensor with --caps-to-sensor; F_MM of
 // --array is then unused). Refracting lenses on an array without errors are interpolated between
 // anchors (MicroimageOptions::anchor_step); --every-lens measures every lens instead (anchor_step 0).
+// --error-anchors N: refracting lenses with errors corrected from Jacobian anchors N lenses apart
+// (MicroimageOptions::error_anchor_step; without it every such lens is measured).
 // Refracting lenses on an array centred on the axis are measured in one quarter of it only, the
 // others mirrored (MicroimageOptions::symmetry), and one turned or moved off the axis has its anchors
 // measured in the same array turned back onto the axis; --no-symmetry measures each lens where it is.
@@ -78,7 +80,7 @@ struct Options {
     bool every_lens = false;
     bool no_symmetry = false;
     int check = 0;
-    int anchor_step = -1, refracting_points = 0, check_points = 0;
+    int anchor_step = -1, refracting_points = 0, check_points = 0, error_anchor_step = 0;
     int brute_points = 0;
     double brute_step_px = 0;
     bool brute_jittered = false;
@@ -125,6 +127,8 @@ bool parse(int argc, char** argv, Options* o)
             o->check_points = std::atoi(argv[++a]);
         else if (arg == "--anchor-step" && left >= 1)
             o->anchor_step = std::atoi(argv[++a]);
+        else if (arg == "--error-anchors" && left >= 1)
+            o->error_anchor_step = std::atoi(argv[++a]);
         else if (arg == "--points" && left >= 1)
             o->refracting_points = std::atoi(argv[++a]);
         else if (arg == "--brute" && left >= 2) {
@@ -273,6 +277,7 @@ int main(int argc, char** argv)
     options.reuse_neighbours = !o.reference;
     if (o.anchor_step >= 0)
         options.anchor_step = o.anchor_step;
+    options.error_anchor_step = o.error_anchor_step;
     if (o.refracting_points > 0)
         options.refracting_points = o.refracting_points;
     if (o.no_symmetry)
@@ -381,8 +386,10 @@ int main(int argc, char** argv)
                     o.brute_points, o.brute_step_px, o.brute_jittered ? "true" : "false", brute_du, brute_dv, brute_check_du, brute_check_dv, brute_cpu);
     std::printf("{\"size\": [%d, %d], \"offset_mm\": [%.9g, %.9g], \"lenses\": %zu, \"lit_lenses\": %zu, "
                 "\"threads\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, \"peak_rss_mib\": %.1f, \"anchors\": %zu, "
-                "\"interpolated\": %zu, \"measured\": %zu, \"quarter_lenses\": %zu}\n",
+                "\"interpolated\": %zu, \"measured\": %zu, \"quarter_lenses\": %zu, \"corrected\": %zu, "
+                "\"error_anchors\": %zu}\n",
                 o.camera.width, o.camera.height, o.offset_mm[0], o.offset_mm[1], truth.size(), lit, o.threads, wall, cpu,
-                usage.ru_maxrss / 1024.0, work.anchors, work.interpolated, work.measured, work.quarter_lenses);
+                usage.ru_maxrss / 1024.0, work.anchors, work.interpolated, work.measured, work.quarter_lenses,
+                work.corrected, work.error_anchors);
     return 0;
 }

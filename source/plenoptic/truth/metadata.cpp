@@ -192,6 +192,12 @@ Json microimages_json(const MicroimageSummary* summary)
     }
     if (summary->work.quarter_lenses > 0)
         integration["quarter_lenses"] = summary->work.quarter_lenses;  // measured; the others mirror them
+    if (summary->work.corrected > 0) {
+        // Refracting microlenses with errors, corrected (docs/real-lenses.md, "Microimage centres").
+        integration["error_anchor_step"] = summary->options.error_anchor_step;
+        integration["error_anchors"] = summary->work.error_anchors;
+        integration["corrected_lenses"] = summary->work.corrected;
+    }
     json["integration"] = integration;
     const LatticeFit& fit = summary->fit;
     if (fit.valid) {

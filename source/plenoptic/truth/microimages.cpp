@@ -956,6 +956,45 @@ struct Anchors {
     LensIndex lens(std::int64_t K, std::int64_t L) const { return LensIndex{K * step, L * step}; }
 };
 
+// The cubic through the 4 x 4 anchors from (i0, j0) (Anchors::stencil) of the value v(i, j, q), at
+// (x, y) in anchor units, and in `error` the estimate of how far it misses the function: each
+// direction's cubic_error from the largest fourth difference along it over the stencil's rows and
+// columns, of each window of five anchors that holds the stencil's four (every anchor of
+// Anchors::each is read).
+template <class V>
+double cubic_through(const Anchors& a, std::int64_t i0, std::int64_t j0, double x, double y, const V& v, int q,
+                     double* error)
+{
+    double largest[2] = {0, 0};
+    for (int across = 0; across < 4; ++across)
+        for (std::int64_t first = -1; first <= 0; ++first) {
+            if (i0 + first >= a.k0 && i0 + first + 4 <= a.k1) {
+                const std::int64_t i = i0 + first, j = j0 + across;
+                const double d4 =
+                    v(i, j, q) - 4 * v(i + 1, j, q) + 6 * v(i + 2, j, q) - 4 * v(i + 3, j, q) + v(i + 4, j, q);
+                largest[0] = std::max(largest[0], std::fabs(d4));
+            }
+            if (j0 + first >= a.l0 && j0 + first + 4 <= a.l1) {
+                const std::int64_t i = i0 + across, j = j0 + first;
+                const double d4 =
+                    v(i, j, q) - 4 * v(i, j + 1, q) + 6 * v(i, j + 2, q) - 4 * v(i, j + 3, q) + v(i, j + 4, q);
+                largest[1] = std::max(largest[1], std::fabs(d4));
+            }
+        }
+    *error = cubic_error(x - double(i0), largest[0]) + cubic_error(y - double(j0), largest[1]);
+    double wx[4], wy[4];
+    cubic_weights(x - double(i0), wx);
+    cubic_weights(y - double(j0), wy);
+    double sum = 0;
+    for (int j = 0; j < 4; ++j) {
+        double row = 0;
+        for (int i = 0; i < 4; ++i)
+            row += wx[i] * v(i0 + i, j0 + j, q);
+        sum += wy[j] * row;
+    }
+    return sum;
+}
+
 // The lens's microimage from the anchors, or false where the anchors do not vouch for the cubic (a
 // dark anchor among those it reads, an anchor with a lobe of light that crossed cells, or a fourth
 // difference too large). Lobes (refracting lenses without baffles, light that left its cell in
@@ -986,39 +1025,12 @@ bool interpolate(const Anchors& a, Vec2 at, MicroimageTruth* truth, Vec2 lattice
         return false;
     auto v = [&](std::int64_t i, std::int64_t j, int q) { return block[j - j0 + 1][i - i0 + 1]->value[q]; };
     const double allowed[3] = {kInterpolatedPx, kInterpolatedPx, kInterpolatedFraction};
-    double wx[4], wy[4];
-    cubic_weights(x - double(i0), wx);
-    cubic_weights(y - double(j0), wy);
     double result[3];
     for (int q = 0; q < 3; ++q) {
-        // The largest fourth difference along each direction over the stencil's rows and columns,
-        // of each window of five anchors that holds the stencil's four.
-        double largest[2] = {0, 0};
-        for (int across = 0; across < 4; ++across)
-            for (std::int64_t first = -1; first <= 0; ++first) {
-                if (i0 + first >= a.k0 && i0 + first + 4 <= a.k1) {
-                    const std::int64_t i = i0 + first, j = j0 + across;
-                    const double d4 = v(i, j, q) - 4 * v(i + 1, j, q) + 6 * v(i + 2, j, q) - 4 * v(i + 3, j, q) +
-                                      v(i + 4, j, q);
-                    largest[0] = std::max(largest[0], std::fabs(d4));
-                }
-                if (j0 + first >= a.l0 && j0 + first + 4 <= a.l1) {
-                    const std::int64_t i = i0 + across, j = j0 + first;
-                    const double d4 = v(i, j, q) - 4 * v(i, j + 1, q) + 6 * v(i, j + 2, q) - 4 * v(i, j + 3, q) +
-                                      v(i, j + 4, q);
-                    largest[1] = std::max(largest[1], std::fabs(d4));
-                }
-            }
-        if (cubic_error(x - double(i0), largest[0]) + cubic_error(y - double(j0), largest[1]) > allowed[q])
+        double error;
+        result[q] = cubic_through(a, i0, j0, x, y, v, q, &error);
+        if (error > allowed[q])
             return false;
-        double sum = 0;
-        for (int j = 0; j < 4; ++j) {
-            double row = 0;
-            for (int i = 0; i < 4; ++i)
-                row += wx[i] * v(i0 + i, j0 + j, q);
-            sum += wy[j] * row;
-        }
-        result[q] = sum;
     }
     truth->lit = true;
     truth->u_px = lattice_px.x + result[0];
@@ -1077,25 +1089,27 @@ public:
     // The cameras the anchors are measured in.
     const PlenopticCamera& model() const { return active_ ? model_ : m_; }
     const PlenopticCamera& light() const { return active_ ? light_model_ : light_; }
-    // Where the lens lies among those anchors, in lattice units (X, Y above).
-    Vec2 position(LensIndex lens) const
+    // Where the lens lies among those anchors, in lattice units (X, Y above); `shift` (array-local,
+    // mm) moves it off its lattice point (a displaced lens: the ideal lens that sits where it sits).
+    Vec2 position(LensIndex lens, Vec2 shift = Vec2{0, 0}) const
     {
-        if (!active_)
+        if (!active_ && shift.x == 0 && shift.y == 0)
             return Vec2{lattice_x(m_.array.grid, lens), double(lens.l)};
-        const Vec2 c = canonical_local(lens);
+        const Vec2 c = canonical_local(lens, shift);
         return Vec2{c.x / m_.array.pitch_mm, c.y / m_.array.row_spacing_mm()};
     }
-    // The lens's lattice centre projected onto the sensor from the exit pupil's centre (pixels,
-    // centre convention) in the anchors' camera: what the interpolated offset is added to.
-    bool centre_px(LensIndex lens, Vec2* px) const
+    // The lens's lattice centre (moved by `shift`) projected onto the sensor from the exit pupil's
+    // centre (pixels, centre convention) in the anchors' camera: what the interpolated offset is
+    // added to.
+    bool centre_px(LensIndex lens, Vec2* px, Vec2 shift = Vec2{0, 0}) const
     {
-        if (!active_) {
+        if (!active_ && shift.x == 0 && shift.y == 0) {
             const MicroimageCentre c = microimage_centre_px(m_, lens);
             *px = Vec2{c.u, c.v};
             return c.valid;
         }
-        const Vec2 c = canonical_local(lens);
-        return project_to_sensor_px(model_, model_.array.to_optics(Vec3{c.x, c.y, 0}), px);
+        const Vec2 c = canonical_local(lens, shift);
+        return project_to_sensor_px(model(), model().array.to_optics(Vec3{c.x, c.y, 0}), px);
     }
     // A sensor point of the anchors' camera (pixels, centre convention) in this camera: turned
     // about the axis with the array.
@@ -1111,10 +1125,12 @@ public:
 private:
     // The lens's lattice point in the canonical array's frame: its place in the optics frame turned
     // back about the axis.
-    Vec2 canonical_local(LensIndex lens) const
+    Vec2 canonical_local(LensIndex lens, Vec2 shift) const
     {
         const Vec2 c = m_.array.lattice_centre_local(lens);
-        const Vec3 q = m_.array.to_optics(Vec3{c.x, c.y, 0});
+        if (!active_)
+            return Vec2{c.x + shift.x, c.y + shift.y};
+        const Vec3 q = m_.array.to_optics(Vec3{c.x + shift.x, c.y + shift.y, 0});
         return Vec2{turn_[0] * q.x + turn_[1] * q.y, -turn_[1] * q.x + turn_[0] * q.y};
     }
 
@@ -1124,6 +1140,416 @@ private:
     bool active_ = false;
     double turn_[2] = {1, 0};  // cos, sin of the array's turn about the axis
 };
+
+// Manufacturing errors on refracting microlenses, corrected (MicroimageOptions::error_anchor_step;
+// renders measure every lens). Measuring each lens costs some 60 ms (its 24 x 24 cell points), hours
+// for a raw; but the errors are small (a fraction of a micrometre, a few per cent, a fraction of a
+// degree) and a lens's microimage changes smoothly with most of them. So a lens with errors is
+// taken as the ideal lens that sits where it sits (the anchors' cubic at its displaced centre: its
+// cell and its neighbours moved with it), corrected to second order in each of its parameters x_p:
+// its displacement along the axis, its focal factor less 1, its axis's x and y, and each adjacent
+// lens's displacement from it (x and y, array frame: where the walls between their columns and the
+// bisector that cuts its cell lie). The correction is the sum over p of J_p x_p + H_p x_p^2 / 2 +
+// K_p x_p x_f (x_f the focal factor's), J_p, H_p and K_p the central, second and mixed differences
+// of Jacobian anchors error_anchor_step lenses apart, each measured with x_p = +h_p and -h_p alone
+// (h_p the largest |x_p| the errors give; a lens's own for a displacement), and with x_p = h_p and
+// x_f = +-h_f; the corrections the 4 x 4 Jacobian anchors nearest the lens give for its x are
+// interpolated by the cubic where their fourth differences vouch for it. Left out: terms in two
+// parameters together other than with the focal factor (two neighbours: some 0.005 px), and kinks
+// where a neighbour's approach cuts lit cell points and its retreat adds none (BENCHMARKS
+// "Refracting microlenses with errors, corrected"). A lens that this cannot vouch for is measured.
+
+// The corrections' cubic is used where its estimated error is below these. The differences carry
+// the measurements' own scatter (some 1e-4 to 1e-3 px, 3e-5 of lit fraction, BENCHMARKS "Refracting
+// microlenses between anchors") divided by the step, and their fourth differences mostly that
+// scatter: a bound at the anchors' 5e-4 px would refuse most lenses on it alone.
+const double kCorrectionPx = 2e-3;
+const double kCorrectionFraction = 2e-4;
+
+// One error parameter of a lens, and the step of its differences.
+struct ErrorParameter {
+    // 0: dz (mm); 1: focal factor - 1; 2, 3: the axis's x, y; 4 + 2 a + c: the displacement of the
+    // lens's adjacent lens a (adjacent_lenses' order: the same lattice direction for every lens)
+    // from its own, component c (x, y; mm, array frame).
+    int kind;
+    double step;
+};
+
+// The parameters' largest count: four of the lens's own, two for each of up to eight adjacent lenses.
+const int kMaxErrorParameters = 4 + 2 * 8;
+
+// The lens's own error with parameter `kind` (< 4) at `value` and no other.
+LensError error_with(int kind, double value)
+{
+    LensError e;
+    if (kind == 0) {
+        e.dz_mm = value;
+    } else if (kind == 1) {
+        e.focal_factor = 1 + value;
+    } else {
+        e.tilt_deg = std::asin(std::fabs(value)) * 180 / kPi;
+        e.tilt_azimuth_deg = (kind == 2 ? 0 : 90) + (value < 0 ? 180 : 0);
+    }
+    return e;
+}
+
+// The lens's parameters' values, in `parameters`' order.
+void error_values(const MicrolensArray& a, LensIndex lens, const std::vector<ErrorParameter>& parameters, double* x)
+{
+    const LensError e = a.error_of(lens);
+    LensIndex adjacent[8];
+    const int count = adjacent_lenses(a.grid, lens, adjacent);
+    for (std::size_t p = 0; p < parameters.size(); ++p) {
+        const int kind = parameters[p].kind;
+        if (kind == 0) {
+            x[p] = e.dz_mm;
+        } else if (kind == 1) {
+            x[p] = e.focal_factor - 1;
+        } else if (kind < 4) {
+            x[p] = kind == 2 ? e.axis.x : e.axis.y;
+        } else {
+            const int j = (kind - 4) / 2;
+            const LensError n = j < count ? a.error_of(adjacent[j]) : e;
+            x[p] = (kind - 4) % 2 == 0 ? n.dx_mm - e.dx_mm : n.dy_mm - e.dy_mm;
+        }
+    }
+}
+
+// The linear part of an affine map of sensor points (pixels): a vector's image.
+template <class F> Vec2 linear_part(const F& map, Vec2 d)
+{
+    const Vec2 o = map(Vec2{0, 0}), p = map(d);
+    return Vec2{p.x - o.x, p.y - o.y};
+}
+
+// Corrects the lenses of `out` interpolated from the ideal anchors (interpolated[i]) for their
+// errors, as above; the lenses it cannot vouch for go onto `pending` (to be measured). `light`: the
+// camera with errors whose light is measured; `anchor_known`: the ideal quarter lenses measured so
+// far (measure_symmetric's cache). False when cancelled.
+bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical, const Symmetry& symmetry,
+                        const MicroimageOptions& options,
+                        const std::vector<Vec2>& at, const std::vector<char>& interpolated,
+                        std::unordered_map<std::uint64_t, std::pair<MicroimageTruth, char>>& anchor_known,
+                        const double range[4], const MicroimageCancel& cancelled, std::vector<MicroimageTruth>& out,
+                        std::vector<std::size_t>& pending, MicroimageWork& counts)
+{
+    const PlenopticCamera& am = canonical.model();
+    const LensErrors& errors = *light.array.errors;
+    std::vector<ErrorParameter> parameters;
+    if (errors.max_dz_mm() > 0)
+        parameters.push_back(ErrorParameter{0, errors.max_dz_mm()});
+    if (errors.max_focal_deviation() > 0)
+        parameters.push_back(ErrorParameter{1, errors.max_focal_deviation()});
+    if (errors.tilts()) {
+        const double h = std::sin(errors.max_tilt_deg() * kPi / 180);
+        parameters.push_back(ErrorParameter{2, h});
+        parameters.push_back(ErrorParameter{3, h});
+    }
+    if (errors.max_shift_mm() > 0) {
+        LensIndex adjacent[8];
+        const int count = adjacent_lenses(am.array.grid, LensIndex{0, 0}, adjacent);
+        for (int c = 0; c < 2 * count; ++c)
+            parameters.push_back(ErrorParameter{4 + c, errors.max_shift_mm() / std::sqrt(2.0)});
+    }
+    const std::size_t P = parameters.size();
+    std::vector<std::size_t> lenses;  // the interpolated lenses
+    for (std::size_t i = 0; i < out.size(); ++i)
+        if (interpolated[i])
+            lenses.push_back(i);
+    if (P == 0 || lenses.empty())
+        return true;
+
+    // The Jacobian anchors: error_anchor_step lenses apart (at least five a side, else every lens is
+    // measured).
+    Anchors jacobian;
+    const std::int64_t step = options.error_anchor_step;
+    jacobian.step = step;
+    jacobian.k0 = std::int64_t(std::floor(range[0] / double(step))) - 1;
+    jacobian.k1 = std::int64_t(std::floor(range[1] / double(step))) + 2;
+    jacobian.l0 = std::int64_t(std::floor(range[2] / double(step))) - 1;
+    jacobian.l1 = std::int64_t(std::floor(range[3] / double(step))) + 2;
+    std::vector<MicroimageTruth> anchors;
+    if (jacobian.k1 - jacobian.k0 >= 4 && jacobian.l1 - jacobian.l0 >= 4) {
+        std::unordered_map<std::uint64_t, char> seen;
+        for (std::size_t index : lenses) {
+            std::int64_t i0, j0;
+            double x, y;
+            jacobian.stencil(at[index], &i0, &j0, &x, &y);
+            jacobian.each(i0, j0, [&](std::int64_t i, std::int64_t j) {
+                const LensIndex lens = jacobian.lens(i, j);
+                if (seen.emplace(anchor_key(lens), 1).second) {
+                    MicroimageTruth t = MicroimageTruth();
+                    t.lens = lens;
+                    anchors.push_back(t);
+                }
+            });
+        }
+    }
+    if (anchors.empty()) {
+        pending.insert(pending.end(), lenses.begin(), lenses.end());
+        std::sort(pending.begin(), pending.end());
+        return true;
+    }
+    std::sort(anchors.begin(), anchors.end(), [](const MicroimageTruth& p, const MicroimageTruth& q) {
+        return p.lens.l != q.lens.l ? p.lens.l < q.lens.l : p.lens.k < q.lens.k;
+    });
+    // Where the camera's mirror symmetry holds (Symmetry), only the anchors' quarter lenses are
+    // measured: a lens's microimage is its quarter lens's mirrored, with each parameter mirrored too
+    // (the axis's and the displacements' components along a mirror change sign, an adjacent lens is
+    // its mirror image's).
+    struct Mirrored {
+        std::size_t quarter;  // into `quarters`
+        bool mirror_x, mirror_y;
+    };
+    std::vector<Mirrored> mirrored(anchors.size());
+    std::vector<MicroimageTruth> quarters;
+    {
+        std::unordered_map<std::uint64_t, std::size_t> where;
+        std::vector<LensIndex> of(anchors.size());
+        for (std::size_t i = 0; i < anchors.size(); ++i) {
+            Mirrored& mm = mirrored[i];
+            mm.mirror_x = mm.mirror_y = false;
+            of[i] = symmetry.valid() ? Symmetry::quarter_lens(am.array, anchors[i].lens, &mm.mirror_x, &mm.mirror_y)
+                                     : anchors[i].lens;
+            if (where.emplace(anchor_key(of[i]), 0).second) {
+                MicroimageTruth t = MicroimageTruth();
+                t.lens = of[i];
+                quarters.push_back(t);
+            }
+        }
+        std::sort(quarters.begin(), quarters.end(), [](const MicroimageTruth& p, const MicroimageTruth& q) {
+            return p.lens.l != q.lens.l ? p.lens.l < q.lens.l : p.lens.k < q.lens.k;
+        });
+        for (std::size_t n = 0; n < quarters.size(); ++n)
+            where[anchor_key(quarters[n].lens)] = n;
+        for (std::size_t i = 0; i < anchors.size(); ++i)
+            mirrored[i].quarter = where.at(anchor_key(of[i]));
+    }
+    std::vector<MicroimageTruth> ideal = quarters;
+    if (!measure_symmetric(am, canonical.light(), options, ideal, jacobian.step, MicroimageProgress(), cancelled,
+                           nullptr, &anchor_known))
+        return false;
+    // The quarter lenses measured with parameter `kind` at `value` and their focal factor less 1 at
+    // `focal` (besides that parameter's own), each alone in its neighbourhood.
+    const double type_focal = am.array.microlens->focal_length_mm(0);
+    auto measure_with = [&](int kind, double value, double focal, std::vector<MicroimageTruth>* result) {
+        std::vector<LensTableRow> rows;
+        for (std::size_t i = 0; i < quarters.size(); ++i) {
+            LensTableRow own;
+            own.lens = quarters[i].lens;
+            own.error = kind < 4 ? error_with(kind, value) : LensError();
+            if (focal != 0)
+                own.error.focal_factor = 1 + focal;
+            if (kind < 4 || focal != 0)
+                rows.push_back(own);
+            if (kind >= 4) {
+                LensIndex adjacent[8];
+                adjacent_lenses(am.array.grid, quarters[i].lens, adjacent);
+                LensTableRow next;
+                next.lens = adjacent[(kind - 4) / 2];
+                ((kind - 4) % 2 == 0 ? next.error.dx_mm : next.error.dy_mm) = value;
+                rows.push_back(next);
+            }
+        }
+        const std::shared_ptr<const LensErrors> table = LensErrors::tabled(rows, std::string(), &type_focal, 1);
+        PlenopticCamera jm = am, jl = canonical.light();
+        jm.array.errors = table;
+        jl.array.errors = table;
+        *result = quarters;
+        return measure_lenses(jm, jl, options, *result, jacobian.step, MicroimageProgress(), cancelled);
+    };
+    // Per quarter lens, for each parameter and each of du, dv and the lit fraction: J, H, and K (the
+    // mixed difference with the focal factor: a lens's light near its cell's edge, where its
+    // neighbours act, moves with its own focal length, some 9 % of the neighbours' effect a per cent
+    // of focal length behind the 22 mm wide-angle).
+    std::vector<char> valid(quarters.size(), 1);
+    std::vector<std::vector<double>> jh(quarters.size(), std::vector<double>(9 * P, 0.0));
+    std::size_t focal = P;  // the focal factor's parameter (P: none)
+    for (std::size_t p = 0; p < P; ++p)
+        if (parameters[p].kind == 1)
+            focal = p;
+    auto value = [&](const MicroimageTruth& t, const MicroimageCentre& c, int q) {
+        return q == 0 ? t.u_px - c.u : q == 1 ? t.v_px - c.v : t.lit_fraction;
+    };
+    std::vector<MicroimageTruth> focal_side[2];
+    if (focal < P)
+        for (int s = 0; s < 2; ++s)
+            if (!measure_with(1, (s == 0 ? 1 : -1) * parameters[focal].step, 0, &focal_side[s]))
+                return false;
+    for (std::size_t p = 0; p < P; ++p) {
+        const int kind = parameters[p].kind;
+        const double h = parameters[p].step;
+        std::vector<MicroimageTruth> side[2], mixed[2];
+        for (int s = 0; s < 2; ++s) {
+            if (p == focal)
+                side[s] = focal_side[s];
+            else if (!measure_with(kind, (s == 0 ? 1 : -1) * h, 0, &side[s]))
+                return false;
+            if (focal < P && p != focal &&
+                !measure_with(kind, h, (s == 0 ? 1 : -1) * parameters[focal].step, &mixed[s]))
+                return false;
+        }
+        for (std::size_t i = 0; i < quarters.size(); ++i) {
+            const MicroimageCentre c = microimage_centre_px(am, quarters[i].lens);
+            bool lit = c.valid && side[0][i].lit && ideal[i].lit && side[1][i].lit;
+            for (int s = 0; s < 2 && focal < P && p != focal; ++s)
+                lit = lit && mixed[s][i].lit && focal_side[s][i].lit;
+            if (!lit) {
+                valid[i] = 0;
+                continue;
+            }
+            for (int q = 0; q < 3; ++q) {
+                const double up = value(side[0][i], c, q), mid = value(ideal[i], c, q), down = value(side[1][i], c, q);
+                jh[i][9 * p + q] = (up - down) / (2 * h);
+                jh[i][9 * p + 3 + q] = (up - 2 * mid + down) / (h * h);
+                if (focal < P && p != focal)
+                    jh[i][9 * p + 6 + q] = (value(mixed[0][i], c, q) - value(mixed[1][i], c, q) -
+                                            value(focal_side[0][i], c, q) + value(focal_side[1][i], c, q)) /
+                                           (2 * parameters[focal].step * h);
+            }
+        }
+    }
+    // Each anchor's from its quarter lens's.
+    std::unordered_map<std::uint64_t, std::vector<double>> differences;
+    for (std::size_t i = 0; i < anchors.size(); ++i) {
+        const Mirrored& mm = mirrored[i];
+        if (!valid[mm.quarter])
+            continue;
+        const std::vector<double>& from = jh[mm.quarter];
+        if (!mm.mirror_x && !mm.mirror_y) {
+            differences[anchor_key(anchors[i].lens)] = from;
+            continue;
+        }
+        // The anchor's adjacent lens a is the mirror image of the quarter lens's adjacent[image[a]].
+        const LensIndex lens = anchors[i].lens, quarter = quarters[mm.quarter].lens;
+        LensIndex adjacent[8], quarter_adjacent[8];
+        const int count = adjacent_lenses(am.array.grid, lens, adjacent);
+        adjacent_lenses(am.array.grid, quarter, quarter_adjacent);
+        int image[8];
+        bool matched = true;
+        for (int a = 0; a < count; ++a) {
+            const Vec2 o = am.array.lattice_centre_local(adjacent[a]) - am.array.lattice_centre_local(lens);
+            const Vec2 want{mm.mirror_x ? -o.x : o.x, mm.mirror_y ? -o.y : o.y};
+            image[a] = -1;
+            for (int b = 0; b < count; ++b) {
+                const Vec2 ob =
+                    am.array.lattice_centre_local(quarter_adjacent[b]) - am.array.lattice_centre_local(quarter);
+                if (std::fabs(ob.x - want.x) + std::fabs(ob.y - want.y) < 1e-6 * am.array.pitch_mm)
+                    image[a] = b;
+            }
+            matched = matched && image[a] >= 0;
+        }
+        if (!matched)
+            continue;
+        std::vector<double> to(9 * P, 0.0);
+        for (std::size_t p = 0; p < P; ++p) {
+            const int kind = parameters[p].kind;
+            int source_kind = kind;
+            double sign = 1;
+            if (kind == 2 && mm.mirror_x)
+                sign = -1;
+            if (kind == 3 && mm.mirror_y)
+                sign = -1;
+            if (kind >= 4) {
+                const int a = (kind - 4) / 2, c = (kind - 4) % 2;
+                source_kind = 4 + 2 * image[a] + c;
+                if ((c == 0 && mm.mirror_x) || (c == 1 && mm.mirror_y))
+                    sign = -1;
+            }
+            std::size_t source = P;
+            for (std::size_t r = 0; r < P; ++r)
+                if (parameters[r].kind == source_kind)
+                    source = r;
+            for (int order = 0; order < 3; ++order) {  // J, H, K: J and K change sign with the parameter
+                const double* f = &from[9 * source + 3 * order];
+                double* t = &to[9 * p + 3 * order];
+                const double factor = order == 1 ? 1 : sign;
+                const Vec2 d = linear_part(
+                    [&](Vec2 px) { return symmetry.map_px(am.sensor, mm.mirror_x, mm.mirror_y, px); },
+                    Vec2{factor * f[0], factor * f[1]});
+                t[0] = d.x;
+                t[1] = d.y;
+                t[2] = factor * f[2];
+            }
+        }
+        differences[anchor_key(lens)].swap(to);
+    }
+    counts.error_anchors = quarters.size();
+
+    // Each lens corrected, on every thread (each result depends on the lens alone).
+    std::vector<char> measure(out.size(), 0);
+    std::atomic<std::size_t> next(0);
+    const std::size_t kChunk = 256;
+    auto work = [&]() {
+        for (std::size_t first = next.fetch_add(kChunk); first < lenses.size(); first = next.fetch_add(kChunk))
+            for (std::size_t n = first; n < std::min(lenses.size(), first + kChunk); ++n) {
+                const std::size_t index = lenses[n];
+                MicroimageTruth& truth = out[index];
+                std::int64_t i0, j0;
+                double x, y;
+                jacobian.stencil(at[index], &i0, &j0, &x, &y);
+                const std::vector<double>* block[6][6] = {};
+                bool missing = false;
+                jacobian.each(i0, j0, [&](std::int64_t i, std::int64_t j) {
+                    const auto found = differences.find(anchor_key(jacobian.lens(i, j)));
+                    if (found == differences.end())
+                        missing = true;
+                    else
+                        block[j - j0 + 1][i - i0 + 1] = &found->second;
+                });
+                if (missing) {
+                    measure[index] = 1;
+                    continue;
+                }
+                double xs[kMaxErrorParameters];
+                error_values(light.array, truth.lens, parameters, xs);
+                auto v = [&](std::int64_t i, std::int64_t j, int q) {
+                    const std::vector<double>& d = *block[j - j0 + 1][i - i0 + 1];
+                    double sum = 0;
+                    const double xf = focal < P ? xs[focal] : 0;
+                    for (std::size_t p = 0; p < P; ++p)
+                        sum += d[9 * p + q] * xs[p] + 0.5 * d[9 * p + 3 + q] * xs[p] * xs[p] +
+                               d[9 * p + 6 + q] * xs[p] * xf;
+                    return sum;
+                };
+                const double allowed[3] = {kCorrectionPx, kCorrectionPx, kCorrectionFraction};
+                double result[3];
+                bool vouched = true;
+                for (int q = 0; q < 3 && vouched; ++q) {
+                    double error;
+                    result[q] = cubic_through(jacobian, i0, j0, x, y, v, q, &error);
+                    vouched = error <= allowed[q];
+                }
+                if (!vouched) {
+                    measure[index] = 1;
+                    continue;
+                }
+                const Vec2 d =
+                    linear_part([&](Vec2 px) { return canonical.to_camera_px(px); }, Vec2{result[0], result[1]});
+                truth.u_px += d.x;
+                truth.v_px += d.y;
+                truth.lit_fraction += result[2];
+            }
+    };
+    const unsigned hardware = std::thread::hardware_concurrency();
+    const int threads = options.threads > 0 ? options.threads : int(std::max(1u, hardware));
+    std::vector<std::thread> workers;
+    for (int t = 1; t < threads; ++t)
+        workers.push_back(std::thread(work));
+    work();
+    for (std::thread& worker : workers)
+        worker.join();
+    std::size_t corrected = 0;
+    for (std::size_t index : lenses) {
+        if (measure[index])
+            pending.push_back(index);
+        else
+            ++corrected;
+    }
+    std::sort(pending.begin(), pending.end());
+    counts.corrected = corrected;
+    return true;
+}
 
 } // namespace
 
@@ -1180,7 +1606,20 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     // Lenses measured so far (as the quarter lenses of the camera's symmetry).
     std::unordered_map<std::uint64_t, std::pair<MicroimageTruth, char>> known;
     const Symmetry symmetry(m, light, options);
-    if (!interpolates(m, light, options) || out.empty()) {
+    // Refracting microlenses with manufacturing errors: the anchors are the ideal array's, and each
+    // lens is interpolated where it sits, then corrected for its errors (correct_for_errors).
+    PlenopticCamera ideal, ideal_light;
+    const bool perturbed = options.error_anchor_step >= 4 && options.anchor_step >= 4 && m.array.errors &&
+                           light.array.errors && m.array.microlens && refracting_shape(*m.array.microlens) != nullptr;
+    if (perturbed) {
+        ideal = m;
+        ideal.array.errors = nullptr;
+        ideal_light = light;
+        ideal_light.array.errors = nullptr;
+    }
+    const PlenopticCamera& base = perturbed ? ideal : m;
+    const PlenopticCamera& base_light = perturbed ? ideal_light : light;
+    if (!interpolates(base, base_light, options) || out.empty()) {
         counts.measured = out.size();
         if (!measure_symmetric(m, light, options, out, 1, progress, cancelled, nullptr, &known))
             out.clear();
@@ -1194,14 +1633,21 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     // The lenses left at the end are measured. Every decision depends on the lenses alone. The
     // anchors are measured in canonical.model() (the camera itself, or its array turned back onto
     // the axis: Canonical), the lenses left in the camera.
-    const Canonical canonical(m, light, options);
+    const Canonical canonical(base, base_light, options);
     const PlenopticCamera& am = canonical.model();
     const Symmetry anchor_symmetry(am, canonical.light(), options);
+    // A lens's displacement in the array's plane (perturbed: where the ideal lens it is sits).
+    auto shift = [&](LensIndex lens) {
+        if (!perturbed)
+            return Vec2{0, 0};
+        const LensError e = m.array.error_of(lens);
+        return Vec2{e.dx_mm, e.dy_mm};
+    };
     // Where each lens lies among the anchors; the anchors' range.
     std::vector<Vec2> at(out.size());
     double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
     for (std::size_t i = 0; i < out.size(); ++i) {
-        at[i] = canonical.position(out[i].lens);
+        at[i] = canonical.position(out[i].lens, shift(out[i].lens));
         x_lo = std::min(x_lo, at[i].x);
         x_hi = std::max(x_hi, at[i].x);
         y_lo = std::min(y_lo, at[i].y);
@@ -1222,6 +1668,8 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         })
                         : MicroimageProgress();
     };
+    // Perturbed: whether each lens was interpolated between the anchors.
+    std::vector<char> interpolated(perturbed ? out.size() : 0, 0);
     int level = 0;
     for (std::int64_t step = options.anchor_step; step >= 4 && !pending.empty(); step /= 2, ++level) {
         if (step % 2 != 0)
@@ -1300,17 +1748,27 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         std::size_t left = 0;
         for (std::size_t index : pending) {
             Vec2 centre;
-            if (!canonical.centre_px(out[index].lens, &centre) ||
+            if (!canonical.centre_px(out[index].lens, &centre, shift(out[index].lens)) ||
                 !interpolate(anchors, at[index], &out[index], centre)) {
                 pending[left++] = index;
                 continue;
             }
+            if (perturbed)
+                interpolated[index] = 1;
             const Vec2 c = canonical.to_camera_px(Vec2{out[index].u_px, out[index].v_px});
             out[index].u_px = c.x;
             out[index].v_px = c.y;
         }
         pending.resize(left);
         pending.shrink_to_fit();
+    }
+    if (perturbed && counts.anchors > 0) {
+        const double range[4] = {x_lo, x_hi, y_lo, y_hi};
+        if (!correct_for_errors(light, canonical, anchor_symmetry, options, at, interpolated, anchor_known, range, cancelled, out,
+                                pending, counts)) {
+            out.clear();
+            return out;
+        }
     }
     counts.interpolated = out.size() - pending.size();
     counts.measured = pending.size();
@@ -1330,8 +1788,11 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
     }
     for (std::size_t i = 0; i < pending.size(); ++i)
         out[pending[i]] = measured[i];
-    counts.quarter_lenses = canonical.active() ? known_canonical.size() + pending.size()
-                                               : (symmetry.valid() ? known.size() : 0);
+    // (With errors the anchors' quarter lenses are the ideal array's, and the lenses left are measured
+    // each where they are.)
+    counts.quarter_lenses = canonical.active() || (perturbed && anchor_symmetry.valid())
+                                ? anchor_known.size() + pending.size()
+                                : (symmetry.valid() ? known.size() : 0);
     return out;
 }
 
