@@ -954,6 +954,43 @@ struct Anchors {
                     f(i, j);
     }
     LensIndex lens(std::int64_t K, std::int64_t L) const { return LensIndex{K * step, L * step}; }
+
+    // Anchors `s` lenses apart over lenses whose positions run from range[0] to range[1] (X) and
+    // range[2] to range[3] (Y): one more below and two more above, so that every stencil fits.
+    void cover(std::int64_t s, const double range[4])
+    {
+        step = s;
+        k0 = std::int64_t(std::floor(range[0] / double(s))) - 1;
+        k1 = std::int64_t(std::floor(range[1] / double(s))) + 2;
+        l0 = std::int64_t(std::floor(range[2] / double(s))) - 1;
+        l1 = std::int64_t(std::floor(range[3] / double(s))) + 2;
+    }
+    // At least five anchors a side (the fourth differences need them).
+    bool enough() const { return k1 - k0 >= 4 && l1 - l0 >= 4; }
+    // The anchors that the lenses `lenses` (indices into `at`, their positions) read, once each and
+    // in the order first read, those for which known(key) is false, as truths with the lens set.
+    template <class Known>
+    std::vector<MicroimageTruth> read_by(const std::vector<std::size_t>& lenses, const std::vector<Vec2>& at,
+                                         const Known& known) const
+    {
+        std::vector<MicroimageTruth> read;
+        std::unordered_map<std::uint64_t, char> seen;
+        for (std::size_t index : lenses) {
+            std::int64_t i0, j0;
+            double x, y;
+            stencil(at[index], &i0, &j0, &x, &y);
+            each(i0, j0, [&](std::int64_t i, std::int64_t j) {
+                const LensIndex anchor = lens(i, j);
+                const std::uint64_t key = anchor_key(anchor);
+                if (!known(key) && seen.emplace(key, 1).second) {
+                    MicroimageTruth t = MicroimageTruth();
+                    t.lens = anchor;
+                    read.push_back(t);
+                }
+            });
+        }
+        return read;
+    }
 };
 
 // The cubic through the 4 x 4 anchors from (i0, j0) (Anchors::stencil) of the value v(i, j, q), at
@@ -1262,29 +1299,10 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
     // The Jacobian anchors: error_anchor_step lenses apart (at least five a side, else every lens is
     // measured).
     Anchors jacobian;
-    const std::int64_t step = options.error_anchor_step;
-    jacobian.step = step;
-    jacobian.k0 = std::int64_t(std::floor(range[0] / double(step))) - 1;
-    jacobian.k1 = std::int64_t(std::floor(range[1] / double(step))) + 2;
-    jacobian.l0 = std::int64_t(std::floor(range[2] / double(step))) - 1;
-    jacobian.l1 = std::int64_t(std::floor(range[3] / double(step))) + 2;
+    jacobian.cover(options.error_anchor_step, range);
     std::vector<MicroimageTruth> anchors;
-    if (jacobian.k1 - jacobian.k0 >= 4 && jacobian.l1 - jacobian.l0 >= 4) {
-        std::unordered_map<std::uint64_t, char> seen;
-        for (std::size_t index : lenses) {
-            std::int64_t i0, j0;
-            double x, y;
-            jacobian.stencil(at[index], &i0, &j0, &x, &y);
-            jacobian.each(i0, j0, [&](std::int64_t i, std::int64_t j) {
-                const LensIndex lens = jacobian.lens(i, j);
-                if (seen.emplace(anchor_key(lens), 1).second) {
-                    MicroimageTruth t = MicroimageTruth();
-                    t.lens = lens;
-                    anchors.push_back(t);
-                }
-            });
-        }
-    }
+    if (jacobian.enough())
+        anchors = jacobian.read_by(lenses, at, [](std::uint64_t) { return false; });
     if (anchors.empty()) {
         pending.insert(pending.end(), lenses.begin(), lenses.end());
         std::sort(pending.begin(), pending.end());
@@ -1643,15 +1661,16 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         const LensError e = m.array.error_of(lens);
         return Vec2{e.dx_mm, e.dy_mm};
     };
-    // Where each lens lies among the anchors; the anchors' range.
+    // Where each lens lies among the anchors; their range (X from range[0] to range[1], Y from
+    // range[2] to range[3]).
     std::vector<Vec2> at(out.size());
-    double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
+    double range[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY};
     for (std::size_t i = 0; i < out.size(); ++i) {
         at[i] = canonical.position(out[i].lens, shift(out[i].lens));
-        x_lo = std::min(x_lo, at[i].x);
-        x_hi = std::max(x_hi, at[i].x);
-        y_lo = std::min(y_lo, at[i].y);
-        y_hi = std::max(y_hi, at[i].y);
+        range[0] = std::min(range[0], at[i].x);
+        range[1] = std::max(range[1], at[i].x);
+        range[2] = std::min(range[2], at[i].y);
+        range[3] = std::max(range[3], at[i].y);
     }
     // Quarter lenses measured as anchors in the canonical camera (`known` holds the camera's own).
     std::unordered_map<std::uint64_t, std::pair<MicroimageTruth, char>> known_canonical;
@@ -1675,34 +1694,13 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         if (step % 2 != 0)
             break;
         Anchors anchors;
-        anchors.step = step;
         anchors.values = &values;
-        anchors.k0 = std::int64_t(std::floor(x_lo / double(step))) - 1;
-        anchors.k1 = std::int64_t(std::floor(x_hi / double(step))) + 2;
-        anchors.l0 = std::int64_t(std::floor(y_lo / double(step))) - 1;
-        anchors.l1 = std::int64_t(std::floor(y_hi / double(step))) + 2;
-        if (anchors.k1 - anchors.k0 < 4 || anchors.l1 - anchors.l0 < 4)
+        anchors.cover(step, range);
+        if (!anchors.enough())
             break;  // fewer than five anchors a side
-        // The anchors the pending lenses read that are not measured yet, row by row.
-        std::vector<std::uint64_t> wanted;
-        std::vector<MicroimageTruth> measured;
-        {
-            std::unordered_map<std::uint64_t, char> seen;
-            for (std::size_t index : pending) {
-                std::int64_t i0, j0;
-                double x, y;
-                anchors.stencil(at[index], &i0, &j0, &x, &y);
-                anchors.each(i0, j0, [&](std::int64_t i, std::int64_t j) {
-                    const LensIndex lens = anchors.lens(i, j);
-                    const std::uint64_t key = anchor_key(lens);
-                    if (values.count(key) == 0 && seen.emplace(key, 1).second) {
-                        MicroimageTruth truth = MicroimageTruth();
-                        truth.lens = lens;
-                        measured.push_back(truth);
-                    }
-                });
-            }
-        }
+        // The anchors the pending lenses read that are not measured yet (sorted row by row below).
+        std::vector<MicroimageTruth> measured =
+            anchors.read_by(pending, at, [&](std::uint64_t key) { return values.count(key) != 0; });
         // Anchors that cost more than measuring the lenses they serve: measure those lenses. (What
         // a set of lenses costs: the lenses to measure for it, the quarter lenses with the symmetry.)
         auto cost = [&](const Symmetry& sym, const MicrolensArray& array,
@@ -1763,9 +1761,8 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         pending.shrink_to_fit();
     }
     if (perturbed && counts.anchors > 0) {
-        const double range[4] = {x_lo, x_hi, y_lo, y_hi};
-        if (!correct_for_errors(light, canonical, anchor_symmetry, options, at, interpolated, anchor_known, range, cancelled, out,
-                                pending, counts)) {
+        if (!correct_for_errors(light, canonical, anchor_symmetry, options, at, interpolated, anchor_known, range,
+                                cancelled, out, pending, counts)) {
             out.clear();
             return out;
         }
