@@ -61,12 +61,12 @@ struct MicroimageOptions {
     // and arrays with errors: every lens measured, whatever this is.
     int anchor_step = 0;
     // Refracting microlenses on an array with manufacturing errors: 0 (the default) measures every
-    // lens. At least 4 (with anchor_step at least 4), an approximation, some 7 to 30 times faster:
+    // lens. At least 4 (with anchor_step at least 4), an approximation, 2 to 27 times faster:
     // each lens is the ideal lens interpolated where it sits, corrected to second order in each of
     // its errors (its own dz, focal length and tilt, its neighbours' displacements) by differences
     // measured at Jacobian anchors this many lenses apart, where their cubic vouches for it; the
-    // other lenses are measured. Within about 0.01 px of measuring each lens behind the 22 mm
-    // wide-angle (as close to brute force as measuring is), 0.02 px and 0.01 of lit fraction behind
+    // other lenses are measured. Within 0.013 px and 0.004 of lit fraction of measuring each lens
+    // behind the 22 mm wide-angle (as close to brute force as measuring is), 0.02 px and 0.01 behind
     // the unit tests' triplet, where the neighbours' displacements cut lit parts of the cells
     // (BENCHMARKS "Refracting microlenses with errors, corrected").
     int error_anchor_step = 0;
