@@ -5,6 +5,7 @@
 #include "plenoptic/truth/microimages.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -594,35 +595,43 @@ MicroimageOptions default_microimage_options()
 
 namespace {
 
-// Measures the lenses of `out` (their `lens` set, row by row), each through `light`'s rays; a run
-// of neighbours is lenses k, k + step, k + 2 step, ... of one row. Reports (now, out.size()) about
-// every tenth of the lenses; false when `cancelled` stopped it. `lobes` (if given): per lens,
-// whether a region of its microimage is a lobe of light that crossed cells (region_moments).
-bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, const MicroimageOptions& options,
-                    std::vector<MicroimageTruth>& out, std::int64_t step, const MicroimageProgress& progress,
-                    const MicroimageCancel& cancelled, std::vector<char>* lobes = nullptr)
-{
-    if (out.empty())
-        return true;
-    const std::vector<CellNode> all_nodes = cell_nodes(m, options);
-    // Per cell point, the radii of its region in the last kHistory lenses of a run, newest first
-    // (fewer at the run's start or after a lens without that region), and a prediction.
-    const std::size_t kHistory = 2;
+// One lens's microimage measured through `light`'s rays (its lens and start points `m`'s), cell
+// point by cell point, each region's radii sought near a prediction where there is one.
+class LensMeasurer {
+public:
+    // Per cell point, the radii of its region in the last kHistory lenses measured with it, newest
+    // first (fewer at a run's start or after a lens without that region), and a prediction.
     struct Radii {
         std::vector<std::vector<std::vector<double>>> history;
         std::vector<double> predicted, now;
     };
-    if (lobes)
-        lobes->assign(out.size(), 0);
-    // Refracting lenses that may be displaced: each lens's cell points moved into its own cell.
-    const bool cut_cells = light.array.errors && light.array.errors->max_shift_mm() > 0 &&
-                           refracting_shape(*light.array.microlens) != nullptr;
-    auto measure = [&](std::size_t index, Radii* radii, std::vector<CellNode>* own_nodes) {
-        MicroimageTruth& truth = out[index];
+    static const std::size_t kHistory = 2;
+
+    LensMeasurer(const PlenopticCamera& m, const PlenopticCamera& light, const MicroimageOptions& options)
+        : m_(m), light_(light), options_(options), all_nodes_(cell_nodes(m, options)),
+          // Refracting lenses that may be displaced: each lens's cell points moved into its own cell.
+          cut_cells_(light.array.errors && light.array.errors->max_shift_mm() > 0 &&
+                     refracting_shape(*light.array.microlens) != nullptr)
+    {
+    }
+
+    // Radii with no history, for this measurer's cell points.
+    Radii fresh() const
+    {
+        Radii radii;
+        radii.history.resize(all_nodes_.size());
+        return radii;
+    }
+
+    // Measures truth.lens; `radii` (if given) predicts each region from its history and takes this
+    // lens's radii into it; `own_nodes` is scratch. `lobe` (if given): whether a region of the
+    // microimage is a lobe of light that crossed cells (region_moments).
+    void measure(MicroimageTruth& truth, Radii* radii, std::vector<CellNode>* own_nodes, bool* lobe_out) const
+    {
         const std::vector<CellNode>& nodes =
-            cut_cells && nodes_in_own_cell(light.array, truth.lens, all_nodes, own_nodes) ? *own_nodes : all_nodes;
+            cut_cells_ && nodes_in_own_cell(light_.array, truth.lens, all_nodes_, own_nodes) ? *own_nodes : all_nodes_;
         bool found_lobe = false;
-        const MicroimageCentre lattice = microimage_centre_px(m, truth.lens);
+        const MicroimageCentre lattice = microimage_centre_px(m_, truth.lens);
         const Vec2 centre{lattice.u, lattice.v};
         Moments total{0, 0, 0};
         RadiusChange change;  // of this lens's regions from their predictions
@@ -642,13 +651,13 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
                     predicted = &radii->predicted;
                 }
             }
-            const Guess guess = guess_region(light, truth.lens, node.lens_u, node.lens_v, centre);
+            const Guess guess = guess_region(light_, truth.lens, node.lens_u, node.lens_v, centre);
             if (!guess.possible) {
                 if (radii)
                     radii->history[point].clear();
                 continue;
             }
-            const LensProbe probe(light, truth.lens, node.lens_u, node.lens_v);
+            const LensProbe probe(light_, truth.lens, node.lens_u, node.lens_v);
             // A start point anywhere in the disc is at most its diameter from the boundary.
             const double search = guess.radius_px + 1, reach = 2.1 * guess.radius_px + 1;
             // Radii are handed from lens to lens as seen from where the guess's central ray lands: it
@@ -661,7 +670,7 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
             const double* st = guess.stretch;
             const bool stretched = st[0] != 1 || st[1] != 0 || st[2] != 0 || st[3] != 1;
             auto stretch_along = [&](int a) {
-                const double theta = 2 * kPi * a / options.azimuths, c = std::cos(theta), s = std::sin(theta);
+                const double theta = 2 * kPi * a / options_.azimuths, c = std::cos(theta), s = std::sin(theta);
                 return c * (st[0] * c + st[1] * s) + s * (st[2] * c + st[3] * s);
             };
             if (predicted && stretched)
@@ -669,8 +678,8 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
                     radii->predicted[a] *= stretch_along(int(a));
             bool lobe = false;
             const Moments region =
-                region_moments(probe, guess.u, guess.v, search, reach, options, reference, predicted, &change, now,
-                               lobes ? &lobe : nullptr);
+                region_moments(probe, guess.u, guess.v, search, reach, options_, reference, predicted, &change, now,
+                               lobe_out ? &lobe : nullptr);
             found_lobe = found_lobe || (lobe && region.area > 0);
             if (radii && stretched)
                 for (std::size_t a = 0; a < now->size(); ++a)
@@ -694,10 +703,39 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
         truth.lit = total.area > 0;
         truth.u_px = truth.lit ? total.mu / total.area - 0.5 : 0;
         truth.v_px = truth.lit ? total.mv / total.area - 0.5 : 0;
-        const double cell = microimage_cell_area_px(m, truth.lens);
+        const double cell = microimage_cell_area_px(m_, truth.lens);
         truth.lit_fraction = cell > 0 ? total.area / cell : 0;
+        if (lobe_out)
+            *lobe_out = found_lobe;
+    }
+
+private:
+    const PlenopticCamera& m_;
+    const PlenopticCamera& light_;
+    const MicroimageOptions& options_;
+    const std::vector<CellNode> all_nodes_;
+    const bool cut_cells_;
+};
+
+// Measures the lenses of `out` (their `lens` set, row by row), each through `light`'s rays; a run
+// of neighbours is lenses k, k + step, k + 2 step, ... of one row. Reports (now, out.size()) about
+// every tenth of the lenses; false when `cancelled` stopped it. `lobes` (if given): per lens,
+// whether a region of its microimage is a lobe of light that crossed cells (region_moments).
+bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, const MicroimageOptions& options,
+                    std::vector<MicroimageTruth>& out, std::int64_t step, const MicroimageProgress& progress,
+                    const MicroimageCancel& cancelled, std::vector<char>* lobes = nullptr)
+{
+    if (out.empty())
+        return true;
+    const LensMeasurer measurer(m, light, options);
+    typedef LensMeasurer::Radii Radii;
+    if (lobes)
+        lobes->assign(out.size(), 0);
+    auto measure = [&](std::size_t index, Radii* radii, std::vector<CellNode>* own_nodes) {
+        bool lobe = false;
+        measurer.measure(out[index], radii, own_nodes, lobes ? &lobe : nullptr);
         if (lobes)
-            (*lobes)[index] = found_lobe;
+            (*lobes)[index] = lobe;
     };
 
     // Runs of up to kRun neighbouring lenses of one row (k, k + 1, ...): the first lens of a run is
@@ -717,8 +755,7 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
     std::size_t reported = 0;
     // The calling thread (`reports`) works too: it polls `cancelled` between lenses and reports.
     auto work = [&](bool reports) {
-        Radii radii;
-        radii.history.resize(all_nodes.size());
+        Radii radii = measurer.fresh();
         std::vector<CellNode> own_nodes;
         for (std::size_t r = next++; r + 1 < runs.size() && !stop; r = next++) {
             for (std::vector<std::vector<double>>& past : radii.history)
@@ -821,6 +858,14 @@ std::uint64_t anchor_key(LensIndex lens)
     return (std::uint64_t(lens.k) << 32) ^ (std::uint64_t(lens.l) & 0xffffffffull);
 }
 
+// Lenses in the order measure_lenses takes them: row by row (l, then k, increasing).
+void sort_row_by_row(std::vector<MicroimageTruth>& lenses)
+{
+    std::sort(lenses.begin(), lenses.end(), [](const MicroimageTruth& p, const MicroimageTruth& q) {
+        return p.lens.l != q.lens.l ? p.lens.l < q.lens.l : p.lens.k < q.lens.k;
+    });
+}
+
 // measure_lenses, with the camera's symmetry where it holds: each lens of `out` takes the microimage
 // of its quarter lens, those measured once each (and kept in `cache`, by lens, for later calls).
 bool measure_symmetric(const PlenopticCamera& m, const PlenopticCamera& light, const MicroimageOptions& options,
@@ -852,9 +897,7 @@ bool measure_symmetric(const PlenopticCamera& m, const PlenopticCamera& light, c
             }
         }
     }
-    std::sort(wanted.begin(), wanted.end(), [](const MicroimageTruth& p, const MicroimageTruth& q) {
-        return p.lens.l != q.lens.l ? p.lens.l < q.lens.l : p.lens.k < q.lens.k;
-    });
+    sort_row_by_row(wanted);
     std::vector<char> wanted_lobes;
     // (The quarter lenses of lenses `step` apart along rows are `step` apart too: anchors of a level.)
     if (!measure_lenses(m, light, options, wanted, step, progress, cancelled, &wanted_lobes))
@@ -1261,13 +1304,10 @@ template <class F> Vec2 linear_part(const F& map, Vec2 d)
 
 // Corrects the lenses of `out` interpolated from the ideal anchors (interpolated[i]) for their
 // errors, as above; the lenses it cannot vouch for go onto `pending` (to be measured). `light`: the
-// camera with errors whose light is measured; `anchor_known`: the ideal quarter lenses measured so
-// far (measure_symmetric's cache). False when cancelled.
+// camera with errors whose light is measured. False when cancelled.
 bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical, const Symmetry& symmetry,
                         const MicroimageOptions& options,
-                        const std::vector<Vec2>& at, const std::vector<char>& interpolated,
-                        std::unordered_map<std::uint64_t, std::pair<MicroimageTruth, char>>& anchor_known,
-                        const double range[4], const MicroimageCancel& cancelled, std::vector<MicroimageTruth>& out,
+                        const std::vector<Vec2>& at, const std::vector<char>& interpolated, const double range[4], const MicroimageCancel& cancelled, std::vector<MicroimageTruth>& out,
                         std::vector<std::size_t>& pending, MicroimageWork& counts)
 {
     const PlenopticCamera& am = canonical.model();
@@ -1308,9 +1348,6 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
         std::sort(pending.begin(), pending.end());
         return true;
     }
-    std::sort(anchors.begin(), anchors.end(), [](const MicroimageTruth& p, const MicroimageTruth& q) {
-        return p.lens.l != q.lens.l ? p.lens.l < q.lens.l : p.lens.k < q.lens.k;
-    });
     // Where the camera's mirror symmetry holds (Symmetry), only the anchors' quarter lenses are
     // measured: a lens's microimage is its quarter lens's mirrored, with each parameter mirrored too
     // (the axis's and the displacements' components along a mirror change sign, an adjacent lens is
@@ -1335,95 +1372,143 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
                 quarters.push_back(t);
             }
         }
-        std::sort(quarters.begin(), quarters.end(), [](const MicroimageTruth& p, const MicroimageTruth& q) {
-            return p.lens.l != q.lens.l ? p.lens.l < q.lens.l : p.lens.k < q.lens.k;
-        });
         for (std::size_t n = 0; n < quarters.size(); ++n)
             where[anchor_key(quarters[n].lens)] = n;
         for (std::size_t i = 0; i < anchors.size(); ++i)
             mirrored[i].quarter = where.at(anchor_key(of[i]));
     }
-    std::vector<MicroimageTruth> ideal = quarters;
-    if (!measure_symmetric(am, canonical.light(), options, ideal, jacobian.step, MicroimageProgress(), cancelled,
-                           nullptr, &anchor_known))
-        return false;
-    // The quarter lenses measured with parameter `kind` at `value` and their focal factor less 1 at
-    // `focal` (besides that parameter's own), each alone in its neighbourhood.
+    // The perturbations measured: parameter `kind` at `value`, the lens's focal factor less 1 at
+    // `focal` (besides that parameter's own). Each is a camera whose table perturbs every quarter
+    // lens alike, each lens alone in its neighbourhood (the anchors lie far apart).
+    struct Perturbation {
+        int kind;
+        double value, focal;
+    };
+    std::vector<Perturbation> perturbations;
+    std::size_t focal = P;  // the focal factor's parameter (P: none)
+    for (std::size_t p = 0; p < P; ++p)
+        if (parameters[p].kind == 1)
+            focal = p;
+    // Where each parameter's measurements are among the perturbations: side[p][s] at +h (s = 0) and
+    // -h, mixed[p][s] at +h with the focal factor's +step (s = 0) and -step.
+    std::vector<std::array<std::size_t, 2>> side(P), mixed(P);
+    for (std::size_t p = 0; p < P; ++p)
+        for (int s = 0; s < 2; ++s) {
+            const double sign = s == 0 ? 1 : -1;
+            side[p][s] = perturbations.size();
+            perturbations.push_back(Perturbation{parameters[p].kind, sign * parameters[p].step, 0});
+            if (focal < P && p != focal) {
+                mixed[p][s] = perturbations.size();
+                perturbations.push_back(Perturbation{parameters[p].kind, parameters[p].step, sign * parameters[focal].step});
+            }
+        }
     const double type_focal = am.array.microlens->focal_length_mm(0);
-    auto measure_with = [&](int kind, double value, double focal, std::vector<MicroimageTruth>* result) {
+    std::vector<PlenopticCamera> perturbed_model(perturbations.size(), am), perturbed_light(perturbations.size(),
+                                                                                           canonical.light());
+    for (std::size_t n = 0; n < perturbations.size(); ++n) {
+        const Perturbation& pert = perturbations[n];
         std::vector<LensTableRow> rows;
         for (std::size_t i = 0; i < quarters.size(); ++i) {
             LensTableRow own;
             own.lens = quarters[i].lens;
-            own.error = kind < 4 ? error_with(kind, value) : LensError();
-            if (focal != 0)
-                own.error.focal_factor = 1 + focal;
-            if (kind < 4 || focal != 0)
+            own.error = pert.kind < 4 ? error_with(pert.kind, pert.value) : LensError();
+            if (pert.focal != 0)
+                own.error.focal_factor = 1 + pert.focal;
+            if (pert.kind < 4 || pert.focal != 0)
                 rows.push_back(own);
-            if (kind >= 4) {
+            if (pert.kind >= 4) {
                 LensIndex adjacent[8];
                 adjacent_lenses(am.array.grid, quarters[i].lens, adjacent);
                 LensTableRow next;
-                next.lens = adjacent[(kind - 4) / 2];
-                ((kind - 4) % 2 == 0 ? next.error.dx_mm : next.error.dy_mm) = value;
+                next.lens = adjacent[(pert.kind - 4) / 2];
+                ((pert.kind - 4) % 2 == 0 ? next.error.dx_mm : next.error.dy_mm) = pert.value;
                 rows.push_back(next);
             }
         }
         const std::shared_ptr<const LensErrors> table = LensErrors::tabled(rows, std::string(), &type_focal, 1);
-        PlenopticCamera jm = am, jl = canonical.light();
-        jm.array.errors = table;
-        jl.array.errors = table;
-        *result = quarters;
-        return measure_lenses(jm, jl, options, *result, jacobian.step, MicroimageProgress(), cancelled);
-    };
+        perturbed_model[n].array.errors = table;
+        perturbed_light[n].array.errors = table;
+    }
+    // Each quarter lens measured ideal from scratch, then with each perturbation, each region's
+    // radii sought near the ideal lens's (a perturbation moves a boundary by a few hundredths of a
+    // pixel where it acts, and most not at all). The answer is the grid step that holds the crossing,
+    // as from scratch (boundary_on_grid); only the search is shorter (behind the 22 mm wide-angle
+    // some 60 % of the probes from scratch; the coarse search about dark start points, a third of
+    // those, is as long). On every thread, a quarter lens at a time; each result depends on the lens
+    // alone.
+    const LensMeasurer ideal_measurer(am, canonical.light(), options);
+    std::vector<LensMeasurer> measurers;
+    measurers.reserve(perturbations.size());
+    for (std::size_t n = 0; n < perturbations.size(); ++n)
+        measurers.emplace_back(perturbed_model[n], perturbed_light[n], options);
+    std::vector<MicroimageTruth> ideal = quarters;
+    std::vector<std::vector<MicroimageTruth>> measured(perturbations.size(), quarters);
+    {
+        std::atomic<std::size_t> next(0);
+        std::atomic<bool> stop(false);
+        auto work = [&](bool polls) {
+            std::vector<CellNode> own_nodes;
+            for (std::size_t i = next++; i < quarters.size() && !stop; i = next++) {
+                LensMeasurer::Radii radii = ideal_measurer.fresh();
+                ideal_measurer.measure(ideal[i], &radii, &own_nodes, nullptr);
+                const std::vector<std::vector<std::vector<double>>> seed = radii.history;
+                for (std::size_t n = 0; n < perturbations.size() && !stop; ++n) {
+                    if (polls && cancelled && cancelled()) {
+                        stop = true;
+                        break;
+                    }
+                    radii.history = seed;
+                    measurers[n].measure(measured[n][i], &radii, &own_nodes, nullptr);
+                }
+            }
+        };
+        const unsigned hardware = std::thread::hardware_concurrency();
+        const int threads = options.threads > 0 ? options.threads : int(std::max(1u, hardware));
+        std::vector<std::thread> workers;
+        for (int t = 1; t < threads && std::size_t(t) < quarters.size(); ++t)
+            workers.push_back(std::thread(work, false));
+        work(true);
+        for (std::thread& worker : workers)
+            worker.join();
+        if (stop)
+            return false;
+    }
     // Per quarter lens, for each parameter and each of du, dv and the lit fraction: J, H, and K (the
     // mixed difference with the focal factor: a lens's light near its cell's edge, where its
     // neighbours act, moves with its own focal length, some 9 % of the neighbours' effect a per cent
     // of focal length behind the 22 mm wide-angle).
     std::vector<char> valid(quarters.size(), 1);
     std::vector<std::vector<double>> jh(quarters.size(), std::vector<double>(9 * P, 0.0));
-    std::size_t focal = P;  // the focal factor's parameter (P: none)
-    for (std::size_t p = 0; p < P; ++p)
-        if (parameters[p].kind == 1)
-            focal = p;
     auto value = [&](const MicroimageTruth& t, const MicroimageCentre& c, int q) {
         return q == 0 ? t.u_px - c.u : q == 1 ? t.v_px - c.v : t.lit_fraction;
     };
-    std::vector<MicroimageTruth> focal_side[2];
+    const std::vector<MicroimageTruth>* focal_side[2] = {nullptr, nullptr};
     if (focal < P)
         for (int s = 0; s < 2; ++s)
-            if (!measure_with(1, (s == 0 ? 1 : -1) * parameters[focal].step, 0, &focal_side[s]))
-                return false;
+            focal_side[s] = &measured[side[focal][s]];
     for (std::size_t p = 0; p < P; ++p) {
-        const int kind = parameters[p].kind;
         const double h = parameters[p].step;
-        std::vector<MicroimageTruth> side[2], mixed[2];
-        for (int s = 0; s < 2; ++s) {
-            if (p == focal)
-                side[s] = focal_side[s];
-            else if (!measure_with(kind, (s == 0 ? 1 : -1) * h, 0, &side[s]))
-                return false;
-            if (focal < P && p != focal &&
-                !measure_with(kind, h, (s == 0 ? 1 : -1) * parameters[focal].step, &mixed[s]))
-                return false;
-        }
+        const std::vector<MicroimageTruth>* up = &measured[side[p][0]];
+        const std::vector<MicroimageTruth>* down = &measured[side[p][1]];
+        const bool mixes = focal < P && p != focal;
         for (std::size_t i = 0; i < quarters.size(); ++i) {
             const MicroimageCentre c = microimage_centre_px(am, quarters[i].lens);
-            bool lit = c.valid && side[0][i].lit && ideal[i].lit && side[1][i].lit;
-            for (int s = 0; s < 2 && focal < P && p != focal; ++s)
-                lit = lit && mixed[s][i].lit && focal_side[s][i].lit;
+            bool lit = c.valid && (*up)[i].lit && ideal[i].lit && (*down)[i].lit;
+            for (int s = 0; s < 2 && mixes; ++s)
+                lit = lit && measured[mixed[p][s]][i].lit && (*focal_side[s])[i].lit;
             if (!lit) {
                 valid[i] = 0;
                 continue;
             }
             for (int q = 0; q < 3; ++q) {
-                const double up = value(side[0][i], c, q), mid = value(ideal[i], c, q), down = value(side[1][i], c, q);
-                jh[i][9 * p + q] = (up - down) / (2 * h);
-                jh[i][9 * p + 3 + q] = (up - 2 * mid + down) / (h * h);
-                if (focal < P && p != focal)
-                    jh[i][9 * p + 6 + q] = (value(mixed[0][i], c, q) - value(mixed[1][i], c, q) -
-                                            value(focal_side[0][i], c, q) + value(focal_side[1][i], c, q)) /
-                                           (2 * parameters[focal].step * h);
+                const double u = value((*up)[i], c, q), mid = value(ideal[i], c, q), d = value((*down)[i], c, q);
+                jh[i][9 * p + q] = (u - d) / (2 * h);
+                jh[i][9 * p + 3 + q] = (u - 2 * mid + d) / (h * h);
+                if (mixes)
+                    jh[i][9 * p + 6 + q] =
+                        (value(measured[mixed[p][0]][i], c, q) - value(measured[mixed[p][1]][i], c, q) -
+                         value((*focal_side[0])[i], c, q) + value((*focal_side[1])[i], c, q)) /
+                        (2 * parameters[focal].step * h);
             }
         }
     }
@@ -1721,9 +1806,7 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
                      [&](std::size_t i) { return measured[i].lens; }) >
             cost(symmetry, m.array, known, pending.size(), [&](std::size_t i) { return out[pending[i]].lens; }))
             break;
-        std::sort(measured.begin(), measured.end(), [](const MicroimageTruth& p, const MicroimageTruth& q) {
-            return p.lens.l != q.lens.l ? p.lens.l < q.lens.l : p.lens.k < q.lens.k;
-        });
+        sort_row_by_row(measured);
         std::vector<char> lobes;
         if (!measure_symmetric(am, canonical.light(), options, measured, step, share(std::min(level, 1) * total / 4),
                                cancelled, &lobes, &anchor_known)) {
@@ -1761,7 +1844,7 @@ std::vector<MicroimageTruth> microimage_truth(const PlenopticCamera& m, const Mi
         pending.shrink_to_fit();
     }
     if (perturbed && counts.anchors > 0) {
-        if (!correct_for_errors(light, canonical, anchor_symmetry, options, at, interpolated, anchor_known, range,
+        if (!correct_for_errors(light, canonical, anchor_symmetry, options, at, interpolated, range,
                                 cancelled, out, pending, counts)) {
             out.clear();
             return out;
