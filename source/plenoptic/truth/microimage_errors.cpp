@@ -1,0 +1,439 @@
+// SPDX-License-Identifier: AGPL-3.0-or-later
+// Refracting lenses with manufacturing errors, corrected from Jacobian anchors (see the header).
+
+#include "plenoptic/truth/microimage_errors.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "plenoptic/array/lens_errors.h"
+#include "plenoptic/projection/microimage_lattice.h"
+
+namespace plenoptic {
+namespace microimage_detail {
+
+namespace {
+
+// The corrections' cubic is used where its estimated error is below these. The differences carry
+// the measurements' own scatter (some 1e-4 to 1e-3 px, 3e-5 of lit fraction, BENCHMARKS "Refracting
+// microlenses between anchors") divided by the step, and their fourth differences mostly that
+// scatter: a bound at the anchors' 5e-4 px would refuse most lenses on it alone.
+const double kCorrectionPx = 2e-3;
+const double kCorrectionFraction = 2e-4;
+
+// One error parameter of a lens, and the step of its differences.
+struct ErrorParameter {
+    // 0: dz (mm); 1: focal factor - 1; 2, 3: the axis's x, y; 4 + 2 a + c: the displacement of the
+    // lens's adjacent lens a (adjacent_lenses' order: the same lattice direction for every lens)
+    // from its own, component c (x, y; mm, array frame).
+    int kind;
+    double step;
+};
+
+// The parameters' largest count: four of the lens's own, two for each of up to eight adjacent lenses.
+const int kMaxErrorParameters = 4 + 2 * 8;
+
+// The lens's own error with parameter `kind` (< 4) at `value` and no other.
+LensError error_with(int kind, double value)
+{
+    LensError e;
+    if (kind == 0) {
+        e.dz_mm = value;
+    } else if (kind == 1) {
+        e.focal_factor = 1 + value;
+    } else {
+        e.tilt_deg = std::asin(std::fabs(value)) * 180 / kPi;
+        e.tilt_azimuth_deg = (kind == 2 ? 0 : 90) + (value < 0 ? 180 : 0);
+    }
+    return e;
+}
+
+// The lens's parameters' values, in `parameters`' order.
+void error_values(const MicrolensArray& a, LensIndex lens, const std::vector<ErrorParameter>& parameters, double* x)
+{
+    const LensError e = a.error_of(lens);
+    LensIndex adjacent[8];
+    const int count = adjacent_lenses(a.grid, lens, adjacent);
+    for (std::size_t p = 0; p < parameters.size(); ++p) {
+        const int kind = parameters[p].kind;
+        if (kind == 0) {
+            x[p] = e.dz_mm;
+        } else if (kind == 1) {
+            x[p] = e.focal_factor - 1;
+        } else if (kind < 4) {
+            x[p] = kind == 2 ? e.axis.x : e.axis.y;
+        } else {
+            const int j = (kind - 4) / 2;
+            const LensError n = j < count ? a.error_of(adjacent[j]) : e;
+            x[p] = (kind - 4) % 2 == 0 ? n.dx_mm - e.dx_mm : n.dy_mm - e.dy_mm;
+        }
+    }
+}
+
+// The linear part of an affine map of sensor points (pixels): a vector's image.
+template <class F> Vec2 linear_part(const F& map, Vec2 d)
+{
+    const Vec2 o = map(Vec2{0, 0}), p = map(d);
+    return Vec2{p.x - o.x, p.y - o.y};
+}
+
+} // namespace
+
+bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical, const Symmetry& symmetry,
+                        const MicroimageOptions& options,
+                        const std::vector<Vec2>& at, const std::vector<char>& interpolated, const double range[4],
+                        const MicroimageCancel& cancelled, std::vector<MicroimageTruth>& out,
+                        std::vector<std::size_t>& pending, MicroimageWork& counts)
+{
+    const PlenopticCamera& am = canonical.model();
+    const LensErrors& errors = *light.array.errors;
+    std::vector<ErrorParameter> parameters;
+    if (errors.max_dz_mm() > 0)
+        parameters.push_back(ErrorParameter{0, errors.max_dz_mm()});
+    if (errors.max_focal_deviation() > 0)
+        parameters.push_back(ErrorParameter{1, errors.max_focal_deviation()});
+    if (errors.tilts()) {
+        const double h = std::sin(errors.max_tilt_deg() * kPi / 180);
+        parameters.push_back(ErrorParameter{2, h});
+        parameters.push_back(ErrorParameter{3, h});
+    }
+    if (errors.max_shift_mm() > 0) {
+        LensIndex adjacent[8];
+        const int count = adjacent_lenses(am.array.grid, LensIndex{0, 0}, adjacent);
+        for (int c = 0; c < 2 * count; ++c)
+            parameters.push_back(ErrorParameter{4 + c, errors.max_shift_mm() / std::sqrt(2.0)});
+    }
+    const std::size_t P = parameters.size();
+    std::vector<std::size_t> lenses;  // the interpolated lenses
+    for (std::size_t i = 0; i < out.size(); ++i)
+        if (interpolated[i])
+            lenses.push_back(i);
+    if (P == 0 || lenses.empty())
+        return true;
+
+    // The Jacobian anchors: error_anchor_step lenses apart (at least five a side, else every lens is
+    // measured).
+    Anchors jacobian;
+    jacobian.cover(options.error_anchor_step, range);
+    std::vector<MicroimageTruth> anchors;
+    if (jacobian.enough())
+        anchors = jacobian.read_by(lenses, at, [](std::uint64_t) { return false; });
+    if (anchors.empty()) {
+        pending.insert(pending.end(), lenses.begin(), lenses.end());
+        std::sort(pending.begin(), pending.end());
+        return true;
+    }
+    // Where the camera's mirror symmetry holds (Symmetry), only the anchors' quarter lenses are
+    // measured: a lens's microimage is its quarter lens's mirrored, with each parameter mirrored too
+    // (the axis's and the displacements' components along a mirror change sign, an adjacent lens is
+    // its mirror image's).
+    struct Mirrored {
+        std::size_t quarter;  // into `quarters`
+        bool mirror_x, mirror_y;
+    };
+    std::vector<Mirrored> mirrored(anchors.size());
+    std::vector<MicroimageTruth> quarters;
+    {
+        std::unordered_map<std::uint64_t, std::size_t> where;
+        std::vector<LensIndex> of(anchors.size());
+        for (std::size_t i = 0; i < anchors.size(); ++i) {
+            Mirrored& mm = mirrored[i];
+            mm.mirror_x = mm.mirror_y = false;
+            of[i] = symmetry.valid() ? Symmetry::quarter_lens(am.array, anchors[i].lens, &mm.mirror_x, &mm.mirror_y)
+                                     : anchors[i].lens;
+            if (where.emplace(anchor_key(of[i]), 0).second) {
+                MicroimageTruth t = MicroimageTruth();
+                t.lens = of[i];
+                quarters.push_back(t);
+            }
+        }
+        for (std::size_t n = 0; n < quarters.size(); ++n)
+            where[anchor_key(quarters[n].lens)] = n;
+        for (std::size_t i = 0; i < anchors.size(); ++i)
+            mirrored[i].quarter = where.at(anchor_key(of[i]));
+    }
+    // The perturbations measured: parameter `kind` at `value`, the lens's focal factor less 1 at
+    // `focal` (besides that parameter's own). Each is a camera whose table perturbs every quarter
+    // lens alike, each lens alone in its neighbourhood (the anchors lie far apart).
+    struct Perturbation {
+        int kind;
+        double value, focal;
+    };
+    std::vector<Perturbation> perturbations;
+    std::size_t focal = P;  // the focal factor's parameter (P: none)
+    for (std::size_t p = 0; p < P; ++p)
+        if (parameters[p].kind == 1)
+            focal = p;
+    // Where each parameter's measurements are among the perturbations: side[p][s] at +h (s = 0) and
+    // -h, mixed[p][s] at +h with the focal factor's +step (s = 0) and -step.
+    std::vector<std::array<std::size_t, 2>> side(P), mixed(P);
+    for (std::size_t p = 0; p < P; ++p)
+        for (int s = 0; s < 2; ++s) {
+            const double sign = s == 0 ? 1 : -1;
+            side[p][s] = perturbations.size();
+            perturbations.push_back(Perturbation{parameters[p].kind, sign * parameters[p].step, 0});
+            if (focal < P && p != focal) {
+                mixed[p][s] = perturbations.size();
+                perturbations.push_back(
+                    Perturbation{parameters[p].kind, parameters[p].step, sign * parameters[focal].step});
+            }
+        }
+    const double type_focal = am.array.microlens->focal_length_mm(0);
+    std::vector<PlenopticCamera> perturbed_model(perturbations.size(), am), perturbed_light(perturbations.size(),
+                                                                                           canonical.light());
+    for (std::size_t n = 0; n < perturbations.size(); ++n) {
+        const Perturbation& pert = perturbations[n];
+        std::vector<LensTableRow> rows;
+        for (std::size_t i = 0; i < quarters.size(); ++i) {
+            LensTableRow own;
+            own.lens = quarters[i].lens;
+            own.error = pert.kind < 4 ? error_with(pert.kind, pert.value) : LensError();
+            if (pert.focal != 0)
+                own.error.focal_factor = 1 + pert.focal;
+            if (pert.kind < 4 || pert.focal != 0)
+                rows.push_back(own);
+            if (pert.kind >= 4) {
+                LensIndex adjacent[8];
+                adjacent_lenses(am.array.grid, quarters[i].lens, adjacent);
+                LensTableRow next;
+                next.lens = adjacent[(pert.kind - 4) / 2];
+                ((pert.kind - 4) % 2 == 0 ? next.error.dx_mm : next.error.dy_mm) = pert.value;
+                rows.push_back(next);
+            }
+        }
+        const std::shared_ptr<const LensErrors> table = LensErrors::tabled(rows, std::string(), &type_focal, 1);
+        perturbed_model[n].array.errors = table;
+        perturbed_light[n].array.errors = table;
+    }
+    // Each quarter lens measured ideal from scratch, then with each perturbation, each region's
+    // radii sought near the ideal lens's (a perturbation moves a boundary by a few hundredths of a
+    // pixel where it acts, and most not at all). The answer is the grid step that holds the crossing,
+    // as from scratch (boundary_on_grid); only the search is shorter (behind the 22 mm wide-angle
+    // some 60 % of the probes from scratch; the coarse search about dark start points, a third of
+    // those, is as long). On every thread, a quarter lens at a time; each result depends on the lens
+    // alone.
+    const LensMeasurer ideal_measurer(am, canonical.light(), options);
+    std::vector<LensMeasurer> measurers;
+    measurers.reserve(perturbations.size());
+    for (std::size_t n = 0; n < perturbations.size(); ++n)
+        measurers.emplace_back(perturbed_model[n], perturbed_light[n], options);
+    std::vector<MicroimageTruth> ideal = quarters;
+    std::vector<std::vector<MicroimageTruth>> measured(perturbations.size(), quarters);
+    {
+        std::atomic<std::size_t> next(0);
+        std::atomic<bool> stop(false);
+        auto work = [&](bool polls) {
+            std::vector<CellNode> own_nodes;
+            for (std::size_t i = next++; i < quarters.size() && !stop; i = next++) {
+                LensMeasurer::Radii radii = ideal_measurer.fresh();
+                ideal_measurer.measure(ideal[i], &radii, &own_nodes, nullptr);
+                const std::vector<std::vector<std::vector<double>>> seed = radii.history;
+                for (std::size_t n = 0; n < perturbations.size() && !stop; ++n) {
+                    if (polls && cancelled && cancelled()) {
+                        stop = true;
+                        break;
+                    }
+                    radii.history = seed;
+                    measurers[n].measure(measured[n][i], &radii, &own_nodes, nullptr);
+                }
+            }
+        };
+        const unsigned hardware = std::thread::hardware_concurrency();
+        const int threads = options.threads > 0 ? options.threads : int(std::max(1u, hardware));
+        std::vector<std::thread> workers;
+        for (int t = 1; t < threads && std::size_t(t) < quarters.size(); ++t)
+            workers.push_back(std::thread(work, false));
+        work(true);
+        for (std::thread& worker : workers)
+            worker.join();
+        if (stop)
+            return false;
+    }
+    // Per quarter lens, for each parameter and each of du, dv and the lit fraction: J, H, and K (the
+    // mixed difference with the focal factor: a lens's light near its cell's edge, where its
+    // neighbours act, moves with its own focal length, some 9 % of the neighbours' effect a per cent
+    // of focal length behind the 22 mm wide-angle).
+    std::vector<char> valid(quarters.size(), 1);
+    std::vector<std::vector<double>> jh(quarters.size(), std::vector<double>(9 * P, 0.0));
+    auto value = [&](const MicroimageTruth& t, const MicroimageCentre& c, int q) {
+        return q == 0 ? t.u_px - c.u : q == 1 ? t.v_px - c.v : t.lit_fraction;
+    };
+    const std::vector<MicroimageTruth>* focal_side[2] = {nullptr, nullptr};
+    if (focal < P)
+        for (int s = 0; s < 2; ++s)
+            focal_side[s] = &measured[side[focal][s]];
+    for (std::size_t p = 0; p < P; ++p) {
+        const double h = parameters[p].step;
+        const std::vector<MicroimageTruth>* up = &measured[side[p][0]];
+        const std::vector<MicroimageTruth>* down = &measured[side[p][1]];
+        const bool mixes = focal < P && p != focal;
+        for (std::size_t i = 0; i < quarters.size(); ++i) {
+            const MicroimageCentre c = microimage_centre_px(am, quarters[i].lens);
+            bool lit = c.valid && (*up)[i].lit && ideal[i].lit && (*down)[i].lit;
+            for (int s = 0; s < 2 && mixes; ++s)
+                lit = lit && measured[mixed[p][s]][i].lit && (*focal_side[s])[i].lit;
+            if (!lit) {
+                valid[i] = 0;
+                continue;
+            }
+            for (int q = 0; q < 3; ++q) {
+                const double u = value((*up)[i], c, q), mid = value(ideal[i], c, q), d = value((*down)[i], c, q);
+                jh[i][9 * p + q] = (u - d) / (2 * h);
+                jh[i][9 * p + 3 + q] = (u - 2 * mid + d) / (h * h);
+                if (mixes)
+                    jh[i][9 * p + 6 + q] =
+                        (value(measured[mixed[p][0]][i], c, q) - value(measured[mixed[p][1]][i], c, q) -
+                         value((*focal_side[0])[i], c, q) + value((*focal_side[1])[i], c, q)) /
+                        (2 * parameters[focal].step * h);
+            }
+        }
+    }
+    // Each anchor's from its quarter lens's.
+    std::unordered_map<std::uint64_t, std::vector<double>> differences;
+    for (std::size_t i = 0; i < anchors.size(); ++i) {
+        const Mirrored& mm = mirrored[i];
+        if (!valid[mm.quarter])
+            continue;
+        const std::vector<double>& from = jh[mm.quarter];
+        if (!mm.mirror_x && !mm.mirror_y) {
+            differences[anchor_key(anchors[i].lens)] = from;
+            continue;
+        }
+        // The anchor's adjacent lens a is the mirror image of the quarter lens's adjacent[image[a]].
+        const LensIndex lens = anchors[i].lens, quarter = quarters[mm.quarter].lens;
+        LensIndex adjacent[8], quarter_adjacent[8];
+        const int count = adjacent_lenses(am.array.grid, lens, adjacent);
+        adjacent_lenses(am.array.grid, quarter, quarter_adjacent);
+        int image[8];
+        bool matched = true;
+        for (int a = 0; a < count; ++a) {
+            const Vec2 o = am.array.lattice_centre_local(adjacent[a]) - am.array.lattice_centre_local(lens);
+            const Vec2 want{mm.mirror_x ? -o.x : o.x, mm.mirror_y ? -o.y : o.y};
+            image[a] = -1;
+            for (int b = 0; b < count; ++b) {
+                const Vec2 ob =
+                    am.array.lattice_centre_local(quarter_adjacent[b]) - am.array.lattice_centre_local(quarter);
+                if (std::fabs(ob.x - want.x) + std::fabs(ob.y - want.y) < 1e-6 * am.array.pitch_mm)
+                    image[a] = b;
+            }
+            matched = matched && image[a] >= 0;
+        }
+        if (!matched)
+            continue;
+        std::vector<double> to(9 * P, 0.0);
+        for (std::size_t p = 0; p < P; ++p) {
+            const int kind = parameters[p].kind;
+            int source_kind = kind;
+            double sign = 1;
+            if (kind == 2 && mm.mirror_x)
+                sign = -1;
+            if (kind == 3 && mm.mirror_y)
+                sign = -1;
+            if (kind >= 4) {
+                const int a = (kind - 4) / 2, c = (kind - 4) % 2;
+                source_kind = 4 + 2 * image[a] + c;
+                if ((c == 0 && mm.mirror_x) || (c == 1 && mm.mirror_y))
+                    sign = -1;
+            }
+            std::size_t source = P;
+            for (std::size_t r = 0; r < P; ++r)
+                if (parameters[r].kind == source_kind)
+                    source = r;
+            for (int order = 0; order < 3; ++order) {  // J, H, K: J and K change sign with the parameter
+                const double* f = &from[9 * source + 3 * order];
+                double* t = &to[9 * p + 3 * order];
+                const double factor = order == 1 ? 1 : sign;
+                const Vec2 d = linear_part(
+                    [&](Vec2 px) { return symmetry.map_px(am.sensor, mm.mirror_x, mm.mirror_y, px); },
+                    Vec2{factor * f[0], factor * f[1]});
+                t[0] = d.x;
+                t[1] = d.y;
+                t[2] = factor * f[2];
+            }
+        }
+        differences[anchor_key(lens)].swap(to);
+    }
+    counts.error_anchors = quarters.size();
+
+    // Each lens corrected, on every thread (each result depends on the lens alone).
+    std::vector<char> measure(out.size(), 0);
+    std::atomic<std::size_t> next(0);
+    const std::size_t kChunk = 256;
+    auto work = [&]() {
+        for (std::size_t first = next.fetch_add(kChunk); first < lenses.size(); first = next.fetch_add(kChunk))
+            for (std::size_t n = first; n < std::min(lenses.size(), first + kChunk); ++n) {
+                const std::size_t index = lenses[n];
+                MicroimageTruth& truth = out[index];
+                std::int64_t i0, j0;
+                double x, y;
+                jacobian.stencil(at[index], &i0, &j0, &x, &y);
+                const std::vector<double>* block[6][6] = {};
+                bool missing = false;
+                jacobian.each(i0, j0, [&](std::int64_t i, std::int64_t j) {
+                    const auto found = differences.find(anchor_key(jacobian.lens(i, j)));
+                    if (found == differences.end())
+                        missing = true;
+                    else
+                        block[j - j0 + 1][i - i0 + 1] = &found->second;
+                });
+                if (missing) {
+                    measure[index] = 1;
+                    continue;
+                }
+                double xs[kMaxErrorParameters];
+                error_values(light.array, truth.lens, parameters, xs);
+                auto v = [&](std::int64_t i, std::int64_t j, int q) {
+                    const std::vector<double>& d = *block[j - j0 + 1][i - i0 + 1];
+                    double sum = 0;
+                    const double xf = focal < P ? xs[focal] : 0;
+                    for (std::size_t p = 0; p < P; ++p)
+                        sum += d[9 * p + q] * xs[p] + 0.5 * d[9 * p + 3 + q] * xs[p] * xs[p] +
+                               d[9 * p + 6 + q] * xs[p] * xf;
+                    return sum;
+                };
+                const double allowed[3] = {kCorrectionPx, kCorrectionPx, kCorrectionFraction};
+                double result[3];
+                bool vouched = true;
+                for (int q = 0; q < 3 && vouched; ++q) {
+                    double error;
+                    result[q] = cubic_through(jacobian, i0, j0, x, y, v, q, &error);
+                    vouched = error <= allowed[q];
+                }
+                if (!vouched) {
+                    measure[index] = 1;
+                    continue;
+                }
+                const Vec2 d =
+                    linear_part([&](Vec2 px) { return canonical.to_camera_px(px); }, Vec2{result[0], result[1]});
+                truth.u_px += d.x;
+                truth.v_px += d.y;
+                truth.lit_fraction += result[2];
+            }
+    };
+    const unsigned hardware = std::thread::hardware_concurrency();
+    const int threads = options.threads > 0 ? options.threads : int(std::max(1u, hardware));
+    std::vector<std::thread> workers;
+    for (int t = 1; t < threads; ++t)
+        workers.push_back(std::thread(work));
+    work();
+    for (std::thread& worker : workers)
+        worker.join();
+    std::size_t corrected = 0;
+    for (std::size_t index : lenses) {
+        if (measure[index])
+            pending.push_back(index);
+        else
+            ++corrected;
+    }
+    std::sort(pending.begin(), pending.end());
+    counts.corrected = corrected;
+    return true;
+}
+
+} // namespace microimage_detail
+} // namespace plenoptic
