@@ -82,16 +82,10 @@ template <class F> Vec2 linear_part(const F& map, Vec2 d)
     return Vec2{p.x - o.x, p.y - o.y};
 }
 
-} // namespace
-
-bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical, const Symmetry& symmetry,
-                        const MicroimageOptions& options,
-                        const std::vector<Vec2>& at, const std::vector<char>& interpolated, const double range[4],
-                        const MicroimageCancel& cancelled, std::vector<MicroimageTruth>& out,
-                        std::vector<std::size_t>& pending, MicroimageWork& counts)
+// The parameters the errors give a lens, each with the step of its differences: the largest value
+// the errors give it (a lens's own displacement for a neighbour's relative one, per component).
+std::vector<ErrorParameter> error_parameters(const LensErrors& errors, GridType grid)
 {
-    const PlenopticCamera& am = canonical.model();
-    const LensErrors& errors = *light.array.errors;
     std::vector<ErrorParameter> parameters;
     if (errors.max_dz_mm() > 0)
         parameters.push_back(ErrorParameter{0, errors.max_dz_mm()});
@@ -104,10 +98,120 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
     }
     if (errors.max_shift_mm() > 0) {
         LensIndex adjacent[8];
-        const int count = adjacent_lenses(am.array.grid, LensIndex{0, 0}, adjacent);
+        const int count = adjacent_lenses(grid, LensIndex{0, 0}, adjacent);
         for (int c = 0; c < 2 * count; ++c)
             parameters.push_back(ErrorParameter{4 + c, errors.max_shift_mm() / std::sqrt(2.0)});
     }
+    return parameters;
+}
+
+// A perturbation of the Jacobian anchors: parameter `kind` at `value`, the lens's focal factor less 1
+// at `focal` (besides that parameter's own).
+struct Perturbation {
+    int kind;
+    double value, focal;
+};
+
+// The table of errors that perturbs each of `lenses` alike (each alone in its neighbourhood: the
+// anchors lie far apart); lenses of the type's focal length `type_focal`.
+std::shared_ptr<const LensErrors> perturbation_table(const Perturbation& pert, const std::vector<MicroimageTruth>& lenses,
+                                                     GridType grid, double type_focal)
+{
+    std::vector<LensTableRow> rows;
+    for (const MicroimageTruth& lens : lenses) {
+        LensTableRow own;
+        own.lens = lens.lens;
+        own.error = pert.kind < 4 ? error_with(pert.kind, pert.value) : LensError();
+        if (pert.focal != 0)
+            own.error.focal_factor = 1 + pert.focal;
+        if (pert.kind < 4 || pert.focal != 0)
+            rows.push_back(own);
+        if (pert.kind >= 4) {
+            LensIndex adjacent[8];
+            adjacent_lenses(grid, lens.lens, adjacent);
+            LensTableRow next;
+            next.lens = adjacent[(pert.kind - 4) / 2];
+            ((pert.kind - 4) % 2 == 0 ? next.error.dx_mm : next.error.dy_mm) = pert.value;
+            rows.push_back(next);
+        }
+    }
+    return LensErrors::tabled(rows, std::string(), &type_focal, 1);
+}
+
+// The differences of `lens` (an anchor of the Jacobian) from those of its quarter lens `quarter`,
+// measured (`from`), under the mirrors that map it there: each parameter mirrored (the axis's and
+// the displacements' components along a mirror change sign, an adjacent lens is its mirror
+// image's), each sensor vector mirrored. False when the adjacent lenses do not match.
+bool mirror_differences(const PlenopticCamera& am, const Symmetry& symmetry,
+                        const std::vector<ErrorParameter>& parameters, LensIndex lens, LensIndex quarter,
+                        bool mirror_x, bool mirror_y, const std::vector<double>& from, std::vector<double>* out)
+{
+    // The anchor's adjacent lens a is the mirror image of the quarter lens's adjacent[image[a]].
+    LensIndex adjacent[8], quarter_adjacent[8];
+    const int count = adjacent_lenses(am.array.grid, lens, adjacent);
+    adjacent_lenses(am.array.grid, quarter, quarter_adjacent);
+    int image[8];
+    bool matched = true;
+    for (int a = 0; a < count; ++a) {
+        const Vec2 o = am.array.lattice_centre_local(adjacent[a]) - am.array.lattice_centre_local(lens);
+        const Vec2 want{mirror_x ? -o.x : o.x, mirror_y ? -o.y : o.y};
+        image[a] = -1;
+        for (int b = 0; b < count; ++b) {
+            const Vec2 ob =
+                am.array.lattice_centre_local(quarter_adjacent[b]) - am.array.lattice_centre_local(quarter);
+            if (std::fabs(ob.x - want.x) + std::fabs(ob.y - want.y) < 1e-6 * am.array.pitch_mm)
+                image[a] = b;
+        }
+        matched = matched && image[a] >= 0;
+    }
+    if (!matched)
+        return false;
+    const std::size_t P = parameters.size();
+    std::vector<double>& to = *out;
+    to.assign(9 * P, 0.0);
+    for (std::size_t p = 0; p < P; ++p) {
+        const int kind = parameters[p].kind;
+        int source_kind = kind;
+        double sign = 1;
+        if (kind == 2 && mirror_x)
+            sign = -1;
+        if (kind == 3 && mirror_y)
+            sign = -1;
+        if (kind >= 4) {
+            const int a = (kind - 4) / 2, c = (kind - 4) % 2;
+            source_kind = 4 + 2 * image[a] + c;
+            if ((c == 0 && mirror_x) || (c == 1 && mirror_y))
+                sign = -1;
+        }
+        std::size_t source = P;
+        for (std::size_t r = 0; r < P; ++r)
+            if (parameters[r].kind == source_kind)
+                source = r;
+        for (int order = 0; order < 3; ++order) {  // J, H, K: J and K change sign with the parameter
+            const double* f = &from[9 * source + 3 * order];
+            double* t = &to[9 * p + 3 * order];
+            const double factor = order == 1 ? 1 : sign;
+            const Vec2 d = linear_part(
+                [&](Vec2 px) { return symmetry.map_px(am.sensor, mirror_x, mirror_y, px); },
+                Vec2{factor * f[0], factor * f[1]});
+            t[0] = d.x;
+            t[1] = d.y;
+            t[2] = factor * f[2];
+        }
+    }
+    return true;
+}
+
+} // namespace
+
+bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical, const Symmetry& symmetry,
+                        const MicroimageOptions& options,
+                        const std::vector<Vec2>& at, const std::vector<char>& interpolated, const double range[4],
+                        const MicroimageCancel& cancelled, std::vector<MicroimageTruth>& out,
+                        std::vector<std::size_t>& pending, MicroimageWork& counts)
+{
+    const PlenopticCamera& am = canonical.model();
+    const std::vector<ErrorParameter> parameters = error_parameters(*light.array.errors, am.array.grid);
     const std::size_t P = parameters.size();
     std::vector<std::size_t> lenses;  // the interpolated lenses
     for (std::size_t i = 0; i < out.size(); ++i)
@@ -157,13 +261,7 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
         for (std::size_t i = 0; i < anchors.size(); ++i)
             mirrored[i].quarter = where.at(anchor_key(of[i]));
     }
-    // The perturbations measured: parameter `kind` at `value`, the lens's focal factor less 1 at
-    // `focal` (besides that parameter's own). Each is a camera whose table perturbs every quarter
-    // lens alike, each lens alone in its neighbourhood (the anchors lie far apart).
-    struct Perturbation {
-        int kind;
-        double value, focal;
-    };
+    // The perturbations measured, each in a camera with its perturbation_table.
     std::vector<Perturbation> perturbations;
     std::size_t focal = P;  // the focal factor's parameter (P: none)
     for (std::size_t p = 0; p < P; ++p)
@@ -187,26 +285,8 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
     std::vector<PlenopticCamera> perturbed_model(perturbations.size(), am), perturbed_light(perturbations.size(),
                                                                                            canonical.light());
     for (std::size_t n = 0; n < perturbations.size(); ++n) {
-        const Perturbation& pert = perturbations[n];
-        std::vector<LensTableRow> rows;
-        for (std::size_t i = 0; i < quarters.size(); ++i) {
-            LensTableRow own;
-            own.lens = quarters[i].lens;
-            own.error = pert.kind < 4 ? error_with(pert.kind, pert.value) : LensError();
-            if (pert.focal != 0)
-                own.error.focal_factor = 1 + pert.focal;
-            if (pert.kind < 4 || pert.focal != 0)
-                rows.push_back(own);
-            if (pert.kind >= 4) {
-                LensIndex adjacent[8];
-                adjacent_lenses(am.array.grid, quarters[i].lens, adjacent);
-                LensTableRow next;
-                next.lens = adjacent[(pert.kind - 4) / 2];
-                ((pert.kind - 4) % 2 == 0 ? next.error.dx_mm : next.error.dy_mm) = pert.value;
-                rows.push_back(next);
-            }
-        }
-        const std::shared_ptr<const LensErrors> table = LensErrors::tabled(rows, std::string(), &type_focal, 1);
+        const std::shared_ptr<const LensErrors> table =
+            perturbation_table(perturbations[n], quarters, am.array.grid, type_focal);
         perturbed_model[n].array.errors = table;
         perturbed_light[n].array.errors = table;
     }
@@ -304,59 +384,10 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
             differences[anchor_key(anchors[i].lens)] = from;
             continue;
         }
-        // The anchor's adjacent lens a is the mirror image of the quarter lens's adjacent[image[a]].
-        const LensIndex lens = anchors[i].lens, quarter = quarters[mm.quarter].lens;
-        LensIndex adjacent[8], quarter_adjacent[8];
-        const int count = adjacent_lenses(am.array.grid, lens, adjacent);
-        adjacent_lenses(am.array.grid, quarter, quarter_adjacent);
-        int image[8];
-        bool matched = true;
-        for (int a = 0; a < count; ++a) {
-            const Vec2 o = am.array.lattice_centre_local(adjacent[a]) - am.array.lattice_centre_local(lens);
-            const Vec2 want{mm.mirror_x ? -o.x : o.x, mm.mirror_y ? -o.y : o.y};
-            image[a] = -1;
-            for (int b = 0; b < count; ++b) {
-                const Vec2 ob =
-                    am.array.lattice_centre_local(quarter_adjacent[b]) - am.array.lattice_centre_local(quarter);
-                if (std::fabs(ob.x - want.x) + std::fabs(ob.y - want.y) < 1e-6 * am.array.pitch_mm)
-                    image[a] = b;
-            }
-            matched = matched && image[a] >= 0;
-        }
-        if (!matched)
-            continue;
-        std::vector<double> to(9 * P, 0.0);
-        for (std::size_t p = 0; p < P; ++p) {
-            const int kind = parameters[p].kind;
-            int source_kind = kind;
-            double sign = 1;
-            if (kind == 2 && mm.mirror_x)
-                sign = -1;
-            if (kind == 3 && mm.mirror_y)
-                sign = -1;
-            if (kind >= 4) {
-                const int a = (kind - 4) / 2, c = (kind - 4) % 2;
-                source_kind = 4 + 2 * image[a] + c;
-                if ((c == 0 && mm.mirror_x) || (c == 1 && mm.mirror_y))
-                    sign = -1;
-            }
-            std::size_t source = P;
-            for (std::size_t r = 0; r < P; ++r)
-                if (parameters[r].kind == source_kind)
-                    source = r;
-            for (int order = 0; order < 3; ++order) {  // J, H, K: J and K change sign with the parameter
-                const double* f = &from[9 * source + 3 * order];
-                double* t = &to[9 * p + 3 * order];
-                const double factor = order == 1 ? 1 : sign;
-                const Vec2 d = linear_part(
-                    [&](Vec2 px) { return symmetry.map_px(am.sensor, mm.mirror_x, mm.mirror_y, px); },
-                    Vec2{factor * f[0], factor * f[1]});
-                t[0] = d.x;
-                t[1] = d.y;
-                t[2] = factor * f[2];
-            }
-        }
-        differences[anchor_key(lens)].swap(to);
+        std::vector<double> to;
+        if (mirror_differences(am, symmetry, parameters, anchors[i].lens, quarters[mm.quarter].lens, mm.mirror_x,
+                               mm.mirror_y, from, &to))
+            differences[anchor_key(anchors[i].lens)].swap(to);
     }
     counts.error_anchors = quarters.size();
 
