@@ -291,36 +291,62 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
         perturbed_light[n].array.errors = table;
     }
     // Each quarter lens measured ideal from scratch, then with each perturbation, each region's
-    // radii sought near the ideal lens's (a perturbation moves a boundary by a few hundredths of a
-    // pixel where it acts, and most not at all). The answer is the grid step that holds the crossing,
-    // as from scratch (boundary_on_grid); only the search is shorter (behind the 22 mm wide-angle
-    // some 60 % of the probes from scratch; the coarse search about dark start points, a third of
-    // those, is as long). On every thread, a quarter lens at a time; each result depends on the lens
-    // alone.
+    // radii sought near a measurement of the same lens that differs from it by one small step: the
+    // ideal lens's, or for a mixed perturbation (a parameter with the focal factor's step) the focal
+    // factor's step alone (a step moves a boundary by a few hundredths of a pixel where it acts, and
+    // most not at all). The answer is the grid step that holds the crossing, as from scratch
+    // (boundary_on_grid); only the search is shorter (behind the 22 mm wide-angle about half the
+    // probes from scratch; the coarse search about dark start points, a third of those, is as long).
+    // On every thread, a quarter lens at a time; each result depends on the lens alone.
+    const std::size_t N = perturbations.size();
+    std::vector<std::size_t> seeded_from(N, N);  // N: the ideal lens
+    std::vector<char> seeds_others(N, 0);
+    for (std::size_t p = 0; p < P && focal < P; ++p)
+        for (int s = 0; s < 2 && p != focal; ++s) {
+            seeded_from[mixed[p][s]] = side[focal][s];
+            seeds_others[side[focal][s]] = 1;
+        }
     const LensMeasurer ideal_measurer(am, canonical.light(), options);
     std::vector<LensMeasurer> measurers;
-    measurers.reserve(perturbations.size());
-    for (std::size_t n = 0; n < perturbations.size(); ++n)
+    measurers.reserve(N);
+    for (std::size_t n = 0; n < N; ++n)
         measurers.emplace_back(perturbed_model[n], perturbed_light[n], options);
     std::vector<MicroimageTruth> ideal = quarters;
-    std::vector<std::vector<MicroimageTruth>> measured(perturbations.size(), quarters);
+    std::vector<std::vector<MicroimageTruth>> measured(N, quarters);
     {
+        typedef std::vector<std::vector<std::vector<double>>> History;
+        // A measurement's radii as a seed: each region's newest radii alone (a history of one lens
+        // predicts that lens's radii, not a trend).
+        auto newest = [](const History& history) {
+            History seed(history.size());
+            for (std::size_t point = 0; point < history.size(); ++point)
+                if (!history[point].empty())
+                    seed[point].push_back(history[point][0]);
+            return seed;
+        };
         std::atomic<std::size_t> next(0);
         std::atomic<bool> stop(false);
         auto work = [&](bool polls) {
             std::vector<CellNode> own_nodes;
+            std::vector<History> seeds(N + 1);
             for (std::size_t i = next++; i < quarters.size() && !stop; i = next++) {
                 LensMeasurer::Radii radii = ideal_measurer.fresh();
                 ideal_measurer.measure(ideal[i], &radii, &own_nodes, nullptr);
-                const std::vector<std::vector<std::vector<double>>> seed = radii.history;
-                for (std::size_t n = 0; n < perturbations.size() && !stop; ++n) {
-                    if (polls && cancelled && cancelled()) {
-                        stop = true;
-                        break;
+                seeds[N] = newest(radii.history);
+                // The seeds of others first.
+                for (int pass = 0; pass < 2; ++pass)
+                    for (std::size_t n = 0; n < N && !stop; ++n) {
+                        if ((seeded_from[n] == N) != (pass == 0))
+                            continue;
+                        if (polls && cancelled && cancelled()) {
+                            stop = true;
+                            break;
+                        }
+                        radii.history = seeds[seeded_from[n]];
+                        measurers[n].measure(measured[n][i], &radii, &own_nodes, nullptr);
+                        if (seeds_others[n])
+                            seeds[n] = newest(radii.history);
                     }
-                    radii.history = seed;
-                    measurers[n].measure(measured[n][i], &radii, &own_nodes, nullptr);
-                }
             }
         };
         const unsigned hardware = std::thread::hardware_concurrency();
