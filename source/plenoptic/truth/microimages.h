@@ -61,7 +61,7 @@ struct MicroimageOptions {
     // and arrays with errors: every lens measured, whatever this is.
     int anchor_step = 0;
     // Refracting microlenses on an array with manufacturing errors: 0 (the default) measures every
-    // lens. At least 4 (with anchor_step at least 4), an approximation, 2.8 to 80 times faster:
+    // lens. At least 4 (with anchor_step at least 4), an approximation, 3.4 to 90 times faster:
     // each lens is the ideal lens interpolated where it sits, corrected to second order in each of
     // its errors (its own dz, focal length and tilt, its neighbours' displacements) by differences
     // measured at Jacobian anchors this many lenses apart, where their cubic vouches for it; the
