@@ -20,11 +20,11 @@
 #include <cstring>
 #include <ctime>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <sys/resource.h>
 
+#include "plenoptic/core/threads.h"
 #include "plenoptic/sensor/diffraction.h"
 
 namespace {
@@ -37,7 +37,7 @@ void direct_convolution(std::vector<float>& picture, int W, int H, int channels,
 {
     const std::vector<float> source(picture);
     std::atomic<int> next_row(0);
-    auto work = [&]() {
+    run_on_threads(threads, [&](int) {
         for (int j = next_row++; j < H; j = next_row++)
             for (int c = 0; c < channels; ++c) {
                 const AiryKernel& k = kernels[c];
@@ -53,13 +53,7 @@ void direct_convolution(std::vector<float>& picture, int W, int H, int channels,
                     picture[(size_t(j) * W + i) * channels + c] = float(sum);
                 }
             }
-    };
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t)
-        pool.emplace_back(work);
-    work();
-    for (std::thread& t : pool)
-        t.join();
+    });
 }
 
 std::vector<float> test_picture(int W, int H)
@@ -98,7 +92,7 @@ long peak_rss_kib()
 
 int main(int argc, char** argv)
 {
-    int W = 0, H = 0, threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    int W = 0, H = 0, threads = thread_count(0, std::size_t(-1));
     double radii[3] = {0, 0, 0};
     bool direct = false, compare = false;
     for (int a = 1; a < argc; ++a) {

@@ -51,7 +51,6 @@
 #include <ctime>
 #include <fstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <sys/resource.h>
@@ -60,6 +59,7 @@
 #include "plenoptic/camera/params.h"
 #include "plenoptic/camera/plenoptic_camera.h"
 #include "plenoptic/camera/rays.h"
+#include "plenoptic/core/threads.h"
 #include "plenoptic/lens/prescription.h"
 #include "plenoptic/optics.h"
 #include "plenoptic/projection/microimage_lattice.h"
@@ -202,12 +202,7 @@ bool brute_centroid(const PlenopticCamera& m, LensIndex lens, int cell_points, d
                     }
             }
     };
-    std::vector<std::thread> workers;
-    for (int t = 1; t < int(sums.size()); ++t)
-        workers.push_back(std::thread(work, t));
-    work(0);
-    for (std::thread& worker : workers)
-        worker.join();
+    run_on_threads(int(sums.size()), work);
     Sum total;
     for (const Sum& sum : sums) {
         total.count += sum.count;
@@ -356,7 +351,7 @@ int main(int argc, char** argv)
         }
         if (o.brute_points > 0) {
             const double b0 = cpu_seconds();
-            const int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+            const int threads = thread_count(o.threads, std::size_t(-1));
             for (std::size_t i = 0; i < which.size(); ++i) {
                 const MicroimageTruth& a = truth[which[i]];
                 const MicroimageTruth& b = each[i];

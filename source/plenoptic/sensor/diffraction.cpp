@@ -8,12 +8,12 @@
 #include <cmath>
 #include <memory>
 #include <mutex>
-#include <thread>
 
 #include <boost/math/special_functions/bessel.hpp>
 #include <fftw3.h>
 
 #include "plenoptic/camera/rays.h"
+#include "plenoptic/core/threads.h"
 
 namespace plenoptic {
 
@@ -278,8 +278,7 @@ bool convolve_rows(int W, int H, int channels, const AiryKernel* kernels, const 
 
     const int tiles = (W + tx - 1) / tx;
     const int tasks = tiles * channels;
-    const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
-    const int count = std::max(1, std::min(threads > 0 ? threads : int(hardware), tasks));
+    const int count = thread_count(threads, std::size_t(std::max(tasks, 0)));
     // Each thread's own transform buffers.
     struct Scratch {
         RealBuffer real;
@@ -327,23 +326,17 @@ bool convolve_rows(int W, int H, int channels, const AiryKernel* kernels, const 
         }
         std::atomic<int> next(0);
         std::atomic<bool> stop(false);
-        auto work = [&](Scratch& s) {
-            for (int task = next++; task < tasks && !stop; task = next++)
-                convolve_tile(task, s);
-        };
-        std::vector<std::thread> pool;
-        for (int t = 1; t < count; ++t)
-            pool.emplace_back(work, std::ref(scratch[size_t(t)]));
-        // The calling thread works too, and looks at `cancelled` between its tiles.
-        for (int task = next++; task < tasks && !stop; task = next++) {
-            if (cancelled && cancelled()) {
-                stop = true;
-                break;
+        // Each thread with its own buffers; the calling thread (t = 0) looks at `cancelled` between
+        // its tiles.
+        run_on_threads(count, [&](int t) {
+            for (int task = next++; task < tasks && !stop; task = next++) {
+                if (t == 0 && cancelled && cancelled()) {
+                    stop = true;
+                    break;
+                }
+                convolve_tile(task, scratch[size_t(t)]);
             }
-            convolve_tile(task, scratch[0]);
-        }
-        for (std::thread& t : pool)
-            t.join();
+        });
         if (stop)
             return false;
         if (!write(j0, std::min(ty, H - j0), output.data()))

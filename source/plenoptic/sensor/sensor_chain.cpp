@@ -9,7 +9,6 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
-#include <thread>
 #include <vector>
 
 #include <boost/random/normal_distribution.hpp>
@@ -17,6 +16,7 @@
 
 #include "plenoptic/core/format.h"
 #include "plenoptic/core/json.h"
+#include "plenoptic/core/threads.h"
 
 namespace plenoptic {
 
@@ -185,17 +185,10 @@ void sensor_raw_rows(const SensorChainParams& c, const float* linear, int W, int
         }
     };
     std::atomic<int> next(0);
-    auto work = [&]() {
+    run_on_threads(thread_count(threads, std::size_t(std::max(rows, 0))), [&](int) {
         for (int r = next++; r < rows; r = next++)
             read_row(r);
-    };
-    const int count = std::min(rows, threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency())));
-    std::vector<std::thread> workers;
-    for (int t = 1; t < count; ++t)
-        workers.emplace_back(work);
-    work();
-    for (std::thread& worker : workers)
-        worker.join();
+    });
 }
 
 std::vector<std::uint16_t> sensor_raw(const SensorChainParams& c, const std::vector<float>& linear, int W, int H)

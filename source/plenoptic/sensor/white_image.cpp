@@ -5,9 +5,9 @@
 
 #include <algorithm>
 #include <atomic>
-#include <thread>
 
 #include "plenoptic/camera/pixel.h"
+#include "plenoptic/core/threads.h"
 
 namespace plenoptic {
 
@@ -64,25 +64,16 @@ bool white_image_rows(const PlenopticCamera& model, int first_row, int rows, flo
             out[size_t(r) * W + i] =
                 float(shade_pixel(model, i, first_row + r, [](const OpticsRay&) { return Rgbt{1, 1, 1, 1}; }).r);
     };
-    auto work = [&]() {
-        for (int r = next_row++; r < rows && !stop; r = next_row++)
+    // The calling thread (t = 0) looks at `cancelled` between rows.
+    run_on_threads(thread_count(threads, std::size_t(std::max(rows, 0))), [&](int t) {
+        for (int r = next_row++; r < rows && !stop; r = next_row++) {
+            if (t == 0 && cancelled && cancelled()) {
+                stop = true;
+                break;
+            }
             shade_row(r);
-    };
-    const unsigned hardware = std::thread::hardware_concurrency();
-    const int count = threads > 0 ? threads : int(std::max(1u, hardware));
-    std::vector<std::thread> workers;
-    for (int t = 1; t < count && t < rows; ++t)
-        workers.push_back(std::thread(work));
-    // The calling thread works too, and looks at `cancelled` between rows.
-    for (int r = next_row++; r < rows && !stop; r = next_row++) {
-        if (cancelled && cancelled()) {
-            stop = true;
-            break;
         }
-        shade_row(r);
-    }
-    for (std::thread& worker : workers)
-        worker.join();
+    });
     return !stop;
 }
 

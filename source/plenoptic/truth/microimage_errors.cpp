@@ -9,10 +9,10 @@
 #include <cmath>
 #include <memory>
 #include <string>
-#include <thread>
 
 #include "plenoptic/array/lens_errors.h"
 #include "plenoptic/projection/microimage_lattice.h"
+#include "plenoptic/core/threads.h"
 
 namespace plenoptic {
 namespace microimage_detail {
@@ -326,7 +326,8 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
         };
         std::atomic<std::size_t> next(0);
         std::atomic<bool> stop(false);
-        auto work = [&](bool polls) {
+        run_on_threads(thread_count(options.threads, quarters.size()), [&](int t) {
+            const bool polls = t == 0;
             std::vector<CellNode> own_nodes;
             std::vector<History> seeds(N + 1);
             for (std::size_t i = next++; i < quarters.size() && !stop; i = next++) {
@@ -348,15 +349,7 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
                             seeds[n] = newest(radii.history);
                     }
             }
-        };
-        const unsigned hardware = std::thread::hardware_concurrency();
-        const int threads = options.threads > 0 ? options.threads : int(std::max(1u, hardware));
-        std::vector<std::thread> workers;
-        for (int t = 1; t < threads && std::size_t(t) < quarters.size(); ++t)
-            workers.push_back(std::thread(work, false));
-        work(true);
-        for (std::thread& worker : workers)
-            worker.join();
+        });
         if (stop)
             return false;
     }
@@ -421,7 +414,7 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
     std::vector<char> measure(out.size(), 0);
     std::atomic<std::size_t> next(0);
     const std::size_t kChunk = 256;
-    auto work = [&]() {
+    run_on_threads(thread_count(options.threads, (lenses.size() + kChunk - 1) / kChunk), [&](int) {
         for (std::size_t first = next.fetch_add(kChunk); first < lenses.size(); first = next.fetch_add(kChunk))
             for (std::size_t n = first; n < std::min(lenses.size(), first + kChunk); ++n) {
                 const std::size_t index = lenses[n];
@@ -471,15 +464,7 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
                 truth.v_px += d.y;
                 truth.lit_fraction += result[2];
             }
-    };
-    const unsigned hardware = std::thread::hardware_concurrency();
-    const int threads = options.threads > 0 ? options.threads : int(std::max(1u, hardware));
-    std::vector<std::thread> workers;
-    for (int t = 1; t < threads; ++t)
-        workers.push_back(std::thread(work));
-    work();
-    for (std::thread& worker : workers)
-        worker.join();
+    });
     std::size_t corrected = 0;
     for (std::size_t index : lenses) {
         if (measure[index])

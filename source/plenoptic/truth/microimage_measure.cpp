@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <thread>
 
 #include "plenoptic/projection/microimage_lattice.h"
 #include "plenoptic/array/refracting_microlens.h"
@@ -16,6 +15,7 @@
 #include "plenoptic/camera/rays.h"
 #include "plenoptic/camera/rays_internal.h"
 #include "plenoptic/core/sampling.h"
+#include "plenoptic/core/threads.h"
 
 namespace plenoptic {
 namespace microimage_detail {
@@ -693,7 +693,8 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
     std::atomic<bool> stop(false);
     std::size_t reported = 0;
     // The calling thread (`reports`) works too: it polls `cancelled` between lenses and reports.
-    auto work = [&](bool reports) {
+    run_on_threads(thread_count(options.threads, runs.size() - 1), [&](int t) {
+        const bool reports = t == 0;
         Radii radii = measurer.fresh();
         std::vector<CellNode> own_nodes;
         for (std::size_t r = next++; r + 1 < runs.size() && !stop; r = next++) {
@@ -712,15 +713,7 @@ bool measure_lenses(const PlenopticCamera& m, const PlenopticCamera& light, cons
                 }
             }
         }
-    };
-    const unsigned hardware = std::thread::hardware_concurrency();
-    const int threads = options.threads > 0 ? options.threads : int(std::max(1u, hardware));
-    std::vector<std::thread> workers;
-    for (int t = 1; t < threads && std::size_t(t) + 1 < runs.size(); ++t)
-        workers.push_back(std::thread(work, false));
-    work(true);
-    for (std::thread& worker : workers)
-        worker.join();
+    });
     return !stop;
 }
 
