@@ -131,13 +131,13 @@ bool trace_sensor_point_as(const PlenopticCamera& m, Vec3 p, const LensIndex* fo
     if (!m.lens)
         return weigh(m, finish(leave, direction, out), p, ray.sampled, m.array.pose.normal, out);
 
-    // A real lens behind an array parallel to the sensor: a ray that crosses the exit pupil's plane
-    // outside the pupil-bounds disc of the point where it leaves the array cannot pass the lens
-    // (PupilBounds holds every point through which light from that point passes, and the bounds
-    // were made for points of this plane), so it is blocked without the surface-by-surface trace:
-    // most of the rays at the rims of microimages and their vignetting probes.
-    if (check_apertures && m.pupil_bounds && !m.array.pose.tilted && m.array.lenses_in_plane() &&
-        !m.pupil_bounds->may_pass(leave, direction))
+    // A real lens: a ray that crosses the exit pupil's plane outside the pupil-bounds disc of the
+    // point where its line crosses the array's plane cannot pass the lens (PupilBounds holds every
+    // point through which light from that point passes; a ray leaving a tilted array or a lens off
+    // the plane is tested from where its line meets it), so it is blocked without the
+    // surface-by-surface trace: most of the rays at the rims of microimages and their vignetting
+    // probes.
+    if (check_apertures && m.pupil_bounds && !m.pupil_bounds->may_pass(leave, direction))
         return false;
     // On through the main lens (a ray that misses its apertures carries no light).
     const bool passed = weigh(m, emit(m.lens->to_scene(leave, direction, check_apertures), out), p, ray.sampled,

@@ -697,12 +697,20 @@ PupilDisc PupilBounds::holding(const std::vector<Ramp>& ramps, Vec3 centre, doub
 
 bool PupilBounds::may_pass(Vec3 point, Vec3 direction) const
 {
-    const double t = (pupil_z_ - point.z) / direction.z;
+    // The ray's line where it crosses the bounds' plane: the same line, and only air lies between.
+    Vec3 from = point;
+    if (point.z != plane_z_) {
+        const double s = (plane_z_ - point.z) / direction.z;
+        if (!std::isfinite(s))
+            return true;
+        from = Vec3{point.x + s * direction.x, point.y + s * direction.y, plane_z_};
+    }
+    const double t = (pupil_z_ - from.z) / direction.z;
     if (!(t > 0) || !std::isfinite(t))
         return true;
-    const PupilDisc disc = disc_for(point);
-    const double x = point.x + t * direction.x - disc.centre.x;
-    const double y = point.y + t * direction.y - disc.centre.y;
+    const PupilDisc disc = disc_for(from);
+    const double x = from.x + t * direction.x - disc.centre.x;
+    const double y = from.y + t * direction.y - disc.centre.y;
     return x * x + y * y <= disc.radius * disc.radius;
 }
 

@@ -57,9 +57,12 @@ public:
     static const int kMaxDiscs = 5;
     int discs_holding(Vec3 centre, double radius, PupilDisc out[kMaxDiscs]) const;
 
-    // False when the ray from `point` (of the bounds' plane) along `direction` certainly misses the
-    // lens: it crosses the exit pupil's plane outside disc_for(point). True otherwise (the ray may
-    // pass; only the exact trace says), and for a ray that does not head for the pupil's plane.
+    // False when the ray from `point` along `direction` certainly misses the lens: from where its
+    // line crosses the bounds' plane, q, it crosses the exit pupil's plane outside disc_for(q). The
+    // point may lie off that plane (a microlens displaced along the axis or tilted, a tilted array):
+    // in the air behind the lens, where nothing else bends the ray, the line decides alone. True
+    // otherwise (the ray may pass; only the exact trace says), and for a ray that does not head for
+    // the pupil's plane or runs along the bounds' plane.
     bool may_pass(Vec3 point, Vec3 direction) const;
 
     // The farthest any passing ray crosses the exit pupil's plane from the axis point where the
