@@ -78,7 +78,16 @@ struct CacheSlot {
     LensIndex lens{0, 0};
     LensError error;
 };
-const int kCacheSlots = 64;
+// The cache's slots: a 16 x 16 tile of the lattice, slot (k mod 16, l mod 16), so that the lenses
+// about a pixel and about the pixels beside it never share a slot (with slots chosen by a hash of
+// the indices, a few neighbouring lenses did, and were drawn again and again).
+const int kCacheSide = 16;
+const int kCacheSlots = kCacheSide * kCacheSide;
+std::size_t cache_slot(LensIndex lens)
+{
+    return std::size_t(std::uint64_t(lens.k) & (kCacheSide - 1)) +
+           kCacheSide * std::size_t(std::uint64_t(lens.l) & (kCacheSide - 1));
+}
 
 } // namespace
 
@@ -163,7 +172,7 @@ LensError LensErrors::draw(LensIndex lens) const
 const LensError& LensErrors::at(LensIndex lens) const
 {
     thread_local CacheSlot cache[kCacheSlots];
-    CacheSlot& slot = cache[lens_key(lens) & (kCacheSlots - 1)];
+    CacheSlot& slot = cache[cache_slot(lens)];
     if (slot.owner == id_ && slot.lens == lens)
         return slot.error;
     slot.error = draw(lens);
