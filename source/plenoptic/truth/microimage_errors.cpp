@@ -202,162 +202,174 @@ bool mirror_differences(const PlenopticCamera& am, const Symmetry& symmetry,
     return true;
 }
 
-} // namespace
+// The perturbations the Jacobian anchors are measured with: each parameter at +h and -h alone
+// (side(p, 0), side(p, 1)) and, when the errors scale focal lengths, each other parameter at +h with
+// the focal factor's +step and -step (mixed(p, 0), mixed(p, 1)).
+class Perturbations {
+public:
+    explicit Perturbations(const std::vector<ErrorParameter>& parameters)
+        : P_(parameters.size()), focal_(parameters.size()), side_(P_), mixed_(P_)
+    {
+        for (std::size_t p = 0; p < P_; ++p)
+            if (parameters[p].kind == 1)
+                focal_ = p;
+        for (std::size_t p = 0; p < P_; ++p)
+            for (int s = 0; s < 2; ++s) {
+                const double sign = s == 0 ? 1 : -1;
+                side_[p][s] = list_.size();
+                list_.push_back(Perturbation{parameters[p].kind, sign * parameters[p].step, 0});
+                if (mixes(p)) {
+                    mixed_[p][s] = list_.size();
+                    list_.push_back(Perturbation{parameters[p].kind, parameters[p].step, sign * parameters[focal_].step});
+                }
+            }
+        // A measurement's search is seeded from one a step away: the ideal lens's (size()), or for a
+        // mixed perturbation the focal factor's step alone.
+        seeded_from_.assign(list_.size(), list_.size());
+        seeds_others_.assign(list_.size(), 0);
+        for (std::size_t p = 0; p < P_; ++p)
+            for (int s = 0; s < 2 && mixes(p); ++s) {
+                seeded_from_[mixed_[p][s]] = side_[focal_][s];
+                seeds_others_[side_[focal_][s]] = 1;
+            }
+    }
 
-bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical, const Symmetry& symmetry,
-                        const MicroimageOptions& options,
-                        const std::vector<Vec2>& at, const std::vector<char>& interpolated, const double range[4],
-                        const MicroimageCancel& cancelled, std::vector<MicroimageTruth>& out,
-                        std::vector<std::size_t>& pending, MicroimageWork& counts)
+    std::size_t size() const { return list_.size(); }
+    const Perturbation& operator[](std::size_t n) const { return list_[n]; }
+    // The focal factor's parameter (the parameters' count when the errors have none).
+    std::size_t focal() const { return focal_; }
+    bool mixes(std::size_t p) const { return focal_ < P_ && p != focal_; }
+    std::size_t side(std::size_t p, int s) const { return side_[p][s]; }
+    std::size_t mixed(std::size_t p, int s) const { return mixed_[p][s]; }
+    std::size_t seeded_from(std::size_t n) const { return seeded_from_[n]; }
+    bool seeds_others(std::size_t n) const { return seeds_others_[n] != 0; }
+
+private:
+    std::size_t P_, focal_;
+    std::vector<Perturbation> list_;
+    std::vector<std::array<std::size_t, 2>> side_, mixed_;
+    std::vector<std::size_t> seeded_from_;
+    std::vector<char> seeds_others_;
+};
+
+// An anchor of the Jacobian and the quarter lens it is measured as (Symmetry: its own lens where the
+// mirror symmetry does not hold).
+struct Mirrored {
+    std::size_t quarter;  // into the quarter lenses
+    bool mirror_x, mirror_y;
+};
+
+// The anchors' quarter lenses, each once, and for each anchor its quarter lens and mirrors.
+std::vector<MicroimageTruth> quarter_lenses(const PlenopticCamera& am, const Symmetry& symmetry,
+                                            const std::vector<MicroimageTruth>& anchors, std::vector<Mirrored>* mirrored)
+{
+    mirrored->assign(anchors.size(), Mirrored());
+    std::vector<MicroimageTruth> quarters;
+    std::unordered_map<std::uint64_t, std::size_t> where;
+    std::vector<LensIndex> of(anchors.size());
+    for (std::size_t i = 0; i < anchors.size(); ++i) {
+        Mirrored& mm = (*mirrored)[i];
+        mm.mirror_x = mm.mirror_y = false;
+        of[i] = symmetry.valid() ? Symmetry::quarter_lens(am.array, anchors[i].lens, &mm.mirror_x, &mm.mirror_y)
+                                 : anchors[i].lens;
+        if (where.emplace(anchor_key(of[i]), 0).second) {
+            MicroimageTruth t = MicroimageTruth();
+            t.lens = of[i];
+            quarters.push_back(t);
+        }
+    }
+    for (std::size_t n = 0; n < quarters.size(); ++n)
+        where[anchor_key(quarters[n].lens)] = n;
+    for (std::size_t i = 0; i < anchors.size(); ++i)
+        (*mirrored)[i].quarter = where.at(anchor_key(of[i]));
+    return quarters;
+}
+
+// Each quarter lens measured ideal from scratch (`ideal`), then with each perturbation
+// (`measured[n]`, in a camera with its perturbation_table), each region's radii sought near a
+// measurement of the same lens that differs from it by one small step: the ideal lens's, or for a
+// mixed perturbation (a parameter with the focal factor's step) the focal factor's step alone (a
+// step moves a boundary by a few hundredths of a pixel where it acts, and most not at all). The
+// answer is the grid step that holds the crossing, as from scratch (boundary_on_grid); only the
+// search is shorter (behind the 22 mm wide-angle about half the probes from scratch; the coarse
+// search about dark start points, a third of those, is as long). On every thread, a quarter lens at
+// a time; each result depends on the lens alone. False when cancelled.
+bool measure_perturbed(const Canonical& canonical, const Perturbations& perturbations,
+                       const std::vector<MicroimageTruth>& quarters, const MicroimageOptions& options,
+                       const MicroimageCancel& cancelled, std::vector<MicroimageTruth>* ideal,
+                       std::vector<std::vector<MicroimageTruth>>* measured)
 {
     const PlenopticCamera& am = canonical.model();
-    const std::vector<ErrorParameter> parameters = error_parameters(*light.array.errors, am.array.grid);
-    const std::size_t P = parameters.size();
-    std::vector<std::size_t> lenses;  // the interpolated lenses
-    for (std::size_t i = 0; i < out.size(); ++i)
-        if (interpolated[i])
-            lenses.push_back(i);
-    if (P == 0 || lenses.empty())
-        return true;
-
-    // The Jacobian anchors: error_anchor_step lenses apart (at least five a side, else every lens is
-    // measured).
-    Anchors jacobian;
-    jacobian.cover(options.error_anchor_step, range);
-    std::vector<MicroimageTruth> anchors;
-    if (jacobian.enough())
-        anchors = jacobian.read_by(lenses, at, [](std::uint64_t) { return false; });
-    if (anchors.empty()) {
-        pending.insert(pending.end(), lenses.begin(), lenses.end());
-        std::sort(pending.begin(), pending.end());
-        return true;
-    }
-    // Where the camera's mirror symmetry holds (Symmetry), only the anchors' quarter lenses are
-    // measured: a lens's microimage is its quarter lens's mirrored, with each parameter mirrored too
-    // (the axis's and the displacements' components along a mirror change sign, an adjacent lens is
-    // its mirror image's).
-    struct Mirrored {
-        std::size_t quarter;  // into `quarters`
-        bool mirror_x, mirror_y;
-    };
-    std::vector<Mirrored> mirrored(anchors.size());
-    std::vector<MicroimageTruth> quarters;
-    {
-        std::unordered_map<std::uint64_t, std::size_t> where;
-        std::vector<LensIndex> of(anchors.size());
-        for (std::size_t i = 0; i < anchors.size(); ++i) {
-            Mirrored& mm = mirrored[i];
-            mm.mirror_x = mm.mirror_y = false;
-            of[i] = symmetry.valid() ? Symmetry::quarter_lens(am.array, anchors[i].lens, &mm.mirror_x, &mm.mirror_y)
-                                     : anchors[i].lens;
-            if (where.emplace(anchor_key(of[i]), 0).second) {
-                MicroimageTruth t = MicroimageTruth();
-                t.lens = of[i];
-                quarters.push_back(t);
-            }
-        }
-        for (std::size_t n = 0; n < quarters.size(); ++n)
-            where[anchor_key(quarters[n].lens)] = n;
-        for (std::size_t i = 0; i < anchors.size(); ++i)
-            mirrored[i].quarter = where.at(anchor_key(of[i]));
-    }
-    // The perturbations measured, each in a camera with its perturbation_table.
-    std::vector<Perturbation> perturbations;
-    std::size_t focal = P;  // the focal factor's parameter (P: none)
-    for (std::size_t p = 0; p < P; ++p)
-        if (parameters[p].kind == 1)
-            focal = p;
-    // Where each parameter's measurements are among the perturbations: side[p][s] at +h (s = 0) and
-    // -h, mixed[p][s] at +h with the focal factor's +step (s = 0) and -step.
-    std::vector<std::array<std::size_t, 2>> side(P), mixed(P);
-    for (std::size_t p = 0; p < P; ++p)
-        for (int s = 0; s < 2; ++s) {
-            const double sign = s == 0 ? 1 : -1;
-            side[p][s] = perturbations.size();
-            perturbations.push_back(Perturbation{parameters[p].kind, sign * parameters[p].step, 0});
-            if (focal < P && p != focal) {
-                mixed[p][s] = perturbations.size();
-                perturbations.push_back(
-                    Perturbation{parameters[p].kind, parameters[p].step, sign * parameters[focal].step});
-            }
-        }
+    const std::size_t N = perturbations.size();
     const double type_focal = am.array.microlens->focal_length_mm(0);
-    std::vector<PlenopticCamera> perturbed_model(perturbations.size(), am), perturbed_light(perturbations.size(),
-                                                                                           canonical.light());
-    for (std::size_t n = 0; n < perturbations.size(); ++n) {
+    std::vector<PlenopticCamera> perturbed_model(N, am), perturbed_light(N, canonical.light());
+    for (std::size_t n = 0; n < N; ++n) {
         const std::shared_ptr<const LensErrors> table =
             perturbation_table(perturbations[n], quarters, am.array.grid, type_focal);
         perturbed_model[n].array.errors = table;
         perturbed_light[n].array.errors = table;
     }
-    // Each quarter lens measured ideal from scratch, then with each perturbation, each region's
-    // radii sought near a measurement of the same lens that differs from it by one small step: the
-    // ideal lens's, or for a mixed perturbation (a parameter with the focal factor's step) the focal
-    // factor's step alone (a step moves a boundary by a few hundredths of a pixel where it acts, and
-    // most not at all). The answer is the grid step that holds the crossing, as from scratch
-    // (boundary_on_grid); only the search is shorter (behind the 22 mm wide-angle about half the
-    // probes from scratch; the coarse search about dark start points, a third of those, is as long).
-    // On every thread, a quarter lens at a time; each result depends on the lens alone.
-    const std::size_t N = perturbations.size();
-    std::vector<std::size_t> seeded_from(N, N);  // N: the ideal lens
-    std::vector<char> seeds_others(N, 0);
-    for (std::size_t p = 0; p < P && focal < P; ++p)
-        for (int s = 0; s < 2 && p != focal; ++s) {
-            seeded_from[mixed[p][s]] = side[focal][s];
-            seeds_others[side[focal][s]] = 1;
-        }
     const LensMeasurer ideal_measurer(am, canonical.light(), options);
     std::vector<LensMeasurer> measurers;
     measurers.reserve(N);
     for (std::size_t n = 0; n < N; ++n)
         measurers.emplace_back(perturbed_model[n], perturbed_light[n], options);
-    std::vector<MicroimageTruth> ideal = quarters;
-    std::vector<std::vector<MicroimageTruth>> measured(N, quarters);
-    {
-        typedef std::vector<std::vector<std::vector<double>>> History;
-        // A measurement's radii as a seed: each region's newest radii alone (a history of one lens
-        // predicts that lens's radii, not a trend).
-        auto newest = [](const History& history) {
-            History seed(history.size());
-            for (std::size_t point = 0; point < history.size(); ++point)
-                if (!history[point].empty())
-                    seed[point].push_back(history[point][0]);
-            return seed;
-        };
-        std::atomic<std::size_t> next(0);
-        std::atomic<bool> stop(false);
-        run_on_threads(thread_count(options.threads, quarters.size()), [&](int t) {
-            const bool polls = t == 0;
-            std::vector<CellNode> own_nodes;
-            std::vector<History> seeds(N + 1);
-            for (std::size_t i = next++; i < quarters.size() && !stop; i = next++) {
-                LensMeasurer::Radii radii = ideal_measurer.fresh();
-                ideal_measurer.measure(ideal[i], &radii, &own_nodes, nullptr);
-                seeds[N] = newest(radii.history);
-                // The seeds of others first.
-                for (int pass = 0; pass < 2; ++pass)
-                    for (std::size_t n = 0; n < N && !stop; ++n) {
-                        if ((seeded_from[n] == N) != (pass == 0))
-                            continue;
-                        if (polls && cancelled && cancelled()) {
-                            stop = true;
-                            break;
-                        }
-                        radii.history = seeds[seeded_from[n]];
-                        measurers[n].measure(measured[n][i], &radii, &own_nodes, nullptr);
-                        if (seeds_others[n])
-                            seeds[n] = newest(radii.history);
+    *ideal = quarters;
+    measured->assign(N, quarters);
+    typedef std::vector<std::vector<std::vector<double>>> History;
+    // A measurement's radii as a seed: each region's newest radii alone (a history of one lens
+    // predicts that lens's radii, not a trend).
+    auto newest = [](const History& history) {
+        History seed(history.size());
+        for (std::size_t point = 0; point < history.size(); ++point)
+            if (!history[point].empty())
+                seed[point].push_back(history[point][0]);
+        return seed;
+    };
+    std::atomic<std::size_t> next(0);
+    std::atomic<bool> stop(false);
+    run_on_threads(thread_count(options.threads, quarters.size()), [&](int t) {
+        const bool polls = t == 0;
+        std::vector<CellNode> own_nodes;
+        std::vector<History> seeds(N + 1);
+        for (std::size_t i = next++; i < quarters.size() && !stop; i = next++) {
+            LensMeasurer::Radii radii = ideal_measurer.fresh();
+            ideal_measurer.measure((*ideal)[i], &radii, &own_nodes, nullptr);
+            seeds[N] = newest(radii.history);
+            // The seeds of others first.
+            for (int pass = 0; pass < 2; ++pass)
+                for (std::size_t n = 0; n < N && !stop; ++n) {
+                    if ((perturbations.seeded_from(n) == N) != (pass == 0))
+                        continue;
+                    if (polls && cancelled && cancelled()) {
+                        stop = true;
+                        break;
                     }
-            }
-        });
-        if (stop)
-            return false;
-    }
-    // Per quarter lens, for each parameter and each of du, dv and the lit fraction: J, H, and K (the
-    // mixed difference with the focal factor: a lens's light near its cell's edge, where its
-    // neighbours act, moves with its own focal length, some 9 % of the neighbours' effect a per cent
-    // of focal length behind the 22 mm wide-angle).
-    std::vector<char> valid(quarters.size(), 1);
+                    radii.history = seeds[perturbations.seeded_from(n)];
+                    measurers[n].measure((*measured)[n][i], &radii, &own_nodes, nullptr);
+                    if (perturbations.seeds_others(n))
+                        seeds[n] = newest(radii.history);
+                }
+        }
+    });
+    return !stop;
+}
+
+// Per quarter lens, for each parameter and each of du, dv and the lit fraction: J, H, and K (the
+// mixed difference with the focal factor: a lens's light near its cell's edge, where its neighbours
+// act, moves with its own focal length, some 9 % of the neighbours' effect a per cent of focal
+// length behind the 22 mm wide-angle), 9 values a parameter. `valid[i]` is cleared where a
+// measurement found no light.
+std::vector<std::vector<double>> quarter_differences(const PlenopticCamera& am,
+                                                     const std::vector<ErrorParameter>& parameters,
+                                                     const Perturbations& perturbations,
+                                                     const std::vector<MicroimageTruth>& quarters,
+                                                     const std::vector<MicroimageTruth>& ideal,
+                                                     const std::vector<std::vector<MicroimageTruth>>& measured,
+                                                     std::vector<char>* valid)
+{
+    const std::size_t P = parameters.size(), focal = perturbations.focal();
+    valid->assign(quarters.size(), 1);
     std::vector<std::vector<double>> jh(quarters.size(), std::vector<double>(9 * P, 0.0));
     auto value = [&](const MicroimageTruth& t, const MicroimageCentre& c, int q) {
         return q == 0 ? t.u_px - c.u : q == 1 ? t.v_px - c.v : t.lit_fraction;
@@ -365,19 +377,19 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
     const std::vector<MicroimageTruth>* focal_side[2] = {nullptr, nullptr};
     if (focal < P)
         for (int s = 0; s < 2; ++s)
-            focal_side[s] = &measured[side[focal][s]];
+            focal_side[s] = &measured[perturbations.side(focal, s)];
     for (std::size_t p = 0; p < P; ++p) {
         const double h = parameters[p].step;
-        const std::vector<MicroimageTruth>* up = &measured[side[p][0]];
-        const std::vector<MicroimageTruth>* down = &measured[side[p][1]];
-        const bool mixes = focal < P && p != focal;
+        const std::vector<MicroimageTruth>* up = &measured[perturbations.side(p, 0)];
+        const std::vector<MicroimageTruth>* down = &measured[perturbations.side(p, 1)];
+        const bool mixes = perturbations.mixes(p);
         for (std::size_t i = 0; i < quarters.size(); ++i) {
             const MicroimageCentre c = microimage_centre_px(am, quarters[i].lens);
             bool lit = c.valid && (*up)[i].lit && ideal[i].lit && (*down)[i].lit;
             for (int s = 0; s < 2 && mixes; ++s)
-                lit = lit && measured[mixed[p][s]][i].lit && (*focal_side[s])[i].lit;
+                lit = lit && measured[perturbations.mixed(p, s)][i].lit && (*focal_side[s])[i].lit;
             if (!lit) {
-                valid[i] = 0;
+                (*valid)[i] = 0;
                 continue;
             }
             for (int q = 0; q < 3; ++q) {
@@ -385,14 +397,24 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
                 jh[i][9 * p + q] = (u - d) / (2 * h);
                 jh[i][9 * p + 3 + q] = (u - 2 * mid + d) / (h * h);
                 if (mixes)
-                    jh[i][9 * p + 6 + q] =
-                        (value(measured[mixed[p][0]][i], c, q) - value(measured[mixed[p][1]][i], c, q) -
-                         value((*focal_side[0])[i], c, q) + value((*focal_side[1])[i], c, q)) /
-                        (2 * parameters[focal].step * h);
+                    jh[i][9 * p + 6 + q] = (value(measured[perturbations.mixed(p, 0)][i], c, q) -
+                                            value(measured[perturbations.mixed(p, 1)][i], c, q) -
+                                            value((*focal_side[0])[i], c, q) + value((*focal_side[1])[i], c, q)) /
+                                           (2 * parameters[focal].step * h);
             }
         }
     }
-    // Each anchor's from its quarter lens's.
+    return jh;
+}
+
+// Each anchor's differences, from its quarter lens's (mirror_differences), by anchor_key; anchors
+// whose quarter lens is not valid are left out.
+std::unordered_map<std::uint64_t, std::vector<double>>
+anchor_differences(const PlenopticCamera& am, const Symmetry& symmetry, const std::vector<ErrorParameter>& parameters,
+                   const std::vector<MicroimageTruth>& anchors, const std::vector<Mirrored>& mirrored,
+                   const std::vector<MicroimageTruth>& quarters, const std::vector<char>& valid,
+                   const std::vector<std::vector<double>>& jh)
+{
     std::unordered_map<std::uint64_t, std::vector<double>> differences;
     for (std::size_t i = 0; i < anchors.size(); ++i) {
         const Mirrored& mm = mirrored[i];
@@ -408,10 +430,19 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
                                mm.mirror_y, from, &to))
             differences[anchor_key(anchors[i].lens)].swap(to);
     }
-    counts.error_anchors = quarters.size();
+    return differences;
+}
 
-    // Each lens corrected, on every thread (each result depends on the lens alone).
-    std::vector<char> measure(out.size(), 0);
+// Each lens of `lenses` (indices into `out`) corrected by the cubic through the 4 x 4 Jacobian
+// anchors nearest it, for its own parameters' values, where their fourth differences vouch for it;
+// `measure[index]` is set for the others. On every thread (each result depends on the lens alone).
+void apply_corrections(const PlenopticCamera& light, const Canonical& canonical, const MicroimageOptions& options,
+                       const std::vector<ErrorParameter>& parameters, std::size_t focal, const Anchors& jacobian,
+                       const std::unordered_map<std::uint64_t, std::vector<double>>& differences,
+                       const std::vector<std::size_t>& lenses, const std::vector<Vec2>& at,
+                       std::vector<MicroimageTruth>& out, std::vector<char>* measure)
+{
+    const std::size_t P = parameters.size();
     std::atomic<std::size_t> next(0);
     const std::size_t kChunk = 256;
     run_on_threads(thread_count(options.threads, (lenses.size() + kChunk - 1) / kChunk), [&](int) {
@@ -432,7 +463,7 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
                         block[j - j0 + 1][i - i0 + 1] = &found->second;
                 });
                 if (missing) {
-                    measure[index] = 1;
+                    (*measure)[index] = 1;
                     continue;
                 }
                 double xs[kMaxErrorParameters];
@@ -455,7 +486,7 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
                     vouched = error <= allowed[q];
                 }
                 if (!vouched) {
-                    measure[index] = 1;
+                    (*measure)[index] = 1;
                     continue;
                 }
                 const Vec2 d =
@@ -465,6 +496,58 @@ bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical
                 truth.lit_fraction += result[2];
             }
     });
+}
+
+} // namespace
+
+bool correct_for_errors(const PlenopticCamera& light, const Canonical& canonical, const Symmetry& symmetry,
+                        const MicroimageOptions& options,
+                        const std::vector<Vec2>& at, const std::vector<char>& interpolated, const double range[4],
+                        const MicroimageCancel& cancelled, std::vector<MicroimageTruth>& out,
+                        std::vector<std::size_t>& pending, MicroimageWork& counts)
+{
+    const PlenopticCamera& am = canonical.model();
+    const std::vector<ErrorParameter> parameters = error_parameters(*light.array.errors, am.array.grid);
+    std::vector<std::size_t> lenses;  // the interpolated lenses
+    for (std::size_t i = 0; i < out.size(); ++i)
+        if (interpolated[i])
+            lenses.push_back(i);
+    if (parameters.empty() || lenses.empty())
+        return true;
+
+    // The Jacobian anchors: error_anchor_step lenses apart (at least five a side, else every lens is
+    // measured).
+    Anchors jacobian;
+    jacobian.cover(options.error_anchor_step, range);
+    std::vector<MicroimageTruth> anchors;
+    if (jacobian.enough())
+        anchors = jacobian.read_by(lenses, at, [](std::uint64_t) { return false; });
+    if (anchors.empty()) {
+        pending.insert(pending.end(), lenses.begin(), lenses.end());
+        std::sort(pending.begin(), pending.end());
+        return true;
+    }
+    // Where the camera's mirror symmetry holds (Symmetry), only the anchors' quarter lenses are
+    // measured: a lens's microimage is its quarter lens's mirrored, with each parameter mirrored too
+    // (the axis's and the displacements' components along a mirror change sign, an adjacent lens is
+    // its mirror image's).
+    std::vector<Mirrored> mirrored;
+    const std::vector<MicroimageTruth> quarters = quarter_lenses(am, symmetry, anchors, &mirrored);
+    const Perturbations perturbations(parameters);
+    std::vector<MicroimageTruth> ideal;
+    std::vector<std::vector<MicroimageTruth>> measured;
+    if (!measure_perturbed(canonical, perturbations, quarters, options, cancelled, &ideal, &measured))
+        return false;
+    std::vector<char> valid;
+    const std::vector<std::vector<double>> jh =
+        quarter_differences(am, parameters, perturbations, quarters, ideal, measured, &valid);
+    const std::unordered_map<std::uint64_t, std::vector<double>> differences =
+        anchor_differences(am, symmetry, parameters, anchors, mirrored, quarters, valid, jh);
+    counts.error_anchors = quarters.size();
+
+    std::vector<char> measure(out.size(), 0);
+    apply_corrections(light, canonical, options, parameters, perturbations.focal(), jacobian, differences, lenses, at,
+                      out, &measure);
     std::size_t corrected = 0;
     for (std::size_t index : lenses) {
         if (measure[index])
