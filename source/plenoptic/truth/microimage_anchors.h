@@ -77,14 +77,7 @@ struct Anchors {
 
     // Anchors `s` lenses apart over lenses whose positions run from range[0] to range[1] (X) and
     // range[2] to range[3] (Y): one more below and two more above, so that every stencil fits.
-    void cover(std::int64_t s, const double range[4])
-    {
-        step = s;
-        k0 = std::int64_t(std::floor(range[0] / double(s))) - 1;
-        k1 = std::int64_t(std::floor(range[1] / double(s))) + 2;
-        l0 = std::int64_t(std::floor(range[2] / double(s))) - 1;
-        l1 = std::int64_t(std::floor(range[3] / double(s))) + 2;
-    }
+    void cover(std::int64_t s, const double range[4]);
     // At least five anchors a side (the fourth differences need them).
     bool enough() const { return k1 - k0 >= 4 && l1 - l0 >= 4; }
     // The anchors that the lenses `lenses` (indices into `at`, their positions) read, once each and
@@ -179,78 +172,26 @@ bool interpolates(const PlenopticCamera& m, const PlenopticCamera& light, const 
 // accuracy, not the same bits (BENCHMARKS "The microimage truth by symmetry").
 class Canonical {
 public:
-    Canonical(const PlenopticCamera& m, const PlenopticCamera& light, const MicroimageOptions& options)
-        : m_(m), light_(light)
-    {
-        const ArrayPose& pose = m.array.pose;
-        const bool about_axis = pose.normal.x == 0 && pose.normal.y == 0 && pose.normal.z == 1 && !pose.tilted;
-        auto equal = [](Vec3 a, Vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; };
-        const bool same = equal(light.array.pose.centre_mm, pose.centre_mm) &&
-                          equal(light.array.pose.normal, pose.normal) &&
-                          equal(mul(light.array.pose.rotation, Vec3{1, 0, 0}), mul(pose.rotation, Vec3{1, 0, 0}));
-        if (!options.symmetry || !about_axis || !same || Symmetry(m, light, options).valid())
-            return;
-        const double none[3] = {0, 0, 0};
-        const ArrayPose canonical = make_array_pose(none, Vec3{0, 0, pose.centre_mm.z});
-        model_ = m;
-        model_.array.pose = canonical;
-        light_model_ = light;
-        light_model_.array.pose = canonical;
-        if (!Symmetry(model_, light_model_, options).valid())
-            return;
-        const Vec3 x = mul(pose.rotation, Vec3{1, 0, 0});
-        turn_[0] = x.x;
-        turn_[1] = x.y;
-        active_ = true;
-    }
+    Canonical(const PlenopticCamera& m, const PlenopticCamera& light, const MicroimageOptions& options);
     bool active() const { return active_; }
     // The cameras the anchors are measured in.
     const PlenopticCamera& model() const { return active_ ? model_ : m_; }
     const PlenopticCamera& light() const { return active_ ? light_model_ : light_; }
     // Where the lens lies among those anchors, in lattice units (X, Y above); `shift` (array-local,
     // mm) moves it off its lattice point (a displaced lens: the ideal lens that sits where it sits).
-    Vec2 position(LensIndex lens, Vec2 shift = Vec2{0, 0}) const
-    {
-        if (!active_ && shift.x == 0 && shift.y == 0)
-            return Vec2{lattice_x(m_.array.grid, lens), double(lens.l)};
-        const Vec2 c = canonical_local(lens, shift);
-        return Vec2{c.x / m_.array.pitch_mm, c.y / m_.array.row_spacing_mm()};
-    }
+    Vec2 position(LensIndex lens, Vec2 shift = Vec2{0, 0}) const;
     // The lens's lattice centre (moved by `shift`) projected onto the sensor from the exit pupil's
     // centre (pixels, centre convention) in the anchors' camera: what the interpolated offset is
     // added to.
-    bool centre_px(LensIndex lens, Vec2* px, Vec2 shift = Vec2{0, 0}) const
-    {
-        if (!active_ && shift.x == 0 && shift.y == 0) {
-            const MicroimageCentre c = microimage_centre_px(m_, lens);
-            *px = Vec2{c.u, c.v};
-            return c.valid;
-        }
-        const Vec2 c = canonical_local(lens, shift);
-        return project_to_sensor_px(model(), model().array.to_optics(Vec3{c.x, c.y, 0}), px);
-    }
+    bool centre_px(LensIndex lens, Vec2* px, Vec2 shift = Vec2{0, 0}) const;
     // A sensor point of the anchors' camera (pixels, centre convention) in this camera: turned
     // about the axis with the array.
-    Vec2 to_camera_px(Vec2 px) const
-    {
-        if (!active_)
-            return px;
-        const Vec3 p = m_.sensor.point(px.x + 0.5, px.y + 0.5);
-        const PixelPoint out = m_.sensor.to_pixel(turn_[0] * p.x - turn_[1] * p.y, turn_[1] * p.x + turn_[0] * p.y);
-        return Vec2{out.u, out.v};
-    }
+    Vec2 to_camera_px(Vec2 px) const;
 
 private:
     // The lens's lattice point in the canonical array's frame: its place in the optics frame turned
     // back about the axis.
-    Vec2 canonical_local(LensIndex lens, Vec2 shift) const
-    {
-        const Vec2 c = m_.array.lattice_centre_local(lens);
-        if (!active_)
-            return Vec2{c.x + shift.x, c.y + shift.y};
-        const Vec3 q = m_.array.to_optics(Vec3{c.x + shift.x, c.y + shift.y, 0});
-        return Vec2{turn_[0] * q.x + turn_[1] * q.y, -turn_[1] * q.x + turn_[0] * q.y};
-    }
+    Vec2 canonical_local(LensIndex lens, Vec2 shift) const;
 
     const PlenopticCamera& m_;
     const PlenopticCamera& light_;
