@@ -92,7 +92,7 @@ long peak_rss_kib()
 
 int main(int argc, char** argv)
 {
-    int W = 0, H = 0, threads = thread_count(0, std::size_t(-1));
+    int W = 0, H = 0, threads = thread_count(0);
     double radii[3] = {0, 0, 0};
     bool direct = false, compare = false;
     for (int a = 1; a < argc; ++a) {

@@ -351,7 +351,7 @@ int main(int argc, char** argv)
         }
         if (o.brute_points > 0) {
             const double b0 = cpu_seconds();
-            const int threads = thread_count(o.threads, std::size_t(-1));
+            const int threads = thread_count(o.threads);
             for (std::size_t i = 0; i < which.size(); ++i) {
                 const MicroimageTruth& a = truth[which[i]];
                 const MicroimageTruth& b = each[i];

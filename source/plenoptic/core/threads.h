@@ -13,8 +13,9 @@
 namespace plenoptic {
 
 // How many threads a request for `requested` means: `requested` when positive, else the machine's
-// hardware threads (at least 1); never more than `items` (at least 1), the work items to share.
-int thread_count(int requested, std::size_t items);
+// hardware threads (at least 1); never more than `items` (at least 1), the work items to share
+// (no limit when not given).
+int thread_count(int requested, std::size_t items = std::size_t(-1));
 
 // Runs work(t) for t = 0 .. count - 1 at once, t = 0 on the calling thread (the one that may poll
 // for cancellation and report progress), the others on threads of their own; returns when all have

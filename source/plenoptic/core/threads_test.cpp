@@ -62,6 +62,8 @@ TEST(Threads, CountFollowsRequestAndItems)
     const int machine = int(std::max(1u, std::thread::hardware_concurrency()));
     EXPECT_EQ(thread_count(0, 1000000), machine);
     EXPECT_EQ(thread_count(-1, 1000000), machine);
+    EXPECT_EQ(thread_count(0), machine);
+    EXPECT_EQ(thread_count(7), 7);
 }
 
 } // namespace
