@@ -112,6 +112,39 @@ inline bool read_refracting_option(int argc, char** argv, int* a, RefractingOpti
     return true;
 }
 
+// --errors S F R SEED: the array's manufacturing errors (microlens_array { errors { position S
+// focal_length F rotation R seed SEED } }).
+struct ErrorsOption {
+    bool given = false;
+    double position_sd_mm = 0, focal_sd = 0, rotation_deg = 0;
+    long long seed = 0;
+};
+
+// As read_camera_option, for --errors.
+inline bool read_errors_option(int argc, char** argv, int* a, ErrorsOption* o)
+{
+    if (!(std::string(argv[*a]) == "--errors" && argc - *a - 1 >= 4))
+        return false;
+    o->given = true;
+    o->position_sd_mm = std::atof(argv[++*a]);
+    o->focal_sd = std::atof(argv[++*a]);
+    o->rotation_deg = std::atof(argv[++*a]);
+    o->seed = std::atoll(argv[++*a]);
+    return true;
+}
+
+// The array of *p (an array given) with those errors, when given.
+inline void use_errors(const ErrorsOption& e, CameraParams* p)
+{
+    if (!e.given)
+        return;
+    p->array.has_errors = true;
+    p->array.errors.position_sd_mm = e.position_sd_mm;
+    p->array.errors.focal_sd = e.focal_sd;
+    p->array.errors.rotation_deg = e.rotation_deg;
+    p->array.errors.seed = e.seed;
+}
+
 inline CameraParams camera_params(const LensFileCamera& camera, const Prescription& lens)
 {
     const CameraOptions& c = camera.options;

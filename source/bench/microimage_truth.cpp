@@ -75,7 +75,7 @@ struct Options {
     double offset_mm[2] = {0, 0};
     double turn_deg = 0, shift_mm[2] = {0, 0};
     int threads = 0;
-    bool errors = false;
+    bench::ErrorsOption errors;
     bool reference = false;
     bool every_lens = false;
     bool no_symmetry = false;
@@ -85,8 +85,6 @@ struct Options {
     double brute_step_px = 0;
     bool brute_jittered = false;
     bench::RefractingOption refracting;
-    double error_values[3] = {0, 0, 0};
-    long long seed = 0;
     std::string csv;
 };
 
@@ -96,7 +94,8 @@ bool parse(int argc, char** argv, Options* o)
         const std::string arg = argv[a];
         const int left = argc - a - 1;
         if (bench::read_camera_option(argc, argv, &a, &o->camera) ||
-            bench::read_refracting_option(argc, argv, &a, &o->refracting))
+            bench::read_refracting_option(argc, argv, &a, &o->refracting) ||
+            bench::read_errors_option(argc, argv, &a, &o->errors))
             continue;
         if (arg == "--array" && left >= 3) {
             o->pitch_mm = std::atof(argv[++a]);
@@ -112,12 +111,7 @@ bool parse(int argc, char** argv, Options* o)
             o->shift_mm[1] = std::atof(argv[++a]);
         } else if (arg == "--threads" && left >= 1)
             o->threads = std::atoi(argv[++a]);
-        else if (arg == "--errors" && left >= 4) {
-            o->errors = true;
-            for (double& value : o->error_values)
-                value = std::atof(argv[++a]);
-            o->seed = std::atoll(argv[++a]);
-        } else if (arg == "--reference")
+        else if (arg == "--reference")
             o->reference = true;
         else if (arg == "--every-lens")
             o->every_lens = true;
@@ -254,13 +248,7 @@ int main(int argc, char** argv)
     p.array.rotate_deg[2] = o.turn_deg;
     p.array.translate_mm[0] = o.shift_mm[0];
     p.array.translate_mm[1] = o.shift_mm[1];
-    if (o.errors) {
-        p.array.has_errors = true;
-        p.array.errors.position_sd_mm = o.error_values[0];
-        p.array.errors.focal_sd = o.error_values[1];
-        p.array.errors.rotation_deg = o.error_values[2];
-        p.array.errors.seed = o.seed;
-    }
+    bench::use_errors(o.errors, &p);
     const std::string error = check_camera(p);
     if (!error.empty()) {
         std::fprintf(stderr, "plenoptic_microimage_truth: %s\n", error.c_str());

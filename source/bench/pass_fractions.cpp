@@ -12,6 +12,7 @@
 //   plenoptic_pass_fractions --lens-file FILE --f-number N --focus-distance Z
 //       --sensor W H PIXEL_MM [--array-matched PITCH_MM | --array PITCH_MM F_MM D_MM] [--thick]
 //       [--samples S] [--patch P] [--unaimed] [--lit-patch L] [--refracting R CAP SUBSTRATE IOR]
+//       [--errors S F R SEED]
 //
 // --array-matched puts a hexagonal plenoptic 1.0 array at the focused image: thin microlenses of
 // focal length f = PITCH * the lens's working f-number (exit pupil to array over its diameter),
@@ -28,6 +29,7 @@
 // --refracting makes the array's lenses plano-convex caps (microlens_array { lens { surface { radius R }
 // thickness CAP ior IOR substrate SUBSTRATE } }, curved side to the scene; with --array, whose F_MM is
 // then unused), which do not aim: their samples are spread uniformly over the pixel and the cell.
+// --errors gives the array manufacturing errors (errors { position S focal_length F rotation R seed SEED }).
 // light_field_radius_mm is where the pupil bounds find that no light passes any more (-1 for the
 // thick lens, which has no such bounds; the bounds with an array are for points of its plane).
 
@@ -62,6 +64,7 @@ struct Options {
     bool unaimed = false;
     int lit_patch = 0;
     bench::RefractingOption refracting;
+    bench::ErrorsOption errors;
 };
 
 void usage()
@@ -69,7 +72,8 @@ void usage()
     std::fprintf(stderr,
                  "usage: plenoptic_pass_fractions --lens-file FILE --f-number N --focus-distance Z\n"
                  "         --sensor W H PIXEL_MM [--array-matched PITCH_MM | --array PITCH_MM F_MM D_MM] [--thick]\n"
-                 "         [--samples S] [--patch P] [--unaimed] [--lit-patch L] [--refracting R CAP SUBSTRATE IOR]\n");
+                 "         [--samples S] [--patch P] [--unaimed] [--lit-patch L] [--refracting R CAP SUBSTRATE IOR]\n"
+                 "         [--errors S F R SEED]\n");
 }
 
 bool parse(int argc, char** argv, Options* o)
@@ -78,7 +82,8 @@ bool parse(int argc, char** argv, Options* o)
         const std::string arg = argv[a];
         const int left = argc - a - 1;
         if (bench::read_camera_option(argc, argv, &a, &o->camera) ||
-            bench::read_refracting_option(argc, argv, &a, &o->refracting))
+            bench::read_refracting_option(argc, argv, &a, &o->refracting) ||
+            bench::read_errors_option(argc, argv, &a, &o->errors))
             continue;
         if (arg == "--array-matched" && left >= 1)
             o->array_pitch_mm = std::atof(argv[++a]);
@@ -115,8 +120,10 @@ CameraParams camera(const Options& o, const Prescription& lens, double array_foc
     c.distance_mm = array_distance_mm;
     c.samples = o.samples;
     CameraParams p = bench::camera_params(c, lens);
-    if (array_focal_mm > 0)
+    if (array_focal_mm > 0) {
         bench::use_refracting(o.refracting, &p);
+        bench::use_errors(o.errors, &p);
+    }
     return p;
 }
 
