@@ -27,28 +27,93 @@ namespace {
 const double kRoundingMargin = 1e-12;
 const double kSqrt3 = 1.7320508075688772935;
 
+// An ellipse of a plane (coordinates h): its points centre + z.x g0 + z.y g1, |z| <= 1; its
+// semi-axes.
+struct PlaneEllipse {
+    Vec2 centre, g0, g1;
+    double major, minor;
+};
+
+// The points h of a plane where |u(h)| <= rho alpha(h), u(h) = u0 + h.x ux + h.y uy a vector normal to
+// N (unit) and alpha(h) = alpha0 + alpha.h > 0: where the line from an apex through the point meets
+// a disc (centre M, radius rho, normal N), u and alpha being the affine parts of that condition
+// times N.(the line's direction). In coordinates y of the plane normal to N (u = u0 + Y h), alpha is
+// affine in y, delta0 + delta.y, so |y| <= rho (delta0 + delta.y): an ellipse with a focus at y = 0,
+// semi-latus rectum l = rho delta0, eccentricity e = rho |delta|, semi-axes l / (1 - e^2) and
+// l / sqrt(1 - e^2), its centre l e / (1 - e^2) from the focus along delta. False when that is not
+// a bounded ellipse (e >= 0.5 is refused: no such geometry here) or not finite.
+bool focus_ellipse(Vec3 u0, Vec3 ux, Vec3 uy, Vec3 N, double alpha0, Vec2 alpha, double rho, PlaneEllipse* out)
+{
+    const Vec3 e1 = normalized(Vec3{1, 0, 0} - N.x * N);
+    const Vec3 e2 = cross(N, e1);
+    const Vec2 y0{dot(e1, u0), dot(e2, u0)};
+    const double Y00 = dot(e1, ux), Y01 = dot(e1, uy), Y10 = dot(e2, ux), Y11 = dot(e2, uy);
+    const double det = Y00 * Y11 - Y01 * Y10;
+    if (!(std::fabs(det) > 0) || !std::isfinite(det))
+        return false;
+    const auto Yinv = [&](Vec2 v) { return Vec2{(Y11 * v.x - Y01 * v.y) / det, (-Y10 * v.x + Y00 * v.y) / det}; };
+    // alpha0 + alpha.h with h = Y^-1 (y - y0): delta = Y^-T alpha, delta0 = alpha0 - alpha.Y^-1 y0.
+    const Vec2 delta{(Y11 * alpha.x - Y10 * alpha.y) / det, (-Y01 * alpha.x + Y00 * alpha.y) / det};
+    const double delta0 = alpha0 - dot(alpha, Yinv(y0));
+    const double l = rho * delta0;
+    const Vec2 b = rho * delta;
+    const double e = length(b);
+    if (!(l > 0) || !(e < 0.5))
+        return false;
+    const double A = l / (1 - e * e), B = l / std::sqrt(1 - e * e);
+    const Vec2 along = e > 0 ? (1 / e) * b : Vec2{1, 0};
+    const Vec2 across{-along.y, along.x};
+    out->centre = Yinv(A * b - y0);
+    out->g0 = Yinv(A * along);
+    out->g1 = Yinv(B * across);
+    // The semi-axes in h: G's singular values.
+    const double Gdet = out->g0.x * out->g1.y - out->g1.x * out->g0.y;
+    const double p = dot(out->g0, out->g0), q = dot(out->g0, out->g1), r = dot(out->g1, out->g1);
+    const double root = std::sqrt(std::max(0.0, 0.25 * (p - r) * (p - r) + q * q));
+    out->major = std::sqrt(0.5 * (p + r) + root);
+    out->minor = std::fabs(Gdet) / out->major;
+    return out->minor > 0 && std::isfinite(out->major) && is_finite(out->centre);
+}
+
 } // namespace
 
 bool camera_can_aim(const PlenopticCamera& m)
 {
-    // Lenses tilted by their errors and the unbent light of a clear gap (fill_factor) leave the
-    // thin lens's affine map; a mask would only block more, but is kept with the gap for simplicity.
+    // The unbent light of a clear gap (fill_factor) leaves the thin lens's affine map; a mask would
+    // only block more, but is kept with the gap for simplicity. A tilted array's cells are not
+    // parallel to the sensor (a lens tilted by its errors is aimed in its own frame: lens_aim).
     return m.lens && m.lens->forms_image() && m.array.grid != GridType::None && m.array.microlens &&
-           m.array.microlens->aims() && !m.array.pose.tilted && !(m.array.errors && m.array.errors->tilts()) &&
-           !(m.array.fill_factor < 1) && m.sampling.samples_max > 1;
+           m.array.microlens->aims() && !m.array.pose.tilted && !(m.array.fill_factor < 1) &&
+           m.sampling.samples_max > 1;
 }
 
 bool lens_aim(const PlenopticCamera& m, LensIndex lens, LensAim* out)
 {
-    const Vec3 centre = m.array.centre_mm(lens);
+    const LensFrame frame = m.array.frame(lens);
+    const Vec3 centre = m.array.to_optics(frame.centre);
     const double circumradius = m.array.cell_circumradius_mm;
+    // A tilted lens's cell leaves the plane through its centre parallel to the array by up to this.
+    const double sin_tilt = frame.tilted ? std::hypot(frame.axes.m[0][2], frame.axes.m[1][2]) : 0;
+    const double tilt_rise = circumradius * sin_tilt;
     PupilDisc disc;
     if (m.pupil_bounds) {
-        // The bounds are for points of one plane: a lens off it (displaced along the axis) is not aimed at.
-        if (!(std::fabs(centre.z - m.pupil_bounds->plane_z()) <= 1e-9 * (1 + std::fabs(centre.z))))
-            return false;
+        // The bounds are for points q of their plane. A ray from a cell point off it, in the air
+        // behind the lens, passes exactly when the ray along the same line from where that line
+        // crosses the plane does (PupilBounds::may_pass); every passing ray crosses the exit
+        // pupil's plane within reach_mm of the axis, so its slope is at most (the point's distance
+        // from the axis + reach) / (its distance to that plane), and the crossing lies within
+        // (how far the point is off the plane) times that of the point.
+        double radius = circumradius;
+        const double off = std::fabs(centre.z - m.pupil_bounds->plane_z()) + tilt_rise;
+        if (off > 1e-12 * (1 + std::fabs(centre.z))) {
+            const double run = m.lens->exit_pupil_centre().z - centre.z - tilt_rise;
+            const double slope = (std::hypot(centre.x, centre.y) + circumradius + m.pupil_bounds->reach_mm()) / run;
+            if (!(run > 0) || !std::isfinite(slope))
+                return false;
+            radius += off * slope * (1 + 1e-9) + 1e-12 * (1 + std::fabs(centre.z));
+        }
         PupilDisc discs[PupilBounds::kMaxDiscs];
-        const int count = m.pupil_bounds->discs_holding(centre, circumradius, discs);
+        const int count = m.pupil_bounds->discs_holding(centre, radius, discs);
         disc = discs[0];
         out->cuts = count - 1;
         for (int k = 0; k < out->cuts; ++k) {
@@ -63,25 +128,80 @@ bool lens_aim(const PlenopticCamera& m, LensIndex lens, LensAim* out)
     } else {
         // An ideal lens blocks exactly outside its exit pupil (the thin lens's aperture in its plane).
         disc = PupilDisc{m.lens->exit_pupil_centre(), m.lens->exit_pupil_radius()};
-    }
-    if (!m.pupil_bounds)
         out->cuts = 0;
+    }
     const Vec3 c = m.array.to_local(centre);
     const Vec3 d = m.array.to_local(disc.centre);
     out->lens = lens;
     out->c = Vec2{c.x, c.y};
     out->z = c.z;
-    out->f = m.array.focal_length_mm(lens);
+    out->f = frame.focal_mm;
     out->grid = m.array.grid;
     out->pitch = m.array.pitch_mm;
     out->circumradius = circumradius;
     out->Z = d.z - c.z;
     out->m = Vec2{d.x, d.y};
     out->rho = disc.radius;
-    return out->Z > 0 && std::isfinite(out->Z) && out->f != 0 && std::isfinite(out->f) && out->rho >= 0 &&
-           std::isfinite(out->rho) && is_finite(out->m) && is_finite(out->c);
+    out->tilted = frame.tilted;
+    out->axes = frame.axes;
+    out->sin_tilt = sin_tilt;
+    if (!(out->Z > 0 && std::isfinite(out->Z) && out->f != 0 && std::isfinite(out->f) && out->rho >= 0 &&
+          std::isfinite(out->rho) && is_finite(out->m) && is_finite(out->c)))
+        return false;
+    if (!frame.tilted)
+        return true;
+    // In the lens's frame the discs of the array's plane Z in front are tilted by t. A ray from
+    // cell point P meets disc k at Q and the lens frame's plane z = Z' through the main disc's
+    // centre at Q Z'/Q_z + P (1 - Z'/Q_z): within the disc's shadow from the lens's centre on that
+    // plane (the cone from the centre over the disc, cut by the plane: an ellipse, focus_ellipse
+    // with u = X (N.M) - M (N.X), alpha = N.X for X = (x, y, Z')), widened by the parallax
+    // |P| |1 - Z'/Q_z| <= circumradius (|M_z - Z'| + rho sin t) / (Z' - that). Each flattened disc
+    // is the disc about the shadow's centre of radius its semi-major axis and that parallax.
+    const Vec3 c3{c.x, c.y, c.z};
+    const Vec3 N{frame.axes.m[2][0], frame.axes.m[2][1], frame.axes.m[2][2]};
+    out->disc_normal = N;
+    out->disc_centre[0] = mul_transposed(frame.axes, Vec3{out->m.x, out->m.y, d.z} - c3);
+    out->disc_radius[0] = out->rho;
+    for (int k = 0; k < out->cuts; ++k) {
+        out->disc_centre[k + 1] = mul_transposed(frame.axes, Vec3{out->cut_m[k].x, out->cut_m[k].y, d.z} - c3);
+        out->disc_radius[k + 1] = out->cut_rho[k];
+    }
+    const double plane = out->disc_centre[0].z;
+    for (int k = 0; k <= out->cuts; ++k) {
+        const Vec3 M = out->disc_centre[k];
+        const double rho = out->disc_radius[k];
+        const double NM = dot(N, M);
+        const Vec3 u0 = Vec3{0, 0, plane * NM} - (N.z * plane) * M;
+        const Vec3 ux = Vec3{NM, 0, 0} - N.x * M, uy = Vec3{0, NM, 0} - N.y * M;
+        PlaneEllipse shadow;
+        if (!focus_ellipse(u0, ux, uy, N, N.z * plane, Vec2{N.x, N.y}, rho, &shadow))
+            return false;
+        const double rise = std::fabs(M.z - plane) + rho * sin_tilt;
+        const double parallax = circumradius * rise / (plane - rise);
+        if (!(plane - rise > 0))
+            return false;
+        const Vec2 centre{c.x + shadow.centre.x, c.y + shadow.centre.y};
+        const double radius = (shadow.major + parallax) * (1 + 1e-10) +
+                              1e-12 * (std::fabs(centre.x) + std::fabs(centre.y) + plane + rho);
+        if (k == 0) {
+            out->m = centre;
+            out->rho = radius;
+        } else {
+            out->cut_m[k - 1] = centre;
+            out->cut_rho[k - 1] = radius;
+        }
+    }
+    out->Z = plane;
+    return out->Z > 0 && std::isfinite(out->Z) && std::isfinite(out->rho) && is_finite(out->m);
 }
 
+Vec3 lens_frame_point(const LensAim& a, Vec3 q)
+{
+    if (!a.tilted)
+        return q;
+    const Vec3 c3{a.c.x, a.c.y, a.z};
+    return c3 + mul_transposed(a.axes, q - c3);
+}
 
 // ---- Rounded polygons -------------------------------------------------------------------------
 
@@ -254,6 +374,58 @@ RoundedPolygon lit_sensor_region(const LensAim& a, double d, int cut)
     return out;
 }
 
+namespace {
+
+// How far, at most, the boundary of a lens's region for disc k (lit_sensor_region) moves per unit
+// of the sensor's distance about d, over a change of up to `change`: the region is
+// C(d) + S(d) H + rho(d) B (B the unit disc), C = c + (c - m) d/Z, S = |1 + d (1/Z - 1/f)|,
+// rho(d) = rho d/Z, so its support function along a unit n is C.n + S h_H(n) + rho(d), h_H(n)
+// between the cell's inradius and `extent` (the circumradius; the inradius alone for the
+// inscribed disc); its rate |C'| + |S' h_H + rho'| at most, both ends tried (S' keeps its sign
+// while 1 + d (1/Z - 1/f) does; else the sum of the rates' sizes).
+double region_drift(const LensAim& a, int cut, double d, double change, double extent)
+{
+    const Vec2 m = cut < 0 ? a.m : a.cut_m[cut];
+    const double rho = cut < 0 ? a.rho : a.cut_rho[cut];
+    const double centre = std::hypot(a.c.x - m.x, a.c.y - m.y) / a.Z, radius = rho / a.Z;
+    const double slope = 1 / a.Z - 1 / a.f, at = 1 + d * slope;
+    const double inradius = 0.5 * a.pitch;
+    if (!(std::fabs(at) > std::fabs(change * slope) * (1 + 1e-9)))
+        return centre + std::fabs(slope) * extent + radius;
+    const double scale = at > 0 ? slope : -slope;
+    return centre + std::max(std::fabs(scale * inradius + radius), std::fabs(scale * extent + radius));
+}
+
+} // namespace
+
+RoundedPolygon sensor_region(const LensAim& a, Vec3 s, double reach, int cut)
+{
+    if (!a.tilted)
+        return lit_sensor_region(a, a.z - s.z, cut);
+    // The plane's points within reach of s lie, in the lens's frame, within reach of its (x, y) and
+    // within reach sin t of its distance (the lens's axis is t off the array's normal).
+    const Vec3 t = lens_frame_point(a, s);
+    const double change = reach * a.sin_tilt;
+    RoundedPolygon r = lit_sensor_region(a, a.z - t.z, cut);
+    r.radius += change * region_drift(a, cut, a.z - t.z, change, a.circumradius) * (1 + 1e-9);
+    // Back to the plane: a point q of it has lens-frame (x, y) = c + B (q - c) + b (q.z - z) (B, b:
+    // the first two rows of axes^T), so q = c + B^-1 (p - c - b (q.z - z)); B's smaller singular
+    // value is |cos t| (axes^T is a rotation), so a radius grows by at most 1 / |cos t|.
+    const Mat3& A = a.axes;
+    const double b00 = A.m[0][0], b01 = A.m[1][0], b10 = A.m[0][1], b11 = A.m[1][1];
+    const double det = b00 * b11 - b01 * b10;
+    const double rise = s.z - a.z;
+    const Vec2 shift{A.m[2][0] * rise, A.m[2][1] * rise};
+    double scale = 0;
+    for (int n = 0; n < r.corners; ++n) {
+        const double x = r.corner[n].x - a.c.x - shift.x, y = r.corner[n].y - a.c.y - shift.y;
+        r.corner[n] = Vec2{a.c.x + (b11 * x - b01 * y) / det, a.c.y + (-b10 * x + b00 * y) / det};
+        scale += std::fabs(r.corner[n].x) + std::fabs(r.corner[n].y);
+    }
+    r.radius = r.radius / std::fabs(A.m[2][2]) * (1 + 1e-12) + 1e-12 * scale;
+    return r;
+}
+
 int own_sensor_cell(const PlenopticCamera& m, LensIndex lens, double sensor_z, HalfPlane out[8])
 {
     // own_lens projects the sensor point s from the exit pupil's centre e onto the array's plane
@@ -417,16 +589,81 @@ bool polygon_discs_x_range(const Vec2* corner, int n, const AimDisc* discs, int 
     return true;
 }
 
-// The lens's finite discs of cell points for sensor point s (the disc and its cuts'); how many.
-int cell_discs(const LensAim& a, Vec3 s, AimDisc discs[1 + LensAim::kMaxCuts])
+// The cell disc of a tilted lens for disc k of the main lens's plane (lit_cell_disc's comment in
+// the header); infinite radius when it cannot be bounded so (then every cell point may pass).
+AimDisc tilted_cell_disc(const LensAim& a, Vec3 s_array, int k)
 {
+    const AimDisc all{Vec2{0, 0}, std::numeric_limits<double>::infinity()};
+    // In the lens's frame, from its centre: the sensor point at distance d behind its plane; every
+    // ray from it leaves cell point P = (h, 0) along X - w P, (X, w) the homogeneous image
+    // (-f s_xy, f d, d - f) (w = 0: parallel rays).
+    const Vec3 c3{a.c.x, a.c.y, a.z};
+    const Vec3 sp = mul_transposed(a.axes, s_array - c3);
+    const double d = -sp.z, f = a.f;
+    if (!(d > 0) || !(f > 0))
+        return all;
+    const Vec3 X{-f * sp.x, -f * sp.y, f * d};
+    const double w = d - f;
+    const Vec3 N = a.disc_normal, M = a.disc_centre[k];
+    const double rho = a.disc_radius[k];
+    const double NX = dot(N, X), NM = dot(N, M);
+    // The ray meets the disc's plane at Q = P + mu (X - w P), mu = N.(M - P) / N.(X - w P); both
+    // must be positive over the cell (affine in h: at its corners).
+    Vec2 corner[6];
+    const int n = cell_polygon(a.grid, a.pitch, corner);
+    for (int q = 0; q < n; ++q)
+        if (!(NX - w * (N.x * corner[q].x + N.y * corner[q].y) > 0 && NM - (N.x * corner[q].x + N.y * corner[q].y) > 0))
+            return all;
+    // Times alpha = N.(X - w P) > 0, |Q - M| <= rho reads |u(h)| <= rho alpha(h) with
+    // u = (P - M) alpha + N.(M - P) (X - w P), affine in h (the quadratic terms cancel):
+    // u0 = (N.M) X - (N.X) M, and u's change along h.x, (N.X - w N.M) x + N.x (w M - X).
+    const Vec3 u0 = NM * X - NX * M;
+    const Vec3 wm = w * M - X;
+    const double q0 = NX - w * NM;
+    PlaneEllipse ellipse;
+    if (!focus_ellipse(u0, Vec3{q0, 0, 0} + N.x * wm, Vec3{0, q0, 0} + N.y * wm, N, NX, Vec2{-w * N.x, -w * N.y}, rho,
+                       &ellipse))
+        return all;
+    const Vec2 C = ellipse.centre, g0 = ellipse.g0, g1 = ellipse.g1;
+    const double Gdet = g0.x * g1.y - g1.x * g0.y;
+    const double major = ellipse.major;
+    const double radius = major * major / ellipse.minor;
+    // The boundary point toward the cell's centre (z on the unit circle with G z along -C) and
+    // the inward normal there (G^-T z).
+    Vec2 z{(g1.y * -C.x - g1.x * -C.y) / Gdet, (-g0.y * -C.x + g0.x * -C.y) / Gdet};
+    const double zl = length(z);
+    z = zl > 0 ? (1 / zl) * z : Vec2{1, 0};
+    const Vec2 point = C + z.x * g0 + z.y * g1;
+    Vec2 normal{(g1.y * z.x - g0.y * z.y) / Gdet, (-g1.x * z.x + g0.x * z.y) / Gdet};
+    normal = (1 / length(normal)) * normal;
+    const Vec2 centre = point - radius * normal;
+    if (!(is_finite(centre) && std::isfinite(radius)))
+        return all;
+    // Rounding: each step is ~1e-16 of the ellipse's size; 1e-10 of it holds it many times over.
+    return AimDisc{centre, radius * (1 + 1e-10) + 1e-10 * (length(C) + major)};
+}
+
+// The lens's finite discs of cell points for sensor point s (array-local; the disc and its cuts');
+// how many.
+int cell_discs(const LensAim& a, Vec3 s_array, AimDisc discs[1 + LensAim::kMaxCuts])
+{
+    if (a.tilted) {
+        int count = 0;
+        for (int k = 0; k <= a.cuts; ++k) {
+            const AimDisc d = tilted_cell_disc(a, s_array, k);
+            if (d.radius < std::numeric_limits<double>::infinity())
+                discs[count++] = d;
+        }
+        return count;
+    }
+    const Vec3 s = s_array;
     if (a.cuts == 0) {
         discs[0] = cell_disc(a, s, a.m, a.rho);
         return discs[0].radius < std::numeric_limits<double>::infinity() ? 1 : 0;
     }
     int count = 0;
     for (int k = -1; k < a.cuts; ++k) {
-        const AimDisc d = k < 0 ? lit_cell_disc(a, s) : lit_cell_cut(a, s, k);
+        const AimDisc d = k < 0 ? cell_disc(a, s, a.m, a.rho) : cell_disc(a, s, a.cut_m[k], a.cut_rho[k]);
         if (d.radius < std::numeric_limits<double>::infinity())
             discs[count++] = d;
     }
@@ -519,12 +756,12 @@ bool cell_x_range(const LensAim& a, const AimDisc* discs, int count, double* x0,
 
 AimDisc lit_cell_disc(const LensAim& a, Vec3 s)
 {
-    return cell_disc(a, s, a.m, a.rho);
+    return a.tilted ? tilted_cell_disc(a, s, 0) : cell_disc(a, s, a.m, a.rho);
 }
 
 AimDisc lit_cell_cut(const LensAim& a, Vec3 s, int k)
 {
-    return cell_disc(a, s, a.cut_m[k], a.cut_rho[k]);
+    return a.tilted ? tilted_cell_disc(a, s, k + 1) : cell_disc(a, s, a.cut_m[k], a.cut_rho[k]);
 }
 
 bool lit_cell_x_range(const LensAim& a, Vec3 s, double* x0, double* x1)
@@ -900,18 +1137,19 @@ struct PixelPlan {
     double px, py;
 };
 
-// A lens's part for the pixel: its region and its cuts', and when the lens is taken as the sensor
-// points' own lens, its projected cell; false when one is not finite.
-bool lens_part(const PlenopticCamera& m, const LensAim& a, double sensor_z, const PixelFrame& frame, bool own,
+// A lens's part for the pixel (centre s, array-local; its points within reach of it): its region
+// and its cuts', and when the lens is taken as the sensor points' own lens, its projected cell;
+// false when one is not finite.
+bool lens_part(const PlenopticCamera& m, const LensAim& a, Vec3 s, double reach, const PixelFrame& frame, bool own,
                LensPart* part)
 {
-    const double d = a.z - sensor_z;
+    const double d = a.z - lens_frame_point(a, s).z;
     if (!(d > 0))
         return false;
     part->sets = 0;
     for (int k = -1; k < a.cuts; ++k)
-        part->set[part->sets++] = lit_sensor_region(a, d, k);
-    part->planes = own ? own_sensor_cell(m, a.lens, sensor_z, part->plane) : 0;
+        part->set[part->sets++] = sensor_region(a, s, reach, k);
+    part->planes = own ? own_sensor_cell(m, a.lens, s.z, part->plane) : 0;
     // Into the pixel's frame; its rounding is ~1e-16 of the frame's offsets.
     const double slack = 1e-13 * (std::fabs(frame.o[0]) + std::fabs(frame.o[1]));
     for (int k = 0; k < part->planes; ++k) {
@@ -959,8 +1197,11 @@ bool holds_pixel(const LensPart& part, double px, double py)
 // cell's circumradius scaled by |g| d/Z plus rho d/Z) lies, with a margin, farther than `reach`
 // from the pixel's centre s (array-local): then part_x_range would drop the lens's part (its
 // region widened by reach leaves out the centre), so the part need not be made. False when unsure.
-bool region_far(const LensAim& a, Vec3 s, double reach)
+bool region_far(const LensAim& a, Vec3 s_array, double reach)
 {
+    // A tilted lens: in its frame, where the pixel's points lie within reach of s's (x, y) and
+    // reach sin t of its distance, over which the region moves (region_drift).
+    const Vec3 s = lens_frame_point(a, s_array);
     const double d = a.z - s.z;
     if (!(d > 0))
         return false;
@@ -969,7 +1210,9 @@ bool region_far(const LensAim& a, Vec3 s, double reach)
     // The margin far exceeds the regions' widening for rounding (1e-12 of their terms).
     const double margin = 1e-9 * (std::fabs(a.c.x) + std::fabs(a.c.y) + std::fabs(a.m.x) + std::fabs(a.m.y) +
                                   std::fabs(s.x) + std::fabs(s.y) + d + (k + 1 + d / std::fabs(a.f)) * a.circumradius);
-    const double outer = (a.circumradius * std::fabs(g) * k + a.rho * k) * (1 + 1e-9) + reach + margin;
+    const double drift =
+        a.tilted ? reach * a.sin_tilt * region_drift(a, -1, d, reach * a.sin_tilt, a.circumradius) : 0;
+    const double outer = (a.circumradius * std::fabs(g) * k + a.rho * k + drift) * (1 + 1e-9) + reach + margin;
     const double dx = s.x - (a.c.x + (a.c.x - a.m.x) * k), dy = s.y - (a.c.y + (a.c.y - a.m.y) * k);
     return dx * dx + dy * dy > outer * outer && std::isfinite(outer);
 }
@@ -981,8 +1224,10 @@ bool region_far(const LensAim& a, Vec3 s, double reach)
 // within the inscribed disc of the lens's own cell (about its displaced centre, radius p/2 less the
 // largest displacement: the neighbours' centres are at least p less twice that away). Shrunk by
 // 1e-9, far beyond the rounding; when it fails, lens_part and holds_pixel decide.
-bool inner_holds_pixel(const PlenopticCamera& m, const LensAim& a, Vec3 s, const Vec2* q, double px, double py)
+bool inner_holds_pixel(const PlenopticCamera& m, const LensAim& a, Vec3 s_array, const Vec2* q, double px, double py)
 {
+    // A tilted lens: as region_far.
+    const Vec3 s = lens_frame_point(a, s_array);
     const double d = a.z - s.z;
     if (!(d > 0))
         return false;
@@ -993,7 +1238,9 @@ bool inner_holds_pixel(const PlenopticCamera& m, const LensAim& a, Vec3 s, const
     for (int cut = -1; cut < a.cuts; ++cut) {
         const Vec2 mm = cut < 0 ? a.m : a.cut_m[cut];
         const double rho = cut < 0 ? a.rho : a.cut_rho[cut];
-        const double room = (inradius + rho * k) * (1 - 1e-9) - reach;
+        const double drift =
+            a.tilted ? reach * a.sin_tilt * region_drift(a, cut, d, reach * a.sin_tilt, 0.5 * a.pitch) : 0;
+        const double room = (inradius + rho * k - drift) * (1 - 1e-9) - reach;
         if (!(room > 0))
             return false;
         const double dx = s.x - (a.c.x + (a.c.x - mm.x) * k), dy = s.y - (a.c.y + (a.c.y - mm.y) * k);
@@ -1041,7 +1288,8 @@ void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced,
         return;  // most pixels: no part to make
     const PixelFrame frame = pixel_frame(m, s.z, i, j);
     LensPart own_part;
-    if (!lens_part(m, a, s.z, frame, !forced, &own_part))
+    const double reach = 0.5 * std::sqrt(px * px + py * py);
+    if (!lens_part(m, a, s, reach, frame, !forced, &own_part))
         return;
     if (holds_pixel(own_part, px, py))
         return;
@@ -1053,32 +1301,46 @@ void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced,
         plan->parts[count++] = own_part;
     } else {
         // Through the exit pupil's centre e the pixel projects onto the array scaled by
-        // (array - e) / (sensor - e); a point within delta of the centre's projection belongs to
-        // the centre's lens or a neighbour while delta < 0.25 pitch (the next ring is at least
-        // 1.15 pitch from any point of the cell, the cell's corners at most 0.71 pitch), less
-        // 1.5 times the farthest a lens is displaced from its lattice place (its errors).
+        // (array - e) / (sensor - e), into the disc of radius delta about its centre's projection
+        // q. A lens whose cell (about its displaced centre) holds a point x of that disc is nearer
+        // x than the centre's own lens is, so its displaced centre lies within
+        // |q - the own lens's| + 2 delta of q, and its lattice place within that plus the largest
+        // displacement. While that stays below 1.15 pitch (the nearest lattice lens's second ring
+        // is farther from any point of its cell), those lenses are that lattice lens and its
+        // neighbours; the ones nearer than that are kept.
         const Vec3 e = m.lens->exit_pupil_centre();
         const double scale = (m.array.pose.centre_mm.z - e.z) / (m.sensor.z_mm - e.z);
         const double delta = 0.5 * std::hypot(px, py) * std::fabs(scale);
         const double shift = m.array.errors ? m.array.errors->max_shift_mm() : 0;
-        if (!(delta + 1.5 * shift < 0.25 * m.array.pitch_mm))
+        const Vec2 own_centre = m.array.centre_local(lens);
+        const double margin = 1e-9 * (std::fabs(q.x) + std::fabs(q.y) + m.array.pitch_mm);
+        const double near = std::hypot(q.x - own_centre.x, q.y - own_centre.y) + 2 * delta + margin;
+        if (!(near + shift < 1.15 * m.array.pitch_mm))
             return;
-        const double reach = 0.5 * std::sqrt(px * px + py * py);
         const GridType grid = m.array.grid;
-        const std::int64_t skew = skew_k(grid, lens);
+        const LensIndex middle_lens = nearest_lens(grid, m.array.pitch_mm, q.x, q.y);
+        const std::int64_t skew = skew_k(grid, middle_lens);
         for (int dl = -1; dl <= 1; ++dl)
             for (int dk = -1; dk <= 1; ++dk) {
                 if (grid == GridType::Hexagonal && std::abs(dk + dl) > 1)
                     continue;  // not a neighbour in skew indices
-                const LensIndex other = from_skew(grid, skew + dk, lens.l + dl);
-                if (dk == 0 && dl == 0) {
+                const LensIndex other = from_skew(grid, skew + dk, middle_lens.l + dl);
+                if (other == lens) {
                     plan->parts[count] = own_part;
                 } else {
+                    const Vec2 place = m.array.lattice_centre_local(other);
+                    if (std::hypot(q.x - place.x, q.y - place.y) > near + shift)
+                        continue;
+                    if (shift > 0) {
+                        const Vec2 c = m.array.centre_local(other);
+                        if (std::hypot(q.x - c.x, q.y - c.y) > near)
+                            continue;
+                    }
                     if (!lens_aim(m, other, &a))
                         return;
                     if (region_far(a, s, reach))
                         continue;  // part_x_range would drop it
-                    if (!lens_part(m, a, s.z, frame, true, &plan->parts[count]))
+                    if (!lens_part(m, a, s, reach, frame, true, &plan->parts[count]))
                         return;
                 }
                 ++count;
@@ -1228,7 +1490,7 @@ ArrayRay aimed_cell_ray(const PlenopticCamera& m, const Vec3& p, LensIndex lens,
         return array.microlens->sample_ray(array, p, lens, u, v);
     const LensAim& a = cache.aim[found];
     const Vec3 s = array.to_local(p);
-    if (!(a.z - s.z > 0))
+    if (!(a.z - lens_frame_point(a, s).z > 0))
         return array.microlens->sample_ray(array, p, lens, u, v);
     AimDisc discs[1 + LensAim::kMaxCuts];
     const int count = cell_discs(a, s, discs);

@@ -26,6 +26,11 @@
 //    cell's projection onto the sensor (own_sensor_cell; with errors, the displaced centres' cell).
 // Each region is sampled by its chords: x uniform over the region's exact x range, then y uniform
 // over the chord at x; the weight is the x range times the chord over the whole's area.
+// A lens tilted by its errors is a thin lens in its own frame (turned about its centre), so all of
+// the above holds there (lens_aim): the main lens's discs, tilted by t in that frame, are replaced
+// by discs of its plane Z holding where the passing rays cross it (rho widened by rho sin t times
+// the steepest passing ray's slope); the sensor's plane is tilted there too, so a pixel's region is
+// taken at its centre's distance and widened by how far it moves over the pixel (sensor_region).
 
 #ifndef PLENOPTIC_AIM_H
 #define PLENOPTIC_AIM_H
@@ -65,15 +70,37 @@ struct LensAim {
     int cuts;
     Vec2 cut_m[kMaxCuts];
     double cut_rho[kMaxCuts];
+    // A lens tilted by its errors: everything above but c and z is in its own frame (the
+    // array-local one turned about its centre to its axis: a point q is c3 + axes^T (q - c3) there,
+    // c3 = (c, z)), and the cell is the lattice's cell in that frame (Microlens::cell_ray's
+    // offsets). m, Z, rho and the cuts are discs of the lens frame's plane Z in front that hold the
+    // main lens's discs, which are tilted there (lens_aim). sin_tilt: the sine of the tilt.
+    bool tilted = false;
+    Mat3 axes = identity_mat3();
+    double sin_tilt = 0;
+    // For a tilted lens's cell points (tilted_cell_discs), the main lens's discs as they are: their
+    // centres in the lens's frame (from its centre; the main disc first, then the cuts'), their
+    // radii, and their plane's normal there.
+    Vec3 disc_centre[1 + kMaxCuts];
+    double disc_radius[1 + kMaxCuts];
+    Vec3 disc_normal;
 };
 
+// A point (array-local) in the lens's own frame (itself for an untilted lens).
+Vec3 lens_frame_point(const LensAim& aim, Vec3 q);
+
 // Whether the camera aims its samples (PlenopticCamera::sampling.aim): behind an image-forming main
-// lens, with an array parallel to the sensor whose microlenses aim (Microlens::aims), and more than
-// one sample per pixel (one sample is the chief ray). make_camera sets it; the camera can clear it.
+// lens, with an array parallel to the sensor whose microlenses aim (Microlens::aims; lenses tilted
+// by their errors too), no clear gap, and more than one sample per pixel (one sample is the chief
+// ray). make_camera sets it; the camera can clear it.
 bool camera_can_aim(const PlenopticCamera& model);
 
 // The lens's aim data; false when the lens cannot be aimed at (then sample it uniformly): a traced
-// lens without pupil bounds, a lens off the bounds' plane, a limiting plane not in front of it.
+// main lens without pupil bounds, a limiting plane not in front of it. Behind a traced lens the
+// bounds are for points of one plane: a lens off it (displaced along the axis, or tilted, whose
+// cell leaves the plane) has its cell's rays' lines cross that plane within (how far off) times
+// (the steepest passing ray's slope, from PupilBounds::reach_mm) of their points, so its discs
+// hold those of a cell widened by that much.
 bool lens_aim(const PlenopticCamera& model, LensIndex lens, LensAim* out);
 
 // A convex region of a plane: the points within `radius` of a convex polygon (`corners` corners in
@@ -90,10 +117,18 @@ void region_x_extent(const RoundedPolygon& r, double* x0, double* x1);
 // The region's chord at x, [*y0, *y1]; false when x lies outside its x range.
 bool region_chord(const RoundedPolygon& r, double x, double* y0, double* y1);
 
-// The region of sensor points (array-local x, y; the sensor d behind the lens plane, d > 0) from
-// which a ray through the lens's cell can pass the main lens's disc (k = -1) or cutting disc k (0
-// to cuts - 1): the cell polygon scaled by |g| d / Z about c + (c - m) d / Z, widened by rho d / Z.
+// The region of sensor points (x, y of the lens's frame; the sensor d behind the lens plane, d > 0)
+// from which a ray through the lens's cell can pass the main lens's disc (k = -1) or cutting disc
+// k (0 to cuts - 1): the cell polygon scaled by |g| d / Z about c + (c - m) d / Z, widened by
+// rho d / Z.
 RoundedPolygon lit_sensor_region(const LensAim& aim, double d, int k = -1);
+
+// The same in the array's frame for the points of the plane through s parallel to the array
+// within `reach` of s (array-local): lit_sensor_region at s's distance for an untilted lens (reach
+// unused); for a tilted one, where that plane is tilted in the lens's frame, widened by how far
+// the region moves over the reach's range of distances and mapped back to that plane (the map's
+// inverse widens a radius by at most 1 / cos(tilt)).
+RoundedPolygon sensor_region(const LensAim& aim, Vec3 s, double reach, int k = -1);
 
 // A half-plane {p : dot(normal, p) <= offset}.
 struct HalfPlane {
@@ -111,7 +146,13 @@ int own_sensor_cell(const PlenopticCamera& model, LensIndex lens, double sensor_
 
 // The disc of cell points (array-local, from the lens's centre) holding every point through which
 // the ray from sensor point s (array-local, behind the lens) can pass the main lens; infinite
-// radius when every point can (g = 0).
+// radius when every point can (g = 0). For a tilted lens (cell points in its own frame), the cell
+// points whose rays meet a disc of the main lens's plane form an ellipse: every ray from s leaves
+// the thin lens through s's image I, so they are the points of the lens's plane that the cone from
+// I over the disc cuts, a tilted section. Its disc is the disc of radius the ellipse's largest
+// radius of curvature tangent to it inside where the line from its centre to the cell's centre
+// meets it, which holds the whole ellipse (Blaschke's rolling theorem) and leaves near the cell
+// only what the curvatures' difference leaves (nanometres for micrometre cells).
 AimDisc lit_cell_disc(const LensAim& aim, Vec3 s);
 // The same for cutting disc k (0 to cuts - 1) of the lens's plane instead of its disc.
 AimDisc lit_cell_cut(const LensAim& aim, Vec3 s, int k);

@@ -49,14 +49,15 @@ CameraParams triplet_camera(bool thick, double d, GridType grid)
     return with_pixels(p, 0.02);
 }
 
-// A camera whose lenses are displaced in the plane and along the axis and whose focal lengths
-// scatter (the array's errors).
-CameraParams with_errors(CameraParams p, double position_mm, double position_z_mm, double focal)
+// A camera whose lenses are displaced in the plane and along the axis, whose focal lengths
+// scatter and whose axes tilt by up to rotation_deg (the array's errors).
+CameraParams with_errors(CameraParams p, double position_mm, double position_z_mm, double focal, double rotation_deg = 0)
 {
     p.array.has_errors = true;
     p.array.errors.position_sd_mm = position_mm;
     p.array.errors.position_sd_z_mm = position_z_mm;
     p.array.errors.focal_sd = focal;
+    p.array.errors.rotation_deg = rotation_deg;
     p.array.errors.seed = 7;
     return p;
 }
@@ -86,6 +87,14 @@ std::vector<AimCase> setups()
          with_errors(with_pixels(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52), 0.05), 0.01, 0.02, 0.03)},
         {"traced triplet, plenoptic 2.0, lenses displaced in the plane and their focal lengths scattered",
          with_errors(triplet_camera(false, 1.1, GridType::Hexagonal), 0.01, 0, 0.03)},
+        {"thin lens, plenoptic 1.0, lenses tilted by up to 3 degrees",
+         with_errors(with_pixels(plenoptic_camera(GridType::Hexagonal, 0.5, 2, 2, 50, 4, 52), 0.05), 0, 0, 0, 3)},
+        {"thin lens, plenoptic 2.0, square, lenses displaced, tilted and their focal lengths scattered",
+         with_errors(with_pixels(plenoptic_camera(GridType::Rectangular, 0.5, 2, 2.6, 50, 4, 52), 0.05), 0.01, 0.02, 0.03, 3)},
+        {"traced triplet, plenoptic 1.0, lenses tilted by up to 3 degrees and displaced along the axis",
+         with_errors(triplet_camera(false, 1.5, GridType::Hexagonal), 0, 0.01, 0, 3)},
+        {"traced triplet, plenoptic 2.0, lenses displaced, tilted and their focal lengths scattered",
+         with_errors(triplet_camera(false, 1.1, GridType::Hexagonal), 0.01, 0.01, 0.03, 2)},
     };
 }
 
@@ -143,9 +152,10 @@ bool in_region(const RoundedPolygon& r, Vec2 p) { return distance_to_polygon(r, 
 
 // Every (sensor point, cell point) pair through which the renderer's unaimed ray passes, for the
 // sensor points of a grid over the picture and the cell points of a grid over the cell, through
-// the point's own lens and its neighbours: the sensor point lies in the lens's lit_sensor_region
-// (and behind the traced lens in both cuts'), and in its own_sensor_cell when the lens is its own
-// (own_lens, the renderer's choice);
+// the point's own lens and its neighbours: the sensor point lies in the lens's sensor_region
+// (and behind the traced lens in its cuts'), also in the one made for the points within a reach of
+// a point beside it, and in its own_sensor_cell when the lens is its own (own_lens, the renderer's
+// choice);
 // the cell point lies in lit_cell_disc of the sensor point (and both cuts'), its x in
 // lit_cell_x_range.
 TEST(Aim, RegionsHoldEveryPassingRay)
@@ -155,7 +165,7 @@ TEST(Aim, RegionsHoldEveryPassingRay)
         const PlenopticCamera m = with_film(make_camera(setup.params), W, H);
         ASSERT_TRUE(m.sampling.aim) << setup.name;
         long passing = 0, sensor_out = 0, own_out = 0, own_checked = 0, cell_out = 0, range_out = 0,
-             aimed_lenses = 0, cut_lenses = 0;
+             aimed_lenses = 0, cut_lenses = 0, tilted_lenses = 0;
         const int cells = 20;
         for (int b = 0; b <= 30; ++b) {
             for (int a = 0; a <= 40; ++a) {
@@ -172,16 +182,22 @@ TEST(Aim, RegionsHoldEveryPassingRay)
                     if (!lens_aim(m, lens, &aim))
                         continue;
                     ++aimed_lenses;
+                    tilted_lenses += aim.tilted ? 1 : 0;
                     const Vec3 s = m.array.to_local(p);
                     const Vec2 s2{s.x, s.y};
-                    RoundedPolygon sensor[3];
-                    for (int k = -1; k < aim.cuts; ++k)
-                        sensor[k + 1] = lit_sensor_region(aim, aim.z - s.z, k);
+                    // A pixel's centre beside s, whose region holds the points within its reach.
+                    const Vec2 beside{0.3 * m.sensor.pixel_size_mm[0], -0.4 * m.sensor.pixel_size_mm[1]};
+                    const Vec3 s_beside{s.x + beside.x, s.y + beside.y, s.z};
+                    RoundedPolygon sensor[2 * (1 + LensAim::kMaxCuts)];
+                    for (int k = -1; k < aim.cuts; ++k) {
+                        sensor[k + 1] = sensor_region(aim, s, 0, k);
+                        sensor[aim.cuts + 1 + k + 1] = sensor_region(aim, s_beside, length(beside) * (1 + 1e-9), k);
+                    }
                     HalfPlane own_cell[8];
                     const int own_planes = own_sensor_cell(m, lens, s.z, own_cell);
                     EXPECT_EQ(own_planes, m.array.grid == GridType::Hexagonal ? 6 : 8) << setup.name;
                     const AimDisc cell = lit_cell_disc(aim, s);
-                    AimDisc cell_cuts[2];
+                    AimDisc cell_cuts[LensAim::kMaxCuts];
                     for (int k = 0; k < aim.cuts; ++k)
                         cell_cuts[k] = lit_cell_cut(aim, s, k);
                     double x0 = 0, x1 = 0;
@@ -194,7 +210,7 @@ TEST(Aim, RegionsHoldEveryPassingRay)
                             if (!ray.passed)
                                 continue;
                             ++passing;
-                            for (int k = 0; k <= aim.cuts; ++k)
+                            for (int k = 0; k < 2 * (aim.cuts + 1); ++k)
                                 if (!in_region(sensor[k], s2))
                                     ++sensor_out;
                             if (lens == own.lens) {
@@ -227,6 +243,11 @@ TEST(Aim, RegionsHoldEveryPassingRay)
         EXPECT_EQ(range_out, 0) << setup.name;
         EXPECT_EQ(own_out, 0) << setup.name;
         EXPECT_GT(own_checked, 5000) << setup.name;
+        // Lenses tilted by their errors are aimed too (in their own frames).
+        if (setup.params.array.errors.rotation_deg > 0)
+            EXPECT_GT(tilted_lenses, 1000) << setup.name;
+        else
+            EXPECT_EQ(tilted_lenses, 0) << setup.name;
         // Behind the traced triplet most lenses are off the axis: cut as well.
         if (setup.params.main.type == MainLensType::Prescription)
             EXPECT_GT(cut_lenses, 500) << setup.name;
@@ -423,7 +444,12 @@ TEST(Aim, AimedSamplesGiveThePixelTheSameLight)
 
 // Behind the ideal main lenses (thin, thick) the regions are exact: every aimed sample of a pixel
 // that light reaches passes. The pixels across microimages' rims (some but not all of 256 uniform
-// samples pass) over a patch of each camera (lenses displaced too); 256 aimed samples each.
+// samples pass) over a patch of each camera (lenses displaced too); 256 aimed samples each. Lenses
+// tilted by their errors are aimed in their own frames, where the main lens's discs are tilted: a
+// pixel's region is rounded by a disc about the disc's elliptic shadow (sensor_region, lens_aim),
+// which overhangs it by its semi-axes' difference, so some samples of the pixels that light only
+// grazes are lost: here 3.0 % with tilts of up to 3 degrees behind 50 um pixels (10.8 % with the
+// first, cruder discs), 0.03 % in the plenoptic 2.0 camera; at most 5 % is allowed.
 TEST(Aim, EveryAimedSampleOfARimPixelPassesBehindIdealLenses)
 {
     for (const AimCase& setup : setups()) {
@@ -432,6 +458,7 @@ TEST(Aim, EveryAimedSampleOfARimPixelPassesBehindIdealLenses)
         const int W = 160, H = 120;
         const PlenopticCamera m = with_film(make_camera(setup.params), W, H);
         ASSERT_TRUE(m.sampling.aim) << setup.name;
+        const bool tilted = setup.params.array.errors.rotation_deg > 0;
         int rim = 0;
         long blocked = 0, aimed = 0;
         for (int j = 40; j < 80; ++j) {
@@ -446,14 +473,19 @@ TEST(Aim, EveryAimedSampleOfARimPixelPassesBehindIdealLenses)
                 int pixel_blocked = 0;
                 for (int n = 0; n < n_samples; ++n)
                     pixel_blocked += !generate_ray(m, i, j, make_sample(i, j, n, n_samples)).passed;
-                EXPECT_EQ(pixel_blocked, 0) << setup.name << " pixel " << i << ", " << j << " (" << uniform_passed
-                                            << " of " << n_samples << " uniform samples pass)";
+                if (!tilted) {
+                    EXPECT_EQ(pixel_blocked, 0) << setup.name << " pixel " << i << ", " << j << " (" << uniform_passed
+                                                << " of " << n_samples << " uniform samples pass)";
+                }
                 blocked += pixel_blocked;
                 aimed += n_samples;
             }
         }
         EXPECT_GT(rim, 100) << setup.name;
-        EXPECT_EQ(blocked, 0) << setup.name << ": " << blocked << " of " << aimed << " aimed samples blocked";
+        if (tilted)
+            EXPECT_LT(blocked * 20, aimed) << setup.name << ": " << blocked << " of " << aimed << " aimed samples blocked";
+        else
+            EXPECT_EQ(blocked, 0) << setup.name << ": " << blocked << " of " << aimed << " aimed samples blocked";
     }
 }
 
@@ -491,8 +523,8 @@ TEST(Aim, OffWhereItCannotAim)
     EXPECT_TRUE(make_camera(turned).sampling.aim);
     CameraParams tilting = thin;
     tilting.array.has_errors = true;
-    tilting.array.errors.rotation_deg = 1;  // lenses tilted by their errors
-    EXPECT_FALSE(make_camera(tilting).sampling.aim);
+    tilting.array.errors.rotation_deg = 1;  // lenses tilted by their errors: aimed in their own frames
+    EXPECT_TRUE(make_camera(tilting).sampling.aim);
     CameraParams gapped = thin;
     gapped.array.fill_factor = 0.8;  // light through the gap is not bent
     EXPECT_FALSE(make_camera(gapped).sampling.aim);
