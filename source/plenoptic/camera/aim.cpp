@@ -648,8 +648,17 @@ AimDisc tilted_cell_disc(const LensAim& a, Vec3 s_array, int k)
 int cell_discs(const LensAim& a, Vec3 s_array, AimDisc discs[1 + LensAim::kMaxCuts])
 {
     if (a.tilted) {
+        // First the flattened discs (lens_aim: they hold where the passing rays from the cell
+        // cross the lens frame's plane Z, so their cell discs hold the exact ones): a disc whose
+        // cell disc holds the whole cell constrains nothing (most sensor points, inside a
+        // microimage), and only the others need their ellipses.
+        const Vec3 s = lens_frame_point(a, s_array);
         int count = 0;
         for (int k = 0; k <= a.cuts; ++k) {
+            const AimDisc flat = k == 0 ? cell_disc(a, s, a.m, a.rho) : cell_disc(a, s, a.cut_m[k - 1], a.cut_rho[k - 1]);
+            if (!(flat.radius < std::numeric_limits<double>::infinity()) ||
+                std::sqrt(flat.centre.x * flat.centre.x + flat.centre.y * flat.centre.y) + a.circumradius <= flat.radius)
+                continue;
             const AimDisc d = tilted_cell_disc(a, s_array, k);
             if (d.radius < std::numeric_limits<double>::infinity())
                 discs[count++] = d;
@@ -1329,11 +1338,13 @@ void plan_pixel(const PlenopticCamera& m, int i, int j, const LensIndex* forced,
                     plan->parts[count] = own_part;
                 } else {
                     const Vec2 place = m.array.lattice_centre_local(other);
-                    if (std::hypot(q.x - place.x, q.y - place.y) > near + shift)
+                    const double dx = q.x - place.x, dy = q.y - place.y;
+                    if (dx * dx + dy * dy > (near + shift) * (near + shift))
                         continue;
                     if (shift > 0) {
                         const Vec2 c = m.array.centre_local(other);
-                        if (std::hypot(q.x - c.x, q.y - c.y) > near)
+                        const double cx = q.x - c.x, cy = q.y - c.y;
+                        if (cx * cx + cy * cy > near * near)
                             continue;
                     }
                     if (!lens_aim(m, other, &a))
