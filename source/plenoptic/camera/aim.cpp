@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "plenoptic/array/microlens_array.h"
+#include "plenoptic/camera/camera_key.h"
 #include "plenoptic/camera/rays.h"
 #include "plenoptic/camera/rays_internal.h"
 #include "plenoptic/lens/main_lens.h"
@@ -845,52 +846,6 @@ struct Intervals {
     }
 };
 
-// What a camera's aim depends on, to tell a cached plan's camera from another (a camera copied or
-// made at the same address differs in one of these when its geometry does).
-struct CameraKey {
-    const PlenopticCamera* camera;
-    const void* parts[4];
-    double geometry[12];
-    bool operator==(const CameraKey& o) const
-    {
-        if (camera != o.camera)
-            return false;
-        for (int k = 0; k < 4; ++k)
-            if (parts[k] != o.parts[k])
-                return false;
-        for (int k = 0; k < 12; ++k)
-            if (!(geometry[k] == o.geometry[k]))
-                return false;
-        return true;
-    }
-};
-
-// Whether k is m's key (key_of(m) == k), without making the key (asked once or twice a sample).
-bool key_is(const CameraKey& k, const PlenopticCamera& m)
-{
-    const Sensor& s = m.sensor;
-    const ArrayPose& pose = m.array.pose;
-    return k.camera == &m && k.parts[0] == m.lens.get() && k.parts[1] == m.array.microlens.get() &&
-           k.parts[2] == m.pupil_bounds.get() && k.parts[3] == m.array.errors.get() && k.geometry[0] == s.z_mm &&
-           k.geometry[1] == s.pixel_size_mm[0] && k.geometry[2] == s.pixel_size_mm[1] &&
-           k.geometry[3] == s.offset_mm[0] && k.geometry[4] == s.offset_mm[1] &&
-           k.geometry[5] == double(s.film.width) && k.geometry[6] == double(s.film.height) &&
-           k.geometry[7] == pose.centre_mm.x && k.geometry[8] == pose.centre_mm.y &&
-           k.geometry[9] == pose.centre_mm.z && k.geometry[10] == pose.rotation.m[0][0] &&
-           k.geometry[11] == pose.rotation.m[0][1];
-}
-
-CameraKey key_of(const PlenopticCamera& m)
-{
-    const Sensor& s = m.sensor;
-    const ArrayPose& pose = m.array.pose;
-    return CameraKey{&m,
-                     {m.lens.get(), m.array.microlens.get(), m.pupil_bounds.get(), m.array.errors.get()},
-                     {s.z_mm, s.pixel_size_mm[0], s.pixel_size_mm[1], s.offset_mm[0], s.offset_mm[1], double(s.film.width),
-                      double(s.film.height), pose.centre_mm.x, pose.centre_mm.y, pose.centre_mm.z, pose.rotation.m[0][0],
-                      pose.rotation.m[0][1]}};
-}
-
 // Array-local (x, y) in the sensor's plane -> the pixel's own frame: (pixel coordinates - the
 // pixel's corner (i, j)) times the pixel's size, in mm. A rigid map (the array is parallel to the
 // sensor), so regions keep their radii; the pixel is [0, px] x [0, py].
@@ -1399,9 +1354,11 @@ namespace {
 const PixelPlan& cached_plan(const PlenopticCamera& m, int i, int j, const LensIndex* forced)
 {
     static thread_local CachedPlans cache;
-    if (!(cache.valid && cache.i == i && cache.j == j && key_is(cache.key, m))) {
+    const bool same_camera = cache.valid && key_is(cache.key, m);
+    if (!(same_camera && cache.i == i && cache.j == j)) {
+        if (!same_camera)
+            cache.key = key_of(m);
         cache.valid = true;
-        cache.key = key_of(m);
         cache.i = i;
         cache.j = j;
         cache.count = cache.next = 0;

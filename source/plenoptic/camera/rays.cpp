@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "plenoptic/camera/aim.h"
+#include "plenoptic/camera/camera_key.h"
 #include "plenoptic/camera/radiometry.h"
 #include "plenoptic/camera/rays_internal.h"
 
@@ -152,63 +154,123 @@ bool trace_sensor_point(const PlenopticCamera& m, Vec3 p, const LensIndex* force
     return trace_sensor_point_as<false>(m, p, forced, lens_u, lens_v, check_apertures, out);
 }
 
-// Whether light through `lens` can reach some point of the pixel centred at p. With k = D/d
-// measured at the lens: the chief ray p -> c meets the main-lens plane at m0 = c (1 + k) - p k
-// (exact, tilted or not); a ray from sensor point p' through cell point h arrives at
-// m0 + (h - c) g - (p' - p) k with g = 1 + k - D/f for an array parallel to the sensor, so the
-// lens reaches the pixel iff that region meets the aperture disc. Conservative: circumradius for
-// the cell, half the pixel diagonal for the pixel; for a slightly tilted array the spread terms get
-// a margin that grows with the tilt (validated against brute force in the unit tests).
+// Whether light through a lens can reach some point of the pixel centred at p, split into what
+// depends on the lens alone (kept per thread for the lenses about the pixels being traced) and p:
+// the lens reaches the pixel iff |(a - k p)_xy| <= radius (always when `always`).
+struct LensReach {
+    double ax = 0, ay = 0, k = 0, radius = 0;
+    bool always = true;
+
+    bool reaches(Vec3 p) const
+    {
+        if (always)
+            return true;
+        const double x = ax - k * p.x, y = ay - k * p.y;
+        return x * x + y * y <= radius * radius;
+    }
+};
+
+// With k = D/d measured at the lens: the chief ray p -> c meets the main-lens plane at
+// m0 = c (1 + k) - p k (exact, tilted or not); a ray from sensor point p' through cell point h
+// arrives at m0 + (h - c) g - (p' - p) k with g = 1 + k - D/f for an array parallel to the sensor,
+// so the lens reaches the pixel iff that region meets the aperture disc. Conservative: circumradius
+// for the cell, half the pixel diagonal for the pixel; for a slightly tilted array the spread terms
+// get a margin that grows with the tilt (validated against brute force in the unit tests). The
+// radius's factor 1 + 1e-9 covers the rounding of a - k p (|a|, |k p| of metres at most against
+// radii of millimetres).
 // Refracting lenses have no first-order bound: their light lands within the traced reach
 // (Overlap::reach_mm) of the lens's microimage centre (the lens centre seen from the exit pupil's
-// centre). Not pruned (true) without that reach, or where the array or a lens is tilted.
-bool refracting_lens_reaches_pixel(const PlenopticCamera& m, LensIndex lens, Vec3 p)
+// centre). Not pruned (always) without that reach, or where the array or a lens is tilted.
+LensReach refracting_lens_reach(const PlenopticCamera& m, LensIndex lens)
 {
+    LensReach r;
     if (!(m.overlap.reach_mm > 0) || m.array.pose.tilted || (m.array.errors && m.array.errors->tilts()))
-        return true;
+        return r;
     const Vec3 c = lens_centre_mm(m, lens);
     const Vec3 e = m.lens->exit_pupil_centre();
     const Vec3 centre = e + ((m.sensor.z_mm - e.z) / (c.z - e.z)) * (c - e);
     const double pixel = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]);
-    return std::hypot(p.x - centre.x, p.y - centre.y) <= (m.overlap.reach_mm + pixel) * (1 + 1e-9);
+    r.always = false;
+    r.ax = centre.x;
+    r.ay = centre.y;
+    r.k = 1;
+    r.radius = (m.overlap.reach_mm + pixel) * (1 + 1e-9);
+    return r;
 }
 
-bool lens_reaches_pixel(const PlenopticCamera& m, LensIndex lens, Vec3 p)
+LensReach lens_reach(const PlenopticCamera& m, LensIndex lens)
 {
+    LensReach r;
     if (!m.lens)
-        return true;
-    const Vec3 c = lens_centre_mm(m, lens);
+        return r;
+    const LensFrame frame = m.array.frame(lens);
+    const Vec3 c = m.array.to_optics(frame.centre);
     const Vec3 e = m.lens->exit_pupil_centre();
     const double main_distance = e.z - c.z;
     const double array_distance = c.z - m.sensor.z_mm;
     if (!(main_distance > 0) || !(array_distance > 0))
-        return true;
+        return r;
     const double k = main_distance / array_distance;
-    const double mx = (c.x - e.x) * (1 + k) - (p.x - e.x) * k;
-    const double my = (c.y - e.y) * (1 + k) - (p.y - e.y) * k;
     double spread = 0.5 * std::hypot(m.sensor.pixel_size_mm[0], m.sensor.pixel_size_mm[1]) * k;
     if (m.array.microlens->forms_image()) {
         if (!m.array.microlens->first_order_exact())
-            return refracting_lens_reaches_pixel(m, lens, p);
-        double blur = std::fabs(1 + k - main_distance / m.array.focal_length_mm(lens));
+            return refracting_lens_reach(m, lens);
+        double blur = std::fabs(1 + k - main_distance / frame.focal_mm);
         if (m.array.fill_factor < 1 && !m.array.mask)
             blur = std::max(blur, 1 + k);  // light through a clear gap is not bent
         spread += m.array.cell_circumradius_mm * blur;
     }
     if (m.array.pose.tilted)
         spread *= 1.25 + 4 * m.array.pose.tilt_sine;
-    if (m.array.errors && m.array.errors->tilts()) {
+    if (frame.tilted) {
         // This lens's own tilt, with the margin of a tilted array (validated by brute force).
-        const double tilt = m.array.errors->at(lens).tilt_deg;
-        if (tilt > 0)
-            spread *= 1.25 + 4 * std::sin(tilt * (kPi / 180));
+        spread *= 1.25 + 4 * std::sin(m.array.errors->at(lens).tilt_deg * (kPi / 180));
     }
-    if (m.pupil_bounds) {
-        // A real lens: the region where light from the lens centre passes its apertures.
-        const PupilDisc disc = m.pupil_bounds->disc_for(c);
-        return std::hypot(mx - disc.centre.x, my - disc.centre.y) <= (disc.radius + spread) * (1 + 1e-9);
+    // A real lens: the region where light from the lens centre passes its apertures.
+    const PupilDisc disc = m.pupil_bounds ? m.pupil_bounds->disc_for(c) : PupilDisc{Vec3{0, 0, e.z}, m.lens->exit_pupil_radius()};
+    r.always = false;
+    r.ax = (c.x - e.x) * (1 + k) + e.x * k - disc.centre.x;
+    r.ay = (c.y - e.y) * (1 + k) + e.y * k - disc.centre.y;
+    r.k = k;
+    r.radius = (disc.radius + spread) * (1 + 1e-9);
+    return r;
+}
+
+// The reach tests of the lenses about the pixels a thread traces: a 32 x 32 tile of the lattice,
+// slot (k mod 32, l mod 32), so that the lenses about one pixel (at most 17 x 17) never share a
+// slot. A new camera (camera/camera_key.h) starts a new generation, which empties every slot.
+struct ReachCache {
+    static const int kSide = 32;
+    struct Slot {
+        std::uint64_t generation = 0;
+        LensIndex lens{0, 0};
+        LensReach reach;
+    };
+    CameraKey key;
+    std::uint64_t generation = 0;
+    Slot slots[kSide * kSide];
+
+    const LensReach& of(const PlenopticCamera& m, LensIndex lens)
+    {
+        Slot& slot = slots[std::size_t(std::uint64_t(lens.k) & (kSide - 1)) +
+                           kSide * std::size_t(std::uint64_t(lens.l) & (kSide - 1))];
+        if (!(slot.generation == generation && slot.lens == lens)) {
+            slot.reach = lens_reach(m, lens);
+            slot.lens = lens;
+            slot.generation = generation;
+        }
+        return slot.reach;
     }
-    return std::hypot(mx, my) <= (m.lens->exit_pupil_radius() + spread) * (1 + 1e-9);
+};
+
+ReachCache& reach_cache(const PlenopticCamera& m)
+{
+    thread_local ReachCache cache;
+    if (cache.generation == 0 || !key_is(cache.key, m)) {
+        cache.key = key_of(m);
+        ++cache.generation;
+    }
+    return cache;
 }
 
 } // namespace
@@ -296,6 +358,7 @@ int overlap_lenses(const PlenopticCamera& m, int i, int j, LensIndex* out, int c
     if (!m.overlap.modelled)
         return count;
     const int rings = m.overlap.rings;
+    ReachCache* reach = m.array.pose.tilt_sine <= kMaxPrunedTiltSine ? &reach_cache(m) : nullptr;
     const std::int64_t own_skew = skew_k(m.array.grid, own);
     const bool hexagonal = m.array.grid == GridType::Hexagonal;
     for (int dl = -rings; dl <= rings; ++dl) {
@@ -305,7 +368,7 @@ int overlap_lenses(const PlenopticCamera& m, int i, int j, LensIndex* out, int c
             if (hexagonal && std::abs(dk + dl) > rings)
                 continue;  // hexagonal ring distance in skew indices: max(|dk|, |dl|, |dk + dl|)
             const LensIndex lens = from_skew(m.array.grid, own_skew + dk, own.l + dl);
-            if (m.array.pose.tilt_sine <= kMaxPrunedTiltSine && !lens_reaches_pixel(m, lens, p))
+            if (reach && !reach->of(m, lens).reaches(p))
                 continue;
             if (count >= capacity)
                 return count;
