@@ -84,6 +84,12 @@ struct LensAim {
     Vec3 disc_centre[1 + kMaxCuts];
     double disc_radius[1 + kMaxCuts];
     Vec3 disc_normal;
+    // For a tilted lens's pixel regions, each flattened disc more tightly (the main disc's first,
+    // then the cuts'): the shadow, an ellipse, with its parallax lies within seg_rho[k] of the
+    // segment from its centre - seg[k] to its centre + seg[k] (seg[k] along the ellipse's major
+    // axis, as long as its semi-axes' difference). seg[k] zero: the disc (m, rho) alone.
+    Vec2 seg[1 + kMaxCuts] = {};
+    double seg_rho[1 + kMaxCuts] = {};
 };
 
 // A point (array-local) in the lens's own frame (itself for an untilted lens).
@@ -107,7 +113,7 @@ bool lens_aim(const PlenopticCamera& model, LensIndex lens, LensAim* out);
 // order, either way round; one corner: a disc).
 struct RoundedPolygon {
     int corners;
-    Vec2 corner[6];
+    Vec2 corner[8];  // a cell's six, and two more where a segment widens it (lit_sensor_region)
     double radius;
 };
 // Whether p lies in the region.
@@ -116,6 +122,9 @@ bool region_holds(const RoundedPolygon& r, Vec2 p);
 void region_x_extent(const RoundedPolygon& r, double* x0, double* x1);
 // The region's chord at x, [*y0, *y1]; false when x lies outside its x range.
 bool region_chord(const RoundedPolygon& r, double x, double* y0, double* y1);
+// The region's convex polygon widened by the segment from -u to u (its radius unchanged); false,
+// r unchanged, when the result would not fit a RoundedPolygon.
+bool widen_by_segment(RoundedPolygon* r, Vec2 u);
 
 // The region of sensor points (x, y of the lens's frame; the sensor d behind the lens plane, d > 0)
 // from which a ray through the lens's cell can pass the main lens's disc (k = -1) or cutting disc

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -150,6 +151,77 @@ double distance_to_polygon(const RoundedPolygon& r, Vec2 p)
 
 bool in_region(const RoundedPolygon& r, Vec2 p) { return distance_to_polygon(r, p) <= r.radius; }
 
+// A random convex polygon of 6, 4 or 1 corners (by trial % 3): points of a turned ellipse at
+// increasing angles, in either turning order, about a random centre (`centred`: about the origin).
+// Radius 0.
+RoundedPolygon random_convex_polygon(std::mt19937& rng, int trial, bool centred)
+{
+    std::uniform_real_distribution<double> uni(0, 1);
+    RoundedPolygon r;
+    const int kind = trial % 3;
+    r.corners = kind == 0 ? 6 : (kind == 1 ? 4 : 1);
+    const double turn = 2 * kPi * uni(rng), size = 0.1 + uni(rng), stretch = 0.3 + uni(rng);
+    Vec2 centre{0, 0};
+    if (!centred)
+        centre = Vec2{uni(rng) - 0.5, uni(rng) - 0.5};
+    const bool reverse = uni(rng) < 0.5;
+    for (int n = 0; n < r.corners; ++n) {
+        const double angle = 2 * kPi * (n + 0.3 * uni(rng)) / r.corners * (reverse ? -1 : 1);
+        const double x = size * std::cos(angle), y = size * stretch * std::sin(angle);
+        r.corner[n] = Vec2{centre.x + x * std::cos(turn) - y * std::sin(turn),
+                           centre.y + x * std::sin(turn) + y * std::cos(turn)};
+    }
+    r.radius = 0;
+    return r;
+}
+
+// A convex polygon widened by a segment is the convex hull of its corners moved both ways along it:
+// every moved corner lies in the widened polygon, and every corner of the widened polygon is a
+// moved corner (so the two convex polygons are one). Over random convex polygons (hexagons,
+// quadrilaterals, single points) and segments, some along an edge.
+TEST(Aim, WideningByASegmentIsTheHullOfTheMovedCorners)
+{
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> uni(0, 1);
+    int widened = 0;
+    for (int trial = 0; trial < 2000; ++trial) {
+        const RoundedPolygon r = random_convex_polygon(rng, trial, true);
+        Vec2 u{uni(rng) - 0.5, uni(rng) - 0.5};
+        if (trial % 10 == 0 && r.corners > 1)
+            u = 0.7 * (r.corner[1] - r.corner[0]);  // along an edge
+        RoundedPolygon w = r;
+        ASSERT_TRUE(widen_by_segment(&w, u)) << trial;
+        ++widened;
+        EXPECT_LE(w.corners, r.corners + 2) << trial;
+        // Convex, its corners in one turning order (what region_holds and the chords rely on).
+        if (w.corners >= 3) {
+            int left = 0, right = 0;
+            for (int k = 0; k < w.corners; ++k) {
+                const Vec2 a = w.corner[k], b = w.corner[(k + 1) % w.corners], c = w.corner[(k + 2) % w.corners];
+                const double turn = cross(b - a, c - b);
+                left += turn > 1e-12 ? 1 : 0;
+                right += turn < -1e-12 ? 1 : 0;
+            }
+            EXPECT_TRUE(left == 0 || right == 0) << trial << ": " << left << " left and " << right << " right turns";
+        }
+        RoundedPolygon held = w;
+        held.radius = 1e-12;
+        for (int n = 0; n < r.corners; ++n)
+            for (double sign : {-1.0, 1.0}) {
+                const Vec2 moved = r.corner[n] + sign * u;
+                EXPECT_TRUE(in_region(held, moved)) << trial << " corner " << n << " moved " << sign;
+            }
+        for (int k = 0; k < w.corners; ++k) {
+            double nearest = INFINITY;
+            for (int n = 0; n < r.corners; ++n)
+                for (double sign : {-1.0, 1.0})
+                    nearest = std::min(nearest, length(w.corner[k] - (r.corner[n] + sign * u)));
+            EXPECT_LT(nearest, 1e-12) << trial << " corner " << k;
+        }
+    }
+    EXPECT_EQ(widened, 2000);
+}
+
 // Every (sensor point, cell point) pair through which the renderer's unaimed ray passes, for the
 // sensor points of a grid over the picture and the cell points of a grid over the cell, through
 // the point's own lens and its neighbours: the sensor point lies in the lens's sensor_region
@@ -165,7 +237,7 @@ TEST(Aim, RegionsHoldEveryPassingRay)
         const PlenopticCamera m = with_film(make_camera(setup.params), W, H);
         ASSERT_TRUE(m.sampling.aim) << setup.name;
         long passing = 0, sensor_out = 0, own_out = 0, own_checked = 0, cell_out = 0, range_out = 0,
-             aimed_lenses = 0, cut_lenses = 0, tilted_lenses = 0;
+             aimed_lenses = 0, cut_lenses = 0, tilted_lenses = 0, stadium_lenses = 0;
         const int cells = 20;
         for (int b = 0; b <= 30; ++b) {
             for (int a = 0; a <= 40; ++a) {
@@ -183,6 +255,7 @@ TEST(Aim, RegionsHoldEveryPassingRay)
                         continue;
                     ++aimed_lenses;
                     tilted_lenses += aim.tilted ? 1 : 0;
+                    stadium_lenses += aim.seg[0].x != 0 || aim.seg[0].y != 0 ? 1 : 0;
                     const Vec3 s = m.array.to_local(p);
                     const Vec2 s2{s.x, s.y};
                     // A pixel's centre beside s, whose region holds the points within its reach.
@@ -244,10 +317,16 @@ TEST(Aim, RegionsHoldEveryPassingRay)
         EXPECT_EQ(own_out, 0) << setup.name;
         EXPECT_GT(own_checked, 5000) << setup.name;
         // Lenses tilted by their errors are aimed too (in their own frames).
-        if (setup.params.array.errors.rotation_deg > 0)
+        if (setup.params.array.errors.rotation_deg > 0) {
             EXPECT_GT(tilted_lenses, 1000) << setup.name;
-        else
+            // Their pixel regions rounded by stadiums (behind ideal main lenses only: lens_aim).
+            if (setup.params.main.type == MainLensType::Prescription)
+                EXPECT_EQ(stadium_lenses, 0) << setup.name;
+            else
+                EXPECT_GT(stadium_lenses, 1000) << setup.name;
+        } else {
             EXPECT_EQ(tilted_lenses, 0) << setup.name;
+        }
         // Behind the traced triplet most lenses are off the axis: cut as well.
         if (setup.params.main.type == MainLensType::Prescription)
             EXPECT_GT(cut_lenses, 500) << setup.name;
@@ -264,19 +343,7 @@ TEST(Aim, RoundedPolygonChords)
     std::uniform_real_distribution<double> uni(0, 1);
     long checked = 0;
     for (int trial = 0; trial < 300; ++trial) {
-        RoundedPolygon r;
-        const int kind = trial % 3;
-        r.corners = kind == 0 ? 6 : (kind == 1 ? 4 : 1);
-        const double turn = 2 * kPi * uni(rng), size = 0.1 + uni(rng), stretch = 0.3 + uni(rng);
-        const Vec2 centre{uni(rng) - 0.5, uni(rng) - 0.5};
-        const bool reverse = uni(rng) < 0.5;
-        for (int n = 0; n < r.corners; ++n) {
-            // An ellipse's points at increasing angles (convex), turned.
-            const double angle = 2 * kPi * (n + 0.3 * uni(rng)) / r.corners * (reverse ? -1 : 1);
-            const double x = size * std::cos(angle), y = size * stretch * std::sin(angle);
-            r.corner[n] = Vec2{centre.x + x * std::cos(turn) - y * std::sin(turn),
-                               centre.y + x * std::sin(turn) + y * std::cos(turn)};
-        }
+        RoundedPolygon r = random_convex_polygon(rng, trial, false);
         r.radius = trial % 7 == 0 ? 0 : 0.5 * uni(rng);
         double x0, x1;
         region_x_extent(r, &x0, &x1);
@@ -446,10 +513,12 @@ TEST(Aim, AimedSamplesGiveThePixelTheSameLight)
 // that light reaches passes. The pixels across microimages' rims (some but not all of 256 uniform
 // samples pass) over a patch of each camera (lenses displaced too); 256 aimed samples each. Lenses
 // tilted by their errors are aimed in their own frames, where the main lens's discs are tilted: a
-// pixel's region is rounded by a disc about the disc's elliptic shadow (sensor_region, lens_aim),
-// which overhangs it by its semi-axes' difference, so some samples of the pixels that light only
-// grazes are lost: here 3.0 % with tilts of up to 3 degrees behind 50 um pixels (10.8 % with the
-// first, cruder discs), 0.03 % in the plenoptic 2.0 camera; at most 5 % is allowed.
+// pixel's region is rounded by a stadium about the disc's elliptic shadow (sensor_region,
+// lens_aim), and taken at the pixel centre's distance from the lens, widened by how fast it moves
+// with that distance, so some samples of the pixels that light only grazes are lost: here 2.4 %
+// with tilts of up to 3 degrees behind 50 um pixels (3.0 % when the shadow was rounded by a disc,
+// 10.8 % with the first, cruder discs), 0.03 % in the plenoptic 2.0 camera; at most 2.7 % is
+// allowed.
 TEST(Aim, EveryAimedSampleOfARimPixelPassesBehindIdealLenses)
 {
     for (const AimCase& setup : setups()) {
@@ -483,7 +552,9 @@ TEST(Aim, EveryAimedSampleOfARimPixelPassesBehindIdealLenses)
         }
         EXPECT_GT(rim, 100) << setup.name;
         if (tilted)
-            EXPECT_LT(blocked * 20, aimed) << setup.name << ": " << blocked << " of " << aimed << " aimed samples blocked";
+            std::cout << setup.name << ": " << blocked << " of " << aimed << " aimed samples of rim pixels blocked\n";
+        if (tilted)
+            EXPECT_LT(blocked * 37, aimed) << setup.name << ": " << blocked << " of " << aimed << " aimed samples blocked";
         else
             EXPECT_EQ(blocked, 0) << setup.name << ": " << blocked << " of " << aimed << " aimed samples blocked";
     }
