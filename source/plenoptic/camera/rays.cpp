@@ -362,12 +362,15 @@ int overlap_lenses(const PlenopticCamera& m, int i, int j, LensIndex* out, int c
     const std::int64_t own_skew = skew_k(m.array.grid, own);
     const bool hexagonal = m.array.grid == GridType::Hexagonal;
     for (int dl = -rings; dl <= rings; ++dl) {
-        for (int dk = -rings; dk <= rings; ++dk) {
+        // Hexagonal ring distance in skew indices: max(|dk|, |dl|, |dk + dl|), so |dk + dl| <= rings.
+        const int first = hexagonal ? std::max(-rings, -rings - dl) : -rings;
+        const int last = hexagonal ? std::min(rings, rings - dl) : rings;
+        const std::int64_t l = own.l + dl;
+        const LensIndex row = from_skew(m.array.grid, own_skew, l);  // the row's lens at dk = 0
+        for (int dk = first; dk <= last; ++dk) {
             if (dk == 0 && dl == 0)
                 continue;
-            if (hexagonal && std::abs(dk + dl) > rings)
-                continue;  // hexagonal ring distance in skew indices: max(|dk|, |dl|, |dk + dl|)
-            const LensIndex lens = from_skew(m.array.grid, own_skew + dk, own.l + dl);
+            const LensIndex lens{row.k + dk, l};
             if (reach && !reach->of(m, lens).reaches(p))
                 continue;
             if (count >= capacity)
