@@ -445,7 +445,7 @@ RoundedPolygon lit_sensor_region(const LensAim& a, double d, int cut)
     // rho / |g| of the cell H: s - c - (c - m) d/Z in (d/Z) g (H + disc(rho/|g|)), and H is
     // symmetric about its centre.
     const Vec2 m = cut < 0 ? a.m : a.cut_m[cut];
-    const double rho = cut < 0 ? a.rho : a.cut_rho[cut];
+    const double rho = a.disc_rho(cut);
     const double g = 1 + a.Z / d - a.Z / a.f;
     const double k = d / a.Z;
     const Vec2 shift{(a.c.x - m.x) * k, (a.c.y - m.y) * k};
@@ -458,10 +458,9 @@ RoundedPolygon lit_sensor_region(const LensAim& a, double d, int cut)
         out.corner[n] = Vec2{centre.x + scale * cell[n].x, centre.y + scale * cell[n].y};
     // A tilted lens's stadium (LensAim::seg) in place of its flattened disc: the cell's polygon
     // widened by the segment (the hull of its corners moved both ways along it), then rounded.
-    const int index = cut < 0 ? 0 : cut + 1;
-    const Vec2 half = a.seg[index];
-    const bool stadium = (half.x != 0 || half.y != 0) && widen_by_segment(&out, Vec2{half.x * k, half.y * k});
-    const double radius = (stadium ? a.seg_rho[index] : rho) * k;
+    const Vec2 half = a.seg[cut + 1];
+    const bool stadium = a.has_stadium(cut) && widen_by_segment(&out, Vec2{half.x * k, half.y * k});
+    const double radius = (stadium ? a.pixel_rho(cut) : rho) * k;
     // g's rounding is up to ~1e-16 of (1 + Z/d + Z/|f|), the scale's of that times d/Z.
     const double slack =
         kRoundingMargin * (std::fabs(shift.x) + std::fabs(shift.y) + radius + std::fabs(a.c.x) + std::fabs(a.c.y) +
@@ -482,12 +481,9 @@ namespace {
 double region_drift(const LensAim& a, int cut, double d, double change, double extent)
 {
     const Vec2 m = cut < 0 ? a.m : a.cut_m[cut];
-    const Vec2 half = a.seg[cut < 0 ? 0 : cut + 1];
-    const bool stadium = half.x != 0 || half.y != 0;
-    const double rho = stadium ? a.seg_rho[cut < 0 ? 0 : cut + 1] : (cut < 0 ? a.rho : a.cut_rho[cut]);
     // A stadium's segment adds |n.seg| d/Z to the support function: a rate of at most |seg| / Z.
-    const double centre = (std::hypot(a.c.x - m.x, a.c.y - m.y) + (stadium ? length(half) : 0)) / a.Z,
-                 radius = rho / a.Z;
+    const double centre = (std::hypot(a.c.x - m.x, a.c.y - m.y) + length(a.seg[cut + 1])) / a.Z,
+                 radius = a.pixel_rho(cut) / a.Z;
     const double slope = 1 / a.Z - 1 / a.f, at = 1 + d * slope;
     const double inradius = 0.5 * a.pitch;
     if (!(std::fabs(at) > std::fabs(change * slope) * (1 + 1e-9)))
@@ -1303,15 +1299,14 @@ bool inner_holds_pixel(const PlenopticCamera& m, const LensAim& a, Vec3 s_array,
         // A stadium (LensAim::seg): the region holds the points within the cell's inscribed radius
         // plus the stadium's radius of its segment (scaled by d/Z), not only of its centre.
         const Vec2 half = a.seg[cut + 1];
-        const bool stadium = half.x != 0 || half.y != 0;
-        const double rho = stadium ? a.seg_rho[cut + 1] : (cut < 0 ? a.rho : a.cut_rho[cut]);
+        const double rho = a.pixel_rho(cut);
         const double drift =
             a.tilted ? reach * a.sin_tilt * region_drift(a, cut, d, reach * a.sin_tilt, 0.5 * a.pitch) : 0;
         const double room = (inradius + rho * k - drift) * (1 - 1e-9) - reach;
         if (!(room > 0))
             return false;
         double dx = s.x - (a.c.x + (a.c.x - mm.x) * k), dy = s.y - (a.c.y + (a.c.y - mm.y) * k);
-        if (stadium) {
+        if (a.has_stadium(cut)) {
             // To the segment's nearest point (its ends at -+ half k).
             const double hx = half.x * k, hy = half.y * k;
             double t = (dx * hx + dy * hy) / (hx * hx + hy * hy);

@@ -90,6 +90,12 @@ struct LensAim {
     // axis, as long as its semi-axes' difference). seg[k] zero: the disc (m, rho) alone.
     Vec2 seg[1 + kMaxCuts] = {};
     double seg_rho[1 + kMaxCuts] = {};
+
+    // Disc `cut`'s (-1: the main disc) stadium for the pixel regions: whether it has one, its
+    // half-segment and its radius (else the flattened disc's radius).
+    bool has_stadium(int cut) const { return seg[cut + 1].x != 0 || seg[cut + 1].y != 0; }
+    double disc_rho(int cut) const { return cut < 0 ? rho : cut_rho[cut]; }
+    double pixel_rho(int cut) const { return has_stadium(cut) ? seg_rho[cut + 1] : disc_rho(cut); }
 };
 
 // A point (array-local) in the lens's own frame (itself for an untilted lens).
