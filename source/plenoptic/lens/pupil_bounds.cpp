@@ -12,10 +12,13 @@
 #include "plenoptic/lens/pupil_bounds.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <exception>
 
 #include "plenoptic/core/setup_progress.h"
+#include "plenoptic/core/threads.h"
 
 namespace plenoptic {
 
@@ -32,7 +35,7 @@ const int kMaxFieldDoublings = 60;
 // needed spans a quarter of the bins' to be held closely; the radii measured are those the spans
 // of whole bins measured before, at each bin and three between), and the margin on each span's
 // radius for what lies between the measured radii (validated by brute force in pupil_bounds_test).
-const int kTightAzimuths = 256;
+const int kTightAzimuths = 512;
 const int kTightScan = 16 * kGrid;  // points along the x axis where the grid's centre is dark
 const int kTightSplit = 4;
 const double kTightMargin = 1.0001;
@@ -82,6 +85,31 @@ void search_square(const Prescription& lens, double r, double plane_z, double pu
     }
     *centre_x = 0.5 * (lo + hi);
     *half = 0.5 * (hi - lo);
+}
+
+// Replaces `points` by the corners of their convex hull (Andrew's monotone chain; points on its
+// edges dropped).
+void keep_convex_hull(std::vector<Vec2>* points)
+{
+    std::vector<Vec2>& p = *points;
+    if (p.size() < 3)
+        return;
+    std::sort(p.begin(), p.end(), [](Vec2 a, Vec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+    std::vector<Vec2> hull(2 * p.size());
+    size_t h = 0;
+    auto turn = [](Vec2 o, Vec2 a, Vec2 b) { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); };
+    for (size_t k = 0; k < p.size(); ++k) {  // lower chain
+        while (h >= 2 && turn(hull[h - 2], hull[h - 1], p[k]) <= 0)
+            --h;
+        hull[h++] = p[k];
+    }
+    for (size_t k = p.size() - 1, lower = h + 1; k-- > 0;) {  // upper chain
+        while (h >= lower && turn(hull[h - 2], hull[h - 1], p[k]) <= 0)
+            --h;
+        hull[h++] = p[k];
+    }
+    p.assign(hull.begin(), hull.begin() + std::ptrdiff_t(h - 1));  // the last point is the first
+    p.shrink_to_fit();
 }
 
 // Whether any ray from field radius r passes, and then the bin's disc.
@@ -247,8 +275,14 @@ bool bin_disc(const Prescription& lens, const Probe& probe, double r, double* ce
     *centre_x = x0;
     if (hull) {
         hull->clear();
-        if (tight && measured)
+        if (tight && measured) {
+            // Only the corners' convex hull is kept: the farthest point of a set from a point (and
+            // from a point or its mirror image, reach_from_pair: the larger of two convex functions)
+            // is one of its hull's corners, so both reaches are unchanged, and the grid's inner
+            // points no longer take memory or time in the cutting discs' search.
             hull->swap(corners);  // empty: no polygon (the region was not measured star-shaped)
+            keep_convex_hull(hull);
+        }
     }
     // Tight: the measured boundary (the bisection's outer ends, the convex allowance between the
     // directions, the grid's passing points); the bounds add kMargin and keep the grid's radius
@@ -337,9 +371,9 @@ const int kCutRefinements = 3;
 // +x), offsets (kPairOffsets in geometric steps, in units of the disc's radius), refined about the
 // best kPairRefinements times, and the least share of the area it must take off to be kept.
 const int kPairAngles = 6;
-const int kPairOffsets = 10;
+const int kPairOffsets = 20;
 const int kPairRefinements = 3;
-const double kPairOffsetLow = 0.05, kPairOffsetHigh = 4;
+const double kPairOffsetLow = 0.001, kPairOffsetHigh = 4;
 const double kPairGain = 1e-3;
 const double kCutOffsetLow = 0.02, kCutOffsetHigh = 4;
 
@@ -416,20 +450,49 @@ PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, doubl
     tight_step_mm_ = step_mm_ / kTightSplit;
     const int tight_spans = kBins * kTightSplit;
     std::vector<Measured> at(size_t(tight_spans + 1));
-    for (int i = 0; i <= tight_spans; ++i) {
-        report_setup("tight pupil bounds", i, tight_spans + 1);
-        Measured& m = at[size_t(i)];
-        // Beyond the bounds' field no ray is traced (may_pass refuses them all).
-        m.lit = !(i * tight_step_mm_ > field_radius_mm_) &&
-                bin_disc(lens, probe, i * tight_step_mm_, &m.centre_x, &m.radius, true, &m.hull) && m.radius > 0;
-    }
+    // The ends are measured on every hardware thread (each into its own slot, so the bounds do not
+    // depend on the thread count); the calling thread reports progress, and when its reporter
+    // throws (Ctrl-C) the others stop at their next end and the exception goes on once they have.
+    std::atomic<int> next(0), done(0);
+    std::atomic<bool> stop(false);
+    std::exception_ptr thrown;
+    run_on_threads(thread_count(0, size_t(tight_spans + 1)), [&](int t) {
+        for (int i = next++; i <= tight_spans && !stop; i = next++) {
+            if (t == 0) {
+                try {
+                    report_setup("tight pupil bounds", done, tight_spans + 1);
+                } catch (...) {
+                    thrown = std::current_exception();
+                    stop = true;
+                    break;
+                }
+            }
+            Measured& m = at[size_t(i)];
+            // Beyond the bounds' field no ray is traced (may_pass refuses them all).
+            m.lit = !(i * tight_step_mm_ > field_radius_mm_) &&
+                    bin_disc(lens, probe, i * tight_step_mm_, &m.centre_x, &m.radius, true, &m.hull) && m.radius > 0;
+            ++done;
+        }
+    });
+    if (thrown)
+        std::rethrow_exception(thrown);
     report_setup("tight pupil bounds", tight_spans + 1, tight_spans + 1);
     const double aspheric_margin = aspheric ? kAsphereMargin : 1;
-    auto lit = [&](int i) { return i >= 0 && i <= tight_spans && at[size_t(i)].lit; };
+    // End -1, beyond the axis: the field point (-step, 0) sees end 1's region mirrored (x to -x), the
+    // lens being one of revolution; so the first span's extents are linear between measured ends
+    // with their curvature's allowance as every other span's are (a disc holding both ends' discs
+    // before, which on the double Gauss's axis left 0.1 % of the radius: its region moves by some
+    // 15 um in the first span).
+    Measured beyond = at[1];
+    beyond.centre_x = -beyond.centre_x;
+    for (Vec2& p : beyond.hull)
+        p.x = -p.x;
+    auto end = [&](int i) -> const Measured& { return i < 0 ? beyond : at[size_t(i)]; };
+    auto lit = [&](int i) { return i >= -1 && i <= tight_spans && end(i).lit; };
     // The x extent, at end i, of the region's disc (offset 0, no hull) or of a cutting disc centred
     // `offset` from the region's centre holding its polygon.
     auto extent = [&](int i, double offset, bool cut, double y, double* lo, double* hi) {
-        const Measured& m = at[size_t(i)];
+        const Measured& m = end(i);
         const double c = m.centre_x + offset;
         // Off the axis, the larger reach of the disc and its mirror image (the polygon is symmetric
         // about the axis only to the bisections' rounding).
@@ -444,7 +507,7 @@ PupilBounds::PupilBounds(const Prescription& lens, const MainLens& traced, doubl
         double lo[4], hi[4];
         bool use[4];  // end i - 1 + k lit (and, for a cut, with its polygon)
         for (int k = 0; k < 4; ++k) {
-            use[k] = lit(i - 1 + k) && !(cut && at[size_t(i - 1 + k)].hull.empty());
+            use[k] = lit(i - 1 + k) && !(cut && end(i - 1 + k).hull.empty());
             if (use[k])
                 extent(i - 1 + k, offset, cut, y, &lo[k], &hi[k]);
         }

@@ -309,15 +309,25 @@ double expect_tight_discs_hold(const char* name, const Prescription& lens, doubl
 
 TEST(PupilBounds, TightDiscsHoldEveryPassingRayAndAreTight)
 {
-    EXPECT_LT(expect_tight_discs_hold("Laikin f/3.5, array 40 mm behind", laikin_wide_angle(3.5), -40), 1.004);
-    expect_tight_discs_hold("triplet, array 37 mm behind", vignetting_triplet(), -37);
+    // On the axis the region is a disc (the lens is one of revolution), and the tight disc may exceed
+    // it only by the span margin (1.0001) and the chord lines' apex between two of the 512
+    // directions (cos(pi / 512) / cos(2 pi / 512) = 1 + 5.6e-5 on a circle), 1.00016 together: the
+    // first span's extents are linear between measured ends like every other span's (its end beyond
+    // the axis is the mirror image of its far end). The double Gauss, whose region moves by some
+    // 15 um across that span, was at 1.0013 while the first span was one disc holding both ends'.
+    const double on_axis = 1.0002;
+    EXPECT_LT(expect_tight_discs_hold("Laikin f/3.5, array 40 mm behind", laikin_wide_angle(3.5), -40), on_axis);
+    EXPECT_LT(expect_tight_discs_hold("triplet, array 37 mm behind", vignetting_triplet(), -37), on_axis);
     // The catalogue's other lenses, with the array where the benchmark's cameras focused at 2.5 m
     // put it (BENCHMARKS.md, "Samples where light passes").
-    expect_tight_discs_hold("double Gauss f/2.1", catalogue_lens("double_gauss_50mm_tronnier_f2.dat", 2.1), -37.13);
+    EXPECT_LT(expect_tight_discs_hold("double Gauss f/2.1", catalogue_lens("double_gauss_50mm_tronnier_f2.dat", 2.1), -37.13),
+              on_axis);
     int fisheye_pairs = 0;
-    expect_tight_discs_hold("fisheye f/4", catalogue_lens("fisheye_10mm_muller_f4.dat", 4), -23.20, &fisheye_pairs);
+    EXPECT_LT(expect_tight_discs_hold("fisheye f/4", catalogue_lens("fisheye_10mm_muller_f4.dat", 4), -23.20, &fisheye_pairs),
+              on_axis);
     EXPECT_GT(fisheye_pairs, 10);  // its cat's eyes off the axis take the off-axis pair (the others may not)
-    expect_tight_discs_hold("telephoto f/5.6", catalogue_lens("telephoto_250mm_sigler_f5.6.dat", 5.6), -133.81);
+    EXPECT_LT(expect_tight_discs_hold("telephoto f/5.6", catalogue_lens("telephoto_250mm_sigler_f5.6.dat", 5.6), -133.81),
+              on_axis);
 }
 
 } // namespace
