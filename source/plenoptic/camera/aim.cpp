@@ -197,8 +197,7 @@ bool lens_aim(const PlenopticCamera& m, LensIndex lens, LensAim* out)
         // samples for 4.5 % more instructions a pixel, its pixel plans' regions having two corners
         // more and their x ranges' ends more often to be searched).
         const double semi = shadow.major - shadow.minor;
-        out->seg[k] = Vec2{0, 0};
-        out->seg_rho[k] = radius;
+        out->seg_rho[k] = radius;  // (seg[k] is zero from above)
         if (!m.pupil_bounds && semi > 1e-5 * shadow.major) {
             const Vec2 g0 = shadow.g0, g1 = shadow.g1;
             const double a11 = g0.x * g0.x + g1.x * g1.x, a12 = g0.x * g0.y + g1.x * g1.y,
@@ -231,6 +230,18 @@ Vec3 lens_frame_point(const LensAim& a, Vec3 q)
     const Vec3 c3{a.c.x, a.c.y, a.z};
     return c3 + mul_transposed(a.axes, q - c3);
 }
+
+namespace {
+
+// A tilted lens's frame point of q less the lens's centre (lens_frame_point(a, q) - c3, as that
+// computes it before adding c3).
+Vec3 lens_frame_offset(const LensAim& a, Vec3 q)
+{
+    const Vec3 c3{a.c.x, a.c.y, a.z};
+    return mul_transposed(a.axes, q - c3);
+}
+
+} // namespace
 
 // ---- Rounded polygons -------------------------------------------------------------------------
 
@@ -687,14 +698,12 @@ bool polygon_discs_x_range(const Vec2* corner, int n, const AimDisc* discs, int 
 
 // The cell disc of a tilted lens for disc k of the main lens's plane (lit_cell_disc's comment in
 // the header); infinite radius when it cannot be bounded so (then every cell point may pass).
-AimDisc tilted_cell_disc(const LensAim& a, Vec3 s_array, int k)
+AimDisc tilted_cell_disc(const LensAim& a, Vec3 sp, int k)
 {
     const AimDisc all{Vec2{0, 0}, std::numeric_limits<double>::infinity()};
-    // In the lens's frame, from its centre: the sensor point at distance d behind its plane; every
-    // ray from it leaves cell point P = (h, 0) along X - w P, (X, w) the homogeneous image
-    // (-f s_xy, f d, d - f) (w = 0: parallel rays).
-    const Vec3 c3{a.c.x, a.c.y, a.z};
-    const Vec3 sp = mul_transposed(a.axes, s_array - c3);
+    // In the lens's frame, from its centre: the sensor point sp (lens_frame_offset) at distance d
+    // behind its plane; every ray from it leaves cell point P = (h, 0) along X - w P, (X, w) the
+    // homogeneous image (-f s_xy, f d, d - f) (w = 0: parallel rays).
     const double d = -sp.z, f = a.f;
     if (!(d > 0) || !(f > 0))
         return all;
@@ -748,14 +757,16 @@ int cell_discs(const LensAim& a, Vec3 s_array, AimDisc discs[1 + LensAim::kMaxCu
         // cross the lens frame's plane Z, so their cell discs hold the exact ones): a disc whose
         // cell disc holds the whole cell constrains nothing (most sensor points, inside a
         // microimage), and only the others need their ellipses.
-        const Vec3 s = lens_frame_point(a, s_array);
+        const Vec3 c3{a.c.x, a.c.y, a.z};
+        const Vec3 sp = mul_transposed(a.axes, s_array - c3);  // lens_frame_point's, once
+        const Vec3 s = c3 + sp;
         int count = 0;
         for (int k = 0; k <= a.cuts; ++k) {
             const AimDisc flat = k == 0 ? cell_disc(a, s, a.m, a.rho) : cell_disc(a, s, a.cut_m[k - 1], a.cut_rho[k - 1]);
             if (!(flat.radius < std::numeric_limits<double>::infinity()) ||
                 std::sqrt(flat.centre.x * flat.centre.x + flat.centre.y * flat.centre.y) + a.circumradius <= flat.radius)
                 continue;
-            const AimDisc d = tilted_cell_disc(a, s_array, k);
+            const AimDisc d = tilted_cell_disc(a, sp, k);
             if (d.radius < std::numeric_limits<double>::infinity())
                 discs[count++] = d;
         }
@@ -861,12 +872,12 @@ bool cell_x_range(const LensAim& a, const AimDisc* discs, int count, double* x0,
 
 AimDisc lit_cell_disc(const LensAim& a, Vec3 s)
 {
-    return a.tilted ? tilted_cell_disc(a, s, 0) : cell_disc(a, s, a.m, a.rho);
+    return a.tilted ? tilted_cell_disc(a, lens_frame_offset(a, s), 0) : cell_disc(a, s, a.m, a.rho);
 }
 
 AimDisc lit_cell_cut(const LensAim& a, Vec3 s, int k)
 {
-    return a.tilted ? tilted_cell_disc(a, s, k + 1) : cell_disc(a, s, a.cut_m[k], a.cut_rho[k]);
+    return a.tilted ? tilted_cell_disc(a, lens_frame_offset(a, s), k + 1) : cell_disc(a, s, a.cut_m[k], a.cut_rho[k]);
 }
 
 bool lit_cell_x_range(const LensAim& a, Vec3 s, double* x0, double* x1)
