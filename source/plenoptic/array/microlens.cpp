@@ -92,7 +92,11 @@ public:
             const Vec3 refracted{w.x / w.z - offset.x / f, w.y / w.z - offset.y / f, 1};
             return ArrayRay{leave, mul(array.pose.rotation, refracted), true, leave};
         }
-        const LensFrame frame = array.frame(lens);
+        return cell_ray_in(array, p, array.frame(lens), offset);
+    }
+
+    ArrayRay cell_ray_in(const MicrolensArray& array, const Vec3& p, const LensFrame& frame, Vec2 offset) const override
+    {
         const bool lens_part = array.in_aperture(offset);
         if (!lens_part && array.mask)
             return no_ray();

@@ -16,6 +16,7 @@
 namespace plenoptic {
 
 struct MicrolensArray;
+struct LensFrame;
 
 // A ray leaving a microlens: where it leaves (optics frame, mm) and its direction (any length).
 // passed false: there is no such ray (the other fields are then meaningless). `sampled`: the
@@ -86,6 +87,18 @@ public:
         (void)array;
         (void)p;
         (void)lens;
+        (void)offset;
+        return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false, Vec3{0, 0, 0}};
+    }
+
+    // The same through a lens whose frame (MicrolensArray::frame) the caller holds: what cell_ray
+    // does for an array with errors or a fill factor, without looking the lens up again (the aim
+    // keeps the frames of the lenses it aims at).
+    virtual ArrayRay cell_ray_in(const MicrolensArray& array, const Vec3& p, const LensFrame& frame, Vec2 offset) const
+    {
+        (void)array;
+        (void)p;
+        (void)frame;
         (void)offset;
         return ArrayRay{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false, Vec3{0, 0, 0}};
     }

@@ -1541,6 +1541,19 @@ PixelAim aim_pixel(const PlenopticCamera& m, int i, int j, double pixel_u, doubl
     return out;
 }
 
+namespace {
+
+// The cell's point (u, v) uniformly, as sample_ray takes it; through `frame` when the caller keeps
+// the lens's frame.
+inline ArrayRay uniform_cell_ray(const MicrolensArray& array, const Vec3& p, LensIndex lens, const LensFrame* frame,
+                                 double u, double v)
+{
+    return frame ? array.microlens->cell_ray_in(array, p, *frame, array.cell_point(u, v))
+                 : array.microlens->sample_ray(array, p, lens, u, v);
+}
+
+} // namespace
+
 ArrayRay aimed_cell_ray(const PlenopticCamera& m, const Vec3& p, LensIndex lens, double u, double v, double* weight)
 {
     *weight = 1;
@@ -1552,8 +1565,12 @@ ArrayRay aimed_cell_ray(const PlenopticCamera& m, const Vec3& p, LensIndex lens,
         int count = 0, next = 0, last = 0;
         bool aimed[8];
         LensAim aim[8];
+        LensFrame frame[8];  // framed: each lens's frame
     };
     static thread_local CachedLenses cache;
+    // An ideal array filling its cells takes its lenses from the lattice (cell_ray's own path); the
+    // others' frames are looked up once a lens here, not again for every sample.
+    const bool framed = array.errors || array.aperture_scale != 1;
     if (!(cache.count > 0 && key_is(cache.key, m))) {
         cache.key = key_of(m);
         cache.count = cache.next = 0;
@@ -1569,14 +1586,17 @@ ArrayRay aimed_cell_ray(const PlenopticCamera& m, const Vec3& p, LensIndex lens,
         cache.count = std::max(cache.count, found + 1);
         cache.aimed[found] = lens_aim(m, lens, &cache.aim[found]);
         cache.aim[found].lens = lens;
+        if (framed)
+            cache.frame[found] = array.frame(lens);
     }
     cache.last = found;
+    const LensFrame* frame = framed ? &cache.frame[found] : nullptr;
     if (!cache.aimed[found])
-        return array.microlens->sample_ray(array, p, lens, u, v);
+        return uniform_cell_ray(array, p, lens, frame, u, v);
     const LensAim& a = cache.aim[found];
     const Vec3 s = array.to_local(p);
     if (!(a.z - lens_frame_point(a, s).z > 0))
-        return array.microlens->sample_ray(array, p, lens, u, v);
+        return uniform_cell_ray(array, p, lens, frame, u, v);
     AimDisc discs[1 + LensAim::kMaxCuts];
     const int count = cell_discs(a, s, discs);
     bool whole = true;
@@ -1585,7 +1605,7 @@ ArrayRay aimed_cell_ray(const PlenopticCamera& m, const Vec3& p, LensIndex lens,
                     a.circumradius <=
                 discs[k].radius;
     if (whole)
-        return array.microlens->sample_ray(array, p, lens, u, v);  // the whole cell may pass
+        return uniform_cell_ray(array, p, lens, frame, u, v);  // the whole cell may pass
     // The cell's part in the discs: x uniform over its exact x range, y over the cell's height and
     // the discs' chords at x.
     const ArrayRay none{Vec3{0, 0, 0}, Vec3{0, 0, 0}, false, Vec3{0, 0, 0}};
@@ -1606,7 +1626,8 @@ ArrayRay aimed_cell_ray(const PlenopticCamera& m, const Vec3& p, LensIndex lens,
         return none;
     const double area = a.grid == GridType::Hexagonal ? 0.5 * kSqrt3 * a.pitch * a.pitch : a.pitch * a.pitch;
     *weight = (hi - lo) * (y1 - y0) / area;
-    return array.microlens->cell_ray(array, p, lens, Vec2{x, y0 + v * (y1 - y0)});
+    const Vec2 offset{x, y0 + v * (y1 - y0)};
+    return frame ? array.microlens->cell_ray_in(array, p, *frame, offset) : array.microlens->cell_ray(array, p, lens, offset);
 }
 
 } // namespace plenoptic
