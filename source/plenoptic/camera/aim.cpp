@@ -13,6 +13,7 @@
 #include "plenoptic/array/microlens_array.h"
 #include "plenoptic/camera/camera_key.h"
 #include "plenoptic/camera/rays.h"
+#include "plenoptic/core/convex_hull.h"
 #include "plenoptic/camera/rays_internal.h"
 #include "plenoptic/lens/main_lens.h"
 #include "plenoptic/lens/pupil_bounds.h"
@@ -429,19 +430,8 @@ bool widen_by_segment(RoundedPolygon* r, Vec2 u)
         points[n++] = r->corner[k] - u;
         points[n++] = r->corner[k] + u;
     }
-    std::sort(points, points + n, [](Vec2 a, Vec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
     Vec2 hull[32];
-    int h = 0;
-    for (int pass = 0; pass < 2; ++pass) {
-        const int start = h;
-        for (int k = 0; k < n; ++k) {
-            const Vec2 p = pass == 0 ? points[k] : points[n - 1 - k];
-            while (h >= start + 2 && cross(hull[h - 1] - hull[h - 2], p - hull[h - 2]) <= 0)
-                --h;
-            hull[h++] = p;
-        }
-        --h;  // the chain's last point starts the other chain
-    }
+    const int h = convex_hull(points, n, hull);
     if (!(h >= 1 && h <= capacity))
         return false;
     r->corners = h;

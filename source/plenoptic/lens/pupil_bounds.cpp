@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <exception>
 
+#include "plenoptic/core/convex_hull.h"
 #include "plenoptic/core/setup_progress.h"
 #include "plenoptic/core/threads.h"
 
@@ -94,22 +95,10 @@ void keep_convex_hull(std::vector<Vec2>* points)
     std::vector<Vec2>& p = *points;
     if (p.size() < 3)
         return;
-    std::sort(p.begin(), p.end(), [](Vec2 a, Vec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
     std::vector<Vec2> hull(2 * p.size());
-    size_t h = 0;
-    auto turn = [](Vec2 o, Vec2 a, Vec2 b) { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); };
-    for (size_t k = 0; k < p.size(); ++k) {  // lower chain
-        while (h >= 2 && turn(hull[h - 2], hull[h - 1], p[k]) <= 0)
-            --h;
-        hull[h++] = p[k];
-    }
-    for (size_t k = p.size() - 1, lower = h + 1; k-- > 0;) {  // upper chain
-        while (h >= lower && turn(hull[h - 2], hull[h - 1], p[k]) <= 0)
-            --h;
-        hull[h++] = p[k];
-    }
-    p.assign(hull.begin(), hull.begin() + std::ptrdiff_t(h - 1));  // the last point is the first
-    p.shrink_to_fit();
+    hull.resize(size_t(convex_hull(p.data(), int(p.size()), hull.data())));
+    hull.shrink_to_fit();
+    p.swap(hull);
 }
 
 // Whether any ray from field radius r passes, and then the bin's disc.
