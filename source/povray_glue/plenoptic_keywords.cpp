@@ -6,6 +6,7 @@
 #include "povray_glue/plenoptic_keywords.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 
@@ -28,6 +29,14 @@ std::string Check_F_Number(const char *, double value) { return check_f_number(v
 std::string Check_Focus_Distance(const char *, double value) { return check_focus_distance(value); }
 std::string Check_Mm_Per_Unit(const char *, double value) { return check_mm_per_unit(value); }
 std::string Check_Confidence(const char *, double value) { return check_confidence(value); }
+// 0 (every lens measured) or a spacing of at least 4 lenses (MicroimageOptions::error_anchor_step).
+std::string Check_Error_Anchors(const char *label, double value)
+{
+    if (!(value == 0 || (value >= 4 && value <= 4096 && value == std::floor(value))))
+        return std::string(label) + " must be 0 (every lens measured) or a whole number of lenses from 4 to 4096, got " +
+               format_number(value);
+    return "";
+}
 std::string Check_Variance(const char *, double value) { return check_variance(value); }
 std::string Check_Blades(const char *, double value) { return check_blades(value); }
 std::string Check_Wavelength(const char *, double value) { return check_wavelength(value); }
@@ -127,6 +136,11 @@ std::vector<Keyword> make_table()
                 [](CameraSetup& s, R r) {
                     s.microimage_centres = (r.values[0] != 0) ? CameraSetup::kWrite : CameraSetup::kDoNotWrite;
                 }),
+        Keyword("microimage_error_anchors", B::Camera, V::Number, "0",
+                "refracting microlenses with manufacturing errors: the microimage centres correct each lens from "
+                "Jacobian anchors N lenses apart (0: every lens measured)",
+                [](CameraSetup& s, R r) { s.microimage_error_anchors = (int)r.values[0]; })
+            .checked(Check_Error_Anchors),
         Keyword("white_image", B::Camera, V::OnOff, "off", "also write the camera's white image(s)",
                 [](CameraSetup& s, R r) {
                     s.white_image = WhiteImageRequest();

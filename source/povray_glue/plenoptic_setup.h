@@ -21,6 +21,10 @@ struct CameraSetup {
     // centres leave the metadata's lattice (a traced prescription, a thin lens with distortion).
     enum MicroimageCentres { kDefault, kWrite, kDoNotWrite };
     MicroimageCentres microimage_centres = kDefault;
+    // `microimage_error_anchors N`: refracting microlenses with manufacturing errors, the truth
+    // corrected from Jacobian anchors N lenses apart (MicroimageOptions::error_anchor_step); 0, the
+    // default, measures every lens.
+    int microimage_error_anchors = 0;
     // `white_image [f_numbers <N...>] [noise_free]`: <output>.white.png (one per f-number).
     WhiteImageRequest white_image;
 

@@ -15,9 +15,11 @@ namespace plenoptic {
 namespace microimage_detail {
 
 // Manufacturing errors on refracting microlenses, corrected (MicroimageOptions::error_anchor_step;
-// renders measure every lens). Measuring each lens costs some 150 ms (its 24 x 24 cell points, its
-// regions less alike its neighbour's than on an ideal array), ten hours for a raw; but the errors are small (a fraction of a micrometre, a few per cent, a fraction of a
-// degree) and a lens's microimage changes smoothly with most of them. So a lens with errors is
+// renders with the camera's microimage_error_anchors N; by default every lens is measured).
+// Measuring each lens costs some 150 ms (its 24 x 24 cell points, its regions less alike its
+// neighbour's than on an ideal array), ten hours for a raw; but the errors are small (a fraction of a
+// micrometre, a few per cent, a fraction of a degree) and a lens's microimage changes smoothly with
+// most of them. So a lens with errors is
 // taken as the ideal lens that sits where it sits (the anchors' cubic at its displaced centre: its
 // cell and its neighbours moved with it), corrected to second order in each of its parameters x_p:
 // its displacement along the axis, its focal factor less 1, its axis's x and y, and each adjacent

@@ -3,10 +3,12 @@
 // this camera (truth/microimages.h), and their summary in the metadata. Needs a main lens and an
 // array; `microimage_centres` on or off, and by default written only where the centres leave the
 // lattice the metadata gives (a traced lens, a thin lens with distortion, an array with manufacturing
-// errors).
+// errors). `microimage_error_anchors N` corrects refracting microlenses with errors from Jacobian
+// anchors N lenses apart instead of measuring each.
 
 #include <cstdio>
 
+#include "plenoptic/array/refracting_microlens.h"
 #include "plenoptic/truth/microimages.h"
 #include "povray_glue/outputs/files.h"
 #include "povray_glue/outputs/render.h"
@@ -20,7 +22,9 @@ public:
     bool write(const WrittenImage& image, SidecarFiles& files) override
     {
         const PlenopticCamera& model = image.camera;
-        const MicroimageOptions options = default_microimage_options();
+        MicroimageOptions options = default_microimage_options();
+        options.error_anchor_step = error_anchors_;
+        warn_if_slow(model);
         // Seconds for large arrays (a fraction of a millisecond a lens and thread behind a real lens): say
         // how far.
         const MicroimageProgress progress = [](std::size_t done, std::size_t total) {
@@ -80,7 +84,28 @@ public:
         return true;
     }
 
+    explicit MicroimagesOutput(int error_anchors) : error_anchors_(error_anchors) {}
+
 private:
+    // Refracting microlenses with manufacturing errors, each measured (150 ms of CPU a lens behind
+    // the 22 mm wide-angle: BENCHMARKS.md, "Refracting microlenses with errors, corrected"): from
+    // some 20,000 lenses, hours; say so before they start, and name the keyword that takes minutes.
+    void warn_if_slow(const PlenopticCamera& model) const
+    {
+        const MicrolensArray& array = model.array;
+        if (error_anchors_ != 0 || !array.errors || !array.microlens || !refracting_shape(*array.microlens))
+            return;
+        const Film film = model.sensor.film;
+        const double lenses = film.width * model.sensor.pixel_size_mm[0] * film.height * model.sensor.pixel_size_mm[1] /
+                              (array.pitch_mm * array.row_spacing_mm());
+        if (lenses >= 20000)
+            std::fprintf(stderr, "plenoptic camera: microimage centres: about %.0f refracting microlenses with "
+                                 "manufacturing errors, each measured (some 0.1 s of CPU a lens: hours); "
+                                 "microimage_error_anchors 64 corrects them from anchors instead (minutes, within "
+                                 "about 0.01 px), microimage_centres off skips them\n", lenses);
+    }
+
+    int error_anchors_;  // `microimage_error_anchors`
     std::unique_ptr<MicroimageSummary> summary_;  // what the metadata names, once written
 };
 
@@ -94,7 +119,7 @@ std::unique_ptr<Output> start_microimages(const Render& render, const RenderArea
     if (model.array.grid == GridType::None || !model.lens ||
         !(asked == CameraSetup::kWrite || (asked == CameraSetup::kDefault && off_lattice)))
         return nullptr;
-    return std::unique_ptr<Output>(new MicroimagesOutput());
+    return std::unique_ptr<Output>(new MicroimagesOutput(render.setup().microimage_error_anchors));
 }
 
 } // namespace plenoptic
