@@ -4,6 +4,7 @@
 #include "plenoptic/array/array_params.h"
 
 #include <cmath>
+#include <vector>
 
 namespace plenoptic {
 
@@ -30,9 +31,16 @@ MicrolensArray make_microlens_array(const ArrayParams& params, double array_z)
     array.abbe = params.abbe;
     if (params.has_errors)
         array.errors = LensErrors::drawn(params.errors);
-    else if (!params.lens_table_file.empty())
-        array.errors = LensErrors::tabled(params.lens_table ? *params.lens_table : std::vector<LensTableRow>(), params.lens_table_file, params.focal_lengths_mm,
-                                          params.lens == MicrolensType::Pinhole ? 0 : array.lens_type_count);
+    else if (!params.lens_table_file.empty()) {
+        // A row's focal_length_mm becomes a factor of its type's focal length as the microlens gives
+        // it (a refracting cap's paraxial one; none for pinholes).
+        std::vector<double> type_focal_mm;
+        if (array.microlens->forms_image())
+            for (int type = 0; type < array.lens_type_count; ++type)
+                type_focal_mm.push_back(array.microlens->focal_length_mm(type));
+        array.errors = LensErrors::tabled(params.lens_table ? *params.lens_table : std::vector<LensTableRow>(),
+                                          params.lens_table_file, type_focal_mm.data(), int(type_focal_mm.size()));
+    }
     array.fill_factor = params.fill_factor;
     array.aperture_scale = params.fill_factor == 1 ? 1 : std::sqrt(params.fill_factor);
     array.mask = params.mask;
