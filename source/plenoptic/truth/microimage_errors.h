@@ -19,9 +19,9 @@ namespace microimage_detail {
 // Measuring each lens costs some 150 ms (its 24 x 24 cell points, its regions less alike its
 // neighbour's than on an ideal array), ten hours for a raw; but the errors are small (a fraction of a
 // micrometre, a few per cent, a fraction of a degree) and a lens's microimage changes smoothly with
-// most of them. So a lens with errors is
-// taken as the ideal lens that sits where it sits (the anchors' cubic at its displaced centre: its
-// cell and its neighbours moved with it), corrected to second order in each of its parameters x_p:
+// most of them. So a lens with errors is taken as the ideal lens that sits where it sits (the
+// anchors' cubic at its displaced centre: its cell and its neighbours moved with it), corrected to
+// second order in each of its parameters x_p:
 // its displacement along the axis, its focal factor less 1, its axis's x and y, and each adjacent
 // lens's displacement from it (x and y, array frame: where the walls between their columns and the
 // bisector that cuts its cell lie). The correction is the sum over p of J_p x_p + H_p x_p^2 / 2 +
