@@ -5,6 +5,7 @@
 #define PLENOPTIC_PIXEL_H
 
 #include <algorithm>
+#include <cstdint>
 
 #include "plenoptic/camera/aim.h"
 #include "plenoptic/camera/rays.h"
@@ -87,31 +88,31 @@ inline void add_sample(SampleSums<N>* s, const Channels<N>& c)
 
 // The pixel value and, per channel, the variance of that estimate. One lens: the mean of its
 // samples. Several lenses: the sum over lenses of the mean over each lens's samples (irradiance
-// adds), scaled up when fewer samples than lenses left some lens without a sample.
+// adds). Fewer samples than lenses (lens_sample's first round, unfinished): slot 0 has its sample
+// and the other lenses sampled are a random choice among them (a rotation drawn per pixel), each
+// equally likely, so their sum, scaled by (L - 1) over their number, is an unbiased estimate of
+// the others' sum; slot 0's light (its own lens's, where most of a pixel's light comes from) is
+// never scaled. With one sample only slot 0 counts (the 1-sample pixel's chief ray).
 template <int N>
 inline void estimate(const SampleSums<N>* sums, int lenses, double value[N], double variance[N])
 {
-    int sampled = 0;
     for (int ch = 0; ch < N; ++ch)
         value[ch] = variance[ch] = 0;
+    int others = 0;  // lenses other than slot 0 with a sample
+    for (int s = 1; s < lenses; ++s)
+        others += sums[s].count > 0;
+    const double scale = others > 0 ? double(lenses - 1) / others : 0;
     for (int s = 0; s < lenses; ++s) {
         const int n = sums[s].count;
         if (n == 0)
             continue;
-        ++sampled;
+        const double k = s == 0 ? 1 : scale;
         for (int ch = 0; ch < N; ++ch) {
             const double mean = sums[s].sum[ch] / n;
-            value[ch] += mean;
+            value[ch] += k * mean;
             // Variance of the mean, as focal_blur computes it: (E[x^2] - E[x]^2) / n.
-            variance[ch] += (sums[s].sum_sq[ch] / n - mean * mean) / n;
+            variance[ch] += k * k * (sums[s].sum_sq[ch] / n - mean * mean) / n;
         }
-    }
-    if (sampled == 0)
-        return;
-    const double scale = double(lenses) / sampled;
-    for (int ch = 0; ch < N; ++ch) {
-        value[ch] *= scale;
-        variance[ch] *= scale * scale;
     }
 }
 
@@ -125,9 +126,28 @@ inline Channels<N> scaled(const double sum[N], double scale)
     return c;
 }
 
+// Which of a pixel's `others` lenses after slot 0 its samples visit first: a rotation drawn from
+// the pixel and the sample stream (a hash: the same on every thread and in every tile).
+inline int lens_rotation(int i, int j, int stream, int others)
+{
+    std::uint32_t h =
+        std::uint32_t(i) * 0x9E3779B1u ^ std::uint32_t(j) * 0x85EBCA77u ^ std::uint32_t(stream) * 0xC2B2AE3Du;
+    h ^= h >> 15;
+    h *= 0x2C1B3C6Du;
+    h ^= h >> 12;
+    h *= 0x297A2D39u;
+    h ^= h >> 15;
+    return int(h % std::uint32_t(others));
+}
+
 // Sample n of `count` samples of pixel (i, j) whose light comes through `lenses` lenses (overlap
-// modelling): it goes through lens slot n mod lenses (*slot), as sample n / lenses of that
-// lens's own stream of make_sample. So each lens gets a whole low-discrepancy pattern over the
+// modelling). Samples go round the lenses, slot n mod L, except in the first round: there the
+// first goes through slot 0 (the pixel's own lens) and the others through slots 1 .. L-1 in an
+// order rotated per pixel (lens_rotation), so that when a pixel takes fewer samples than it has
+// lenses, the lenses beyond its own that get one are a random choice (estimate scales their sum
+// up, unbiased), not always the same neighbours; a round holds every lens once either way, so
+// the points each lens gets are the same. Sample n goes through its lens as sample n / L of that
+// lens's own stream of make_sample, so each lens gets a whole low-discrepancy pattern over the
 // pixel and the aperture, and the lenses' shares differ by one sample at most. (Every L-th point
 // of one Halton sequence is not such a pattern: with L = 2, the even points have their base-2
 // coordinate, the aperture's u, all in one half of [0, 1).) With one lens this is exactly
@@ -135,6 +155,8 @@ inline Channels<N> scaled(const double sum[N], double scale)
 inline CameraSample lens_sample(int i, int j, int n, int count, int lenses, int* slot, int stream = 0)
 {
     *slot = n % lenses;
+    if (n < lenses && n > 0)
+        *slot = 1 + (n - 1 + lens_rotation(i, j, stream, lenses - 1)) % (lenses - 1);
     // `count`, not the lens's share of it: only a 1-sample pixel is sampled at its centre, and a
     // lens that gets one sample of several gets a random point (point 0 of its rotated stream).
     return make_sample(i, j, n / lenses, count, stream + *slot);
@@ -446,10 +468,13 @@ Channels<N> pixel_channels(const PlenopticCamera& model, int i, int j, TraceFn& 
 // (no array, round stop) every pixel of n > 1 samples is the mean colour of its passing samples
 // times its lit area from the table, averaged over a 4 x 4 grid (detail::lit_area_value). With one sample,
 // the chief ray alone (weighted by the lit area at the pixel's centre).
-// With overlap modelling, sample n goes through the pixel's lens n mod L (L lenses from
-// overlap_lenses; with aimed samples, less those whose light cannot reach the pixel:
-// aim_reaches_pixel) as sample n / L of that lens's own sample stream (detail::lens_sample), and
-// the value is the sum over lenses of each lens's mean; t is clamped to [0, 1]. A pixel that no
+// With overlap modelling, the samples go round the pixel's L lenses (from overlap_lenses; with
+// aimed samples, less those whose light cannot reach the pixel: aim_reaches_pixel), its own lens
+// first in each round and the others in an order rotated per pixel, each as sample n / L of that
+// lens's own sample stream (detail::lens_sample), and the value is the sum over lenses of each
+// lens's mean; with fewer samples than lenses, the other lenses' sum is scaled up by L - 1 over
+// their number sampled (detail::estimate: unbiased, as the rotation is random); t is clamped to
+// [0, 1]. A pixel that no
 // lens reaches is black and opaque, never background. With spectral sampling, the samples are shared
 // among the wavelength bands (detail::spectral_pixel).
 template <class TraceFn>

@@ -240,7 +240,12 @@ TEST(Pixel, OverlapLensesEachGetAWholeSamplePattern)
             for (int n = 0; n < count; ++n) {
                 int slot = -1;
                 const CameraSample s = detail::lens_sample(3 * pixel, 100 - pixel, n, count, lenses, &slot);
-                ASSERT_EQ(slot, n % lenses);
+                // Each round of L samples: the own lens (slot 0) first, then every other lens once
+                // (in the first round in a rotated order, then in order).
+                ASSERT_EQ(slot == 0, n % lenses == 0);
+                ASSERT_EQ(share[slot], n / lenses);
+                if (n >= lenses)
+                    ASSERT_EQ(slot, n % lenses);
                 const double v[4] = {s.pixel_u, s.pixel_v, s.lens_u, s.lens_v};
                 for (int d = 0; d < 4; ++d) {
                     sum[slot][d] += v[d];
@@ -270,6 +275,57 @@ TEST(Pixel, OverlapLensesEachGetAWholeSamplePattern)
         EXPECT_EQ(a.pixel_v, b.pixel_v);
         EXPECT_EQ(a.lens_u, b.lens_u);
         EXPECT_EQ(a.lens_v, b.lens_v);
+    }
+}
+
+TEST(Pixel, FewerSamplesThanLensesStillEstimateTheSumOverLenses)
+{
+    // A pixel with L lenses takes m < L samples: the sum over its lenses of each lens's light, here a
+    // constant a lens (any sample through lens s sees v[s]), must come out right on average over
+    // pixels: the own lens's always, the others' as a random choice scaled by (L - 1) / (m - 1).
+    // The sum is known (independent of the code); the old rule (samples to lenses 0 .. m-1 in
+    // order, the sum scaled by L / m) gave L / m times the first m lenses' light: 2.7 times the
+    // truth here for m = 3 of L = 7. Also: every lens is used, and one sample gives the own lens.
+    const int L = 7;
+    const double v[L] = {0.5, 0.0, 0.3, 0.0, 0.1, 0.05, 0.2};
+    const double truth = 0.5 + 0.0 + 0.3 + 0.0 + 0.1 + 0.05 + 0.2;
+    for (int m = 1; m <= 2 * L + 1; ++m) {
+        double total = 0;
+        int pixels = 0;
+        int used[L] = {};
+        for (int j = 0; j < 60; ++j) {
+            for (int i = 0; i < 60; ++i) {
+                detail::SampleSums<1> sums[L];
+                for (int s = 0; s < L; ++s) {
+                    sums[s].sum[0] = sums[s].sum_sq[0] = 0;
+                    sums[s].count = 0;
+                }
+                for (int n = 0; n < m; ++n) {
+                    int slot = -1;
+                    detail::lens_sample(i, j, n, m, L, &slot);
+                    ASSERT_GE(slot, 0);
+                    ASSERT_LT(slot, L);
+                    ++used[slot];
+                    detail::Channels<1> c;
+                    c.v[0] = v[slot];
+                    detail::add_sample<1>(&sums[slot], c);
+                }
+                double value[1], variance[1];
+                detail::estimate<1>(sums, L, value, variance);
+                total += value[0];
+                ++pixels;
+            }
+        }
+        const double mean = total / pixels;
+        if (m == 1) {
+            EXPECT_DOUBLE_EQ(mean, v[0]);  // the 1-sample pixel: its own lens
+            continue;
+        }
+        // The others' part is a random choice of m - 1 of 6 lenses a pixel: over 3600 pixels its
+        // mean is within 2 % of theirs (m >= L: every lens sampled, exact).
+        EXPECT_NEAR(mean, truth, m >= L ? 1e-12 : 0.02 * truth) << m << " samples of " << L << " lenses";
+        for (int s = 1; s < L; ++s)
+            EXPECT_GT(used[s], 0) << "lens slot " << s << " never sampled with " << m << " samples";
     }
 }
 
