@@ -219,3 +219,28 @@ def test_a_lens_table_of_refracting_lenses_gives_the_same_truth(args):
     print("tabled against drawn: %d lenses inside the table, largest %.2g px" % (inside.sum(), du.max()))
     assert du.max() < 1e-6
     assert np.abs(a["lit_fraction"] - b["lit_fraction"])[inside].max() < 1e-6
+
+
+def test_a_lens_table_that_shrinks_a_cap_below_its_cell_is_refused(args):
+    """A refracting lens's radius scales with its focal length (R = f (n - 1)): a table row whose
+    focal length leaves the cap narrower than its cell is refused, naming the file, the lens, its
+    focal length and the cell (0.1 mm gives R = 0.05 mm; the hexagonal cell's corners are 0.1 / sqrt(3)
+    = 0.0577 mm out). A row at 0.17 mm (R = 0.085 mm, whose cap rises 0.022 mm over the cell, within
+    its 0.025 mm thickness) is accepted."""
+    work = os.path.join(args.work, "array_errors")
+    os.makedirs(work, exist_ok=True)
+    for focal, refused in ((0.1, True), (0.17, False)):
+        table = os.path.join(work, "shrunk_%g.csv" % focal)
+        with open(table, "w") as f:
+            f.write("k,l,focal_length_mm\n0,0,%r\n" % focal)
+        status, output = pt.render(args.povray, work, "shrunk_%g" % focal,
+                                   refracting_scene(0, 'lens_table "%s"' % table).replace("samples 1", "samples 1 "
+                                   "microimage_centres off"), 40, 30, expect_failure=True)
+        text = " ".join(output.split())
+        if refused:
+            assert status != 0, text[-2000:]
+            for fragment in ("lens_table", "shrunk_0.1.csv", "lens (0, 0)", "focal_length_mm 0.1",
+                             "does not cover the lens's cell", "0.0577"):
+                assert fragment in text, (fragment, text[-2000:])
+        else:
+            assert status == 0, text[-2000:]

@@ -382,29 +382,63 @@ std::string check_microlens_conic(const char* keyword, double value)
     return "";
 }
 
+// The cap of surface radius `radius` (conic and thickness as written) over its cell: "" or what is
+// wrong with it.
+std::string check_cap(const ArrayParams& array, double radius)
+{
+    const RefractingShape& s = array.refracting;
+    RefractingShape shape = s;
+    shape.radius_mm = radius;
+    const double corner = cell_circumradius(array.grid, array.pitch_mm);
+    const char* grid = array.grid == GridType::Hexagonal ? "hexagonal" : "rectangular";
+    // The cap's surface must exist over the whole cell: a sphere out to its radius, a conic out to
+    // R / sqrt(1 + k) (k > -1).
+    const double reach = s.conic > -1 ? radius / std::sqrt(1 + s.conic) : INFINITY;
+    if (!(reach > corner))
+        return "surface radius " + format_number(radius) + " mm" +
+               (s.conic != 0 ? " with conic " + format_number(s.conic) + " (the surface ends " +
+                               format_number(reach) + " mm from the axis)" : std::string()) +
+               " does not cover the lens's cell: its corners are " + format_number(corner) + " mm from the centre (" +
+               grid + " pitch " + format_number(array.pitch_mm) + " mm); the radius must exceed that (a flatter cap)";
+    const double height = shape.sag(corner * corner);
+    if (!(height <= s.cap_mm))
+        return "the cap rises " + format_number(height) + " mm from its cell's corners to its vertex (surface radius " +
+               format_number(radius) + " mm over " + format_number(corner) + " mm), more than its thickness " +
+               format_number(s.cap_mm) + " mm; give thickness at least that, or a larger radius";
+    return "";
+}
+
 std::string check_refracting_shape(const ArrayParams& array)
 {
     const RefractingShape& s = array.refracting;
     if (array.fill_factor != 1 || array.mask)
         return "microlens_array fill_factor and mask are not modelled for refracting microlenses (lens { }): their "
                "caps fill their cells";
-    const double corner = cell_circumradius(array.grid, array.pitch_mm);
-    const char* grid = array.grid == GridType::Hexagonal ? "hexagonal" : "rectangular";
-    // The cap's surface must exist over the whole cell: a sphere out to its radius, a conic out to
-    // R / sqrt(1 + k) (k > -1).
-    const double reach = s.conic > -1 ? s.radius_mm / std::sqrt(1 + s.conic) : INFINITY;
-    if (!(reach > corner))
-        return "microlens_array lens surface radius " + format_number(s.radius_mm) + " mm" +
-               (s.conic != 0 ? " with conic " + format_number(s.conic) + " (the surface ends " +
-                               format_number(reach) + " mm from the axis)" : std::string()) +
-               " does not cover the lens's cell: its corners are " + format_number(corner) + " mm from the centre (" +
-               grid + " pitch " + format_number(array.pitch_mm) + " mm); the radius must exceed that (a flatter cap)";
-    const double height = s.sag(corner * corner);
-    if (!(height <= s.cap_mm))
-        return "microlens_array lens: the cap rises " + format_number(height) + " mm from its cell's corners to its "
-               "vertex (surface radius " + format_number(s.radius_mm) + " mm over " + format_number(corner) +
-               " mm), more than its thickness " + format_number(s.cap_mm) +
-               " mm; give thickness at least that, or a larger radius";
+    std::string message = check_cap(array, s.radius_mm);
+    if (!message.empty())
+        return "microlens_array lens " + message;
+    // A lens whose focal length is e times the cap's has its radius scaled by e (array/
+    // refracting_microlens.cpp): the smallest such cap must cover its cell too.
+    if (array.has_errors && array.errors.focal_sd > 0) {
+        const double smallest = 1 - kErrorSigmas * array.errors.focal_sd;
+        message = smallest > 0 ? check_cap(array, s.radius_mm * smallest) : "has no radius left";
+        if (!message.empty())
+            return "microlens_array errors focal_length " + format_number(array.errors.focal_sd) +
+                   ": a lens drawn at " + format_number(smallest) + " times the cap's focal length (the draws go to " +
+                   format_number(kErrorSigmas) + " standard deviations), whose radius scales with it: " + message +
+                   "; give a smaller focal_length error or a flatter cap";
+    } else if (array.lens_table) {
+        for (const LensTableRow& row : *array.lens_table) {
+            if (!(row.focal_length_mm > 0))
+                continue;
+            message = check_cap(array, s.radius_mm * row.focal_length_mm / s.focal_length_mm());
+            if (!message.empty())
+                return "microlens_array lens_table \"" + array.lens_table_file + "\": lens (" +
+                       std::to_string(row.lens.k) + ", " + std::to_string(row.lens.l) + ") of focal_length_mm " +
+                       format_number(row.focal_length_mm) + " (the cap's own is " + format_number(s.focal_length_mm()) +
+                       " mm; its radius scales with it): " + message;
+        }
+    }
     return "";
 }
 
