@@ -244,3 +244,25 @@ def test_a_lens_table_that_shrinks_a_cap_below_its_cell_is_refused(args):
                 assert fragment in text, (fragment, text[-2000:])
         else:
             assert status == 0, text[-2000:]
+
+
+def test_a_lens_table_focal_length_far_from_its_types_is_refused(args):
+    """Measured focal lengths must lie within 20 % of the lens type's (drawn errors reach 4 x 5 %):
+    1.5 times the array's 0.6 mm is refused with the lens, the value and the ratio (a row of 1e-300
+    once put a microimage centre at 1.7e298 px); 1.1 times renders."""
+    work = os.path.join(args.work, "array_errors")
+    os.makedirs(work, exist_ok=True)
+    for focal, refused in ((0.9, True), (0.66, False)):
+        table = os.path.join(work, "focal_%g.csv" % focal)
+        with open(table, "w") as f:
+            f.write("k,l,focal_length_mm\n0,0,%r\n" % focal)
+        status, output = pt.render(args.povray, work, "focal_%g" % focal,
+                                   scene(4, 'lens_table "%s"' % table, "samples 1"), 40, 30, expect_failure=True)
+        text = " ".join(output.split())
+        if refused:
+            assert status != 0, text[-2000:]
+            for fragment in ("lens_table", "lens (0, 0)", "focal_length_mm 0.9", "1.5 times its type's 0.6 mm",
+                             "within 20 %"):
+                assert fragment in text, (fragment, text[-2000:])
+        else:
+            assert status == 0, text[-2000:]

@@ -262,6 +262,8 @@ ParsedLensTable parse_lens_table(const std::string& text, double pitch_mm)
             value[f] = std::strtod(s.c_str(), &end);
             if (end == s.c_str() || *end != '\0' || !std::isfinite(value[f]))
                 return fail(number, std::string("column ") + names[f] + " holds \"" + s + "\", not a finite number");
+            if (f == F && !(value[f] > 0))
+                return fail(number, "focal_length_mm must be positive (or empty: the lens type's), got " + s);
         }
         if (value[K] != std::floor(value[K]) || value[L] != std::floor(value[L]) || std::fabs(value[K]) > 1e9 ||
             std::fabs(value[L]) > 1e9)

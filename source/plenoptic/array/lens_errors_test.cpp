@@ -290,6 +290,7 @@ TEST(LensErrors, LensTableReadsItsColumnsByName)
         {"k,l,tilt_deg\n0,0,45\n", 2, "tilt_deg"},
         {"k,l\n0.5,0\n", 2, "whole numbers"},
         {"k,l,focal_length_mm\n0,0,-1\n", 2, "positive"},
+        {"k,l,focal_length_mm\n0,0,\n1,0,0\n", 3, "positive (or empty: the lens type's), got 0"},
         {"# nothing\n", 1, "empty"},
     };
     for (const Bad& b : bad) {

@@ -547,6 +547,25 @@ std::string check_array_errors(const ArrayParams& array)
             if (row.focal_length_mm > 0 || row.error.tilt_deg > 0)
                 return "lens_table \"" + array.lens_table_file + "\": lens (" + std::to_string(row.lens.k) + ", " +
                        std::to_string(row.lens.l) + ") has a focal length or a tilt, which pinholes do not have";
+    if (!array.lens_table_file.empty() && !pinholes && array.lens_table) {
+        // A measured focal length within the drawn errors' reach of its type's (1 +- 4 x 0.05).
+        const double largest = 0.2;
+        for (const LensTableRow& row : *array.lens_table) {
+            if (!(row.focal_length_mm > 0))
+                continue;
+            const int types = array.lens == MicrolensType::ThinLens ? array.focal_length_count : 1;
+            const double type_focal = array.lens == MicrolensType::Refracting
+                                          ? array.refracting.focal_length_mm()
+                                          : array.focal_lengths_mm[types == 1 ? 0 : lens_type(row.lens, types)];
+            const double factor = row.focal_length_mm / type_focal;
+            if (!(std::fabs(factor - 1) <= largest))
+                return "lens_table \"" + array.lens_table_file + "\": lens (" + std::to_string(row.lens.k) + ", " +
+                       std::to_string(row.lens.l) + ") has focal_length_mm " + format_number(row.focal_length_mm) +
+                       ", " + format_number(factor) + " times its type's " + format_number(type_focal) +
+                       " mm; a lens's focal length must lie within " + format_number(100 * largest) +
+                       " % of its type's (as drawn errors do)";
+        }
+    }
     if (array.fill_factor != 1 || array.mask) {
         if (pinholes)
             return "microlens_array fill_factor and mask need microlenses that form an image (a pinhole passes light "
