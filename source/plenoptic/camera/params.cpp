@@ -383,8 +383,8 @@ std::string check_microlens_conic(const char* keyword, double value)
 }
 
 // The cap of surface radius `radius` (conic and thickness as written) over its cell: "" or what is
-// wrong with it.
-std::string check_cap(const ArrayParams& array, double radius)
+// wrong with it (with `height`, also a cap that rises more than its thickness).
+std::string check_cap(const ArrayParams& array, double radius, bool height_too = true)
 {
     const RefractingShape& s = array.refracting;
     RefractingShape shape = s;
@@ -401,7 +401,7 @@ std::string check_cap(const ArrayParams& array, double radius)
                " does not cover the lens's cell: its corners are " + format_number(corner) + " mm from the centre (" +
                grid + " pitch " + format_number(array.pitch_mm) + " mm); the radius must exceed that (a flatter cap)";
     const double height = shape.sag(corner * corner);
-    if (!(height <= s.cap_mm))
+    if (height_too && !(height <= s.cap_mm))
         return "the cap rises " + format_number(height) + " mm from its cell's corners to its vertex (surface radius " +
                format_number(radius) + " mm over " + format_number(corner) + " mm), more than its thickness " +
                format_number(s.cap_mm) + " mm; give thickness at least that, or a larger radius";
@@ -418,10 +418,11 @@ std::string check_refracting_shape(const ArrayParams& array)
     if (!message.empty())
         return "microlens_array lens " + message;
     // A lens whose focal length is e times the cap's has its radius scaled by e (array/
-    // refracting_microlens.cpp): the smallest such cap must cover its cell too.
+    // refracting_microlens.cpp): the smallest such cap must cover its cell too (its surface must
+    // exist out to the cell's corners; the thickness is the written cap's, checked above).
     if (array.has_errors && array.errors.focal_sd > 0) {
         const double smallest = 1 - kErrorSigmas * array.errors.focal_sd;
-        message = smallest > 0 ? check_cap(array, s.radius_mm * smallest) : "has no radius left";
+        message = smallest > 0 ? check_cap(array, s.radius_mm * smallest, false) : "has no radius left";
         if (!message.empty())
             return "microlens_array errors focal_length " + format_number(array.errors.focal_sd) +
                    ": a lens drawn at " + format_number(smallest) + " times the cap's focal length (the draws go to " +
@@ -431,7 +432,7 @@ std::string check_refracting_shape(const ArrayParams& array)
         for (const LensTableRow& row : *array.lens_table) {
             if (!(row.focal_length_mm > 0))
                 continue;
-            message = check_cap(array, s.radius_mm * row.focal_length_mm / s.focal_length_mm());
+            message = check_cap(array, s.radius_mm * row.focal_length_mm / s.focal_length_mm(), false);
             if (!message.empty())
                 return "microlens_array lens_table \"" + array.lens_table_file + "\": lens (" +
                        std::to_string(row.lens.k) + ", " + std::to_string(row.lens.l) + ") of focal_length_mm " +
