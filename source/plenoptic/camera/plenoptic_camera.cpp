@@ -38,10 +38,8 @@ struct OverlapGeometry {
 // (the rings it gives are checked against brute force in the unit tests). 0 for other lenses.
 const int kReachPupilGrid = 12, kReachCellGrid = 32;
 
-double traced_reach_mm(const PlenopticCamera& m)
+double traced_reach_of_centre_lens(const PlenopticCamera& m)
 {
-    if (!refracting_shape(*m.array.microlens) || !m.lens)
-        return 0;
     const LensIndex lens{0, 0};
     const Vec3 c = m.array.centre_mm(lens);
     const Vec3 e = m.lens->exit_pupil_centre();
@@ -78,6 +76,33 @@ double traced_reach_mm(const PlenopticCamera& m)
     }
     const double step = 2 * grown / kReachCellGrid * (m.sensor.z_mm - e.z) / (c.z - e.z);
     return reach > 0 ? 1.05 * reach + step : 0;
+}
+
+// The traced reach of lens (0, 0) as it is; where lenses tilt, also of that lens tilted by the
+// largest tilt towards 8 azimuths, at the smallest and the largest focal factor the errors give
+// (each in a camera whose other lenses are ideal), the largest of them.
+double traced_reach_mm(const PlenopticCamera& m)
+{
+    if (!refracting_shape(*m.array.microlens) || !m.lens)
+        return 0;
+    double reach = traced_reach_of_centre_lens(m);
+    if (!(m.array.errors && m.array.errors->tilts()))
+        return reach;
+    const double deviation = m.array.errors->max_focal_deviation();
+    const double focal = m.array.microlens->focal_length_mm(0);
+    for (int a = 0; a < 8; ++a) {
+        for (double factor : {1 - deviation, 1 + deviation}) {
+            LensTableRow row;
+            row.lens = LensIndex{0, 0};
+            row.error.tilt_deg = m.array.errors->max_tilt_deg();
+            row.error.tilt_azimuth_deg = 45.0 * a;
+            row.error.focal_factor = factor;
+            PlenopticCamera tilted = m;
+            tilted.array.errors = LensErrors::tabled(std::vector<LensTableRow>{row}, std::string(), &focal, 1);
+            reach = std::max(reach, traced_reach_of_centre_lens(tilted));
+        }
+    }
+    return reach;
 }
 
 OverlapGeometry overlap_geometry(const PlenopticCamera& m)

@@ -180,11 +180,12 @@ struct LensReach {
 // radii of millimetres).
 // Refracting lenses have no first-order bound: their light lands within the traced reach
 // (Overlap::reach_mm) of the lens's microimage centre (the lens centre seen from the exit pupil's
-// centre). Not pruned (always) without that reach, or where the array or a lens is tilted.
+// centre; for lenses that tilt, the largest of the tilted centre lens's: traced_reach_mm). Not
+// pruned (always) without that reach, or where the array is tilted.
 LensReach refracting_lens_reach(const PlenopticCamera& m, LensIndex lens)
 {
     LensReach r;
-    if (!(m.overlap.reach_mm > 0) || m.array.pose.tilted || (m.array.errors && m.array.errors->tilts()))
+    if (!(m.overlap.reach_mm > 0) || m.array.pose.tilted)
         return r;
     const Vec3 c = lens_centre_mm(m, lens);
     const Vec3 e = m.lens->exit_pupil_centre();

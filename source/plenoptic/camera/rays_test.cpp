@@ -450,7 +450,8 @@ TEST(Optics, OverlapPruningNeverDropsALensThatDeliversLight)
     // Refracting caps on a thick substrate (light crosses into the neighbours' glass), either side
     // facing the main lens, and with errors: the rings and the pruning come from the traced reach.
     // The point here is that no lens that delivers light is dropped; how many candidates the
-    // pruning keeps is not asserted (with tilted lenses it keeps all of them).
+    // pruning keeps is not asserted (with tilted lenses, by the reach of the centre lens tilted
+    // every way: traced_reach_mm).
     for (bool scene_side : {true, false}) {
         CameraParams refracting = plenoptic_camera(GridType::Hexagonal, 0.1, 0.16, 0.2, 50, 2.5, 50);
         test::use_refracting_caps(&refracting, 0.08, 1.5, 0.025, 0.2);
