@@ -221,48 +221,44 @@ def test_a_lens_table_of_refracting_lenses_gives_the_same_truth(args):
     assert np.abs(a["lit_fraction"] - b["lit_fraction"])[inside].max() < 1e-6
 
 
+def check_one_row_table(args, name, focal, scene_with, refused_with):
+    """Renders scene_with('lens_table "<table>"') with a table of one row, lens (0, 0) of focal
+    length `focal`: refused, naming each of `refused_with` (when given), or rendered."""
+    work = os.path.join(args.work, "array_errors")
+    os.makedirs(work, exist_ok=True)
+    table = os.path.join(work, "%s_%g.csv" % (name, focal))
+    with open(table, "w") as f:
+        f.write("k,l,focal_length_mm\n0,0,%r\n" % focal)
+    status, output = pt.render(args.povray, work, "%s_%g" % (name, focal), scene_with('lens_table "%s"' % table),
+                               40, 30, expect_failure=True)
+    text = " ".join(output.split())
+    if not refused_with:
+        assert status == 0, text[-2000:]
+        return
+    assert status != 0, text[-2000:]
+    for fragment in refused_with:
+        assert fragment in text, (fragment, text[-2000:])
+
+
 def test_a_lens_table_that_shrinks_a_cap_below_its_cell_is_refused(args):
     """A refracting lens's radius scales with its focal length (R = f (n - 1)): a table row whose
     focal length leaves the cap narrower than its cell is refused, naming the file, the lens, its
     focal length and the cell (0.1 mm gives R = 0.05 mm; the hexagonal cell's corners are 0.1 / sqrt(3)
-    = 0.0577 mm out). A row at 0.17 mm (R = 0.085 mm, whose cap rises 0.022 mm over the cell, within
-    its 0.025 mm thickness) is accepted."""
-    work = os.path.join(args.work, "array_errors")
-    os.makedirs(work, exist_ok=True)
-    for focal, refused in ((0.1, True), (0.17, False)):
-        table = os.path.join(work, "shrunk_%g.csv" % focal)
-        with open(table, "w") as f:
-            f.write("k,l,focal_length_mm\n0,0,%r\n" % focal)
-        status, output = pt.render(args.povray, work, "shrunk_%g" % focal,
-                                   refracting_scene(0, 'lens_table "%s"' % table).replace("samples 1", "samples 1 "
-                                   "microimage_centres off"), 40, 30, expect_failure=True)
-        text = " ".join(output.split())
-        if refused:
-            assert status != 0, text[-2000:]
-            for fragment in ("lens_table", "shrunk_0.1.csv", "lens (0, 0)", "focal_length_mm 0.1",
-                             "does not cover the lens's cell", "0.0577"):
-                assert fragment in text, (fragment, text[-2000:])
-        else:
-            assert status == 0, text[-2000:]
+    = 0.0577 mm out). A row at 0.17 mm (R = 0.085 mm) is accepted."""
+    def scene_with(table):
+        return refracting_scene(0, table).replace("samples 1", "samples 1 microimage_centres off")
+    check_one_row_table(args, "shrunk", 0.1, scene_with, ("lens_table", "shrunk_0.1.csv", "lens (0, 0)",
+                                                          "focal_length_mm 0.1", "does not cover the lens's cell",
+                                                          "0.0577"))
+    check_one_row_table(args, "shrunk", 0.17, scene_with, ())
 
 
 def test_a_lens_table_focal_length_far_from_its_types_is_refused(args):
     """Measured focal lengths must lie within 20 % of the lens type's (drawn errors reach 4 x 5 %):
     1.5 times the array's 0.6 mm is refused with the lens, the value and the ratio (a row of 1e-300
     once put a microimage centre at 1.7e298 px); 1.1 times renders."""
-    work = os.path.join(args.work, "array_errors")
-    os.makedirs(work, exist_ok=True)
-    for focal, refused in ((0.9, True), (0.66, False)):
-        table = os.path.join(work, "focal_%g.csv" % focal)
-        with open(table, "w") as f:
-            f.write("k,l,focal_length_mm\n0,0,%r\n" % focal)
-        status, output = pt.render(args.povray, work, "focal_%g" % focal,
-                                   scene(4, 'lens_table "%s"' % table, "samples 1"), 40, 30, expect_failure=True)
-        text = " ".join(output.split())
-        if refused:
-            assert status != 0, text[-2000:]
-            for fragment in ("lens_table", "lens (0, 0)", "focal_length_mm 0.9", "1.5 times its type's 0.6 mm",
-                             "within 20 %"):
-                assert fragment in text, (fragment, text[-2000:])
-        else:
-            assert status == 0, text[-2000:]
+    def scene_with(table):
+        return scene(4, table, "samples 1")
+    check_one_row_table(args, "focal", 0.9, scene_with, ("lens_table", "lens (0, 0)", "focal_length_mm 0.9",
+                                                         "1.5 times its type's 0.6 mm", "within 20 %"))
+    check_one_row_table(args, "focal", 0.66, scene_with, ())
