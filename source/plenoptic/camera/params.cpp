@@ -382,9 +382,13 @@ std::string check_microlens_conic(const char* keyword, double value)
     return "";
 }
 
+// The largest deviation of a lens's focal length from its type's, drawn (4 standard deviations of
+// at most 0.05) or tabled.
+const double kMaxFocalDeviation = 0.2;
+
 // The cap of surface radius `radius` (conic and thickness as written) over its cell: "" or what is
 // wrong with it (with `height`, also a cap that rises more than its thickness).
-std::string check_cap(const ArrayParams& array, double radius, bool height_too = true)
+static std::string check_cap(const ArrayParams& array, double radius, bool height_too = true)
 {
     const RefractingShape& s = array.refracting;
     RefractingShape shape = s;
@@ -420,9 +424,10 @@ std::string check_refracting_shape(const ArrayParams& array)
     // A lens whose focal length is e times the cap's has its radius scaled by e (array/
     // refracting_microlens.cpp): the smallest such cap must cover its cell too (its surface must
     // exist out to the cell's corners; the thickness is the written cap's, checked above).
-    if (array.has_errors && array.errors.focal_sd > 0) {
+    // (A deviation beyond the drawn errors' limit is refused by check_array_errors, naming it.)
+    if (array.has_errors && array.errors.focal_sd > 0 && array.errors.focal_sd < kMaxFocalDeviation / kErrorSigmas) {
         const double smallest = 1 - kErrorSigmas * array.errors.focal_sd;
-        message = smallest > 0 ? check_cap(array, s.radius_mm * smallest, false) : "has no radius left";
+        message = check_cap(array, s.radius_mm * smallest, false);
         if (!message.empty())
             return "microlens_array errors focal_length " + format_number(array.errors.focal_sd) +
                    ": a lens drawn at " + format_number(smallest) + " times the cap's focal length (the draws go to " +
@@ -536,9 +541,9 @@ std::string check_array_errors(const ArrayParams& array)
         if (!(e.position_sd_z_mm < array.pitch_mm / (4 * kErrorSigmas)))
             return "errors position: S_z " + format_number(e.position_sd_z_mm) + " must be below " +
                    format_number(array.pitch_mm / (4 * kErrorSigmas)) + " mm (pitch / 16)";
-        if (!(e.focal_sd < 0.2 / kErrorSigmas))
+        if (!(e.focal_sd < kMaxFocalDeviation / kErrorSigmas))
             return "errors focal_length " + format_number(e.focal_sd) + " must be below " +
-                   format_number(0.2 / kErrorSigmas) + " (a relative standard deviation: 0.01 is 1 %)";
+                   format_number(kMaxFocalDeviation / kErrorSigmas) + " (a relative standard deviation: 0.01 is 1 %)";
         if (pinholes && (e.focal_sd > 0 || e.rotation_deg > 0))
             return "errors focal_length and rotation need microlenses that form an image (pinholes have neither a focal "
                    "length nor an axis): use position only";
@@ -549,8 +554,8 @@ std::string check_array_errors(const ArrayParams& array)
                 return "lens_table \"" + array.lens_table_file + "\": lens (" + std::to_string(row.lens.k) + ", " +
                        std::to_string(row.lens.l) + ") has a focal length or a tilt, which pinholes do not have";
     if (!array.lens_table_file.empty() && !pinholes && array.lens_table) {
-        // A measured focal length within the drawn errors' reach of its type's (1 +- 4 x 0.05).
-        const double largest = 0.2;
+        // A measured focal length within the drawn errors' reach of its type's.
+        const double largest = kMaxFocalDeviation;
         for (const LensTableRow& row : *array.lens_table) {
             if (!(row.focal_length_mm > 0))
                 continue;
