@@ -236,8 +236,10 @@ def check_one_row_table(args, name, focal, scene_with, refused_with):
         assert status == 0, text[-2000:]
         return
     assert status != 0, text[-2000:]
+    # POV-Ray wraps its messages at 80 columns, inside long words (paths) too: compare without spaces.
+    squashed = "".join(output.split())
     for fragment in refused_with:
-        assert fragment in text, (fragment, text[-2000:])
+        assert "".join(fragment.split()) in squashed, (fragment, text[-2000:])
 
 
 def test_a_lens_table_that_shrinks_a_cap_below_its_cell_is_refused(args):
